@@ -1,0 +1,434 @@
+"""Gearbox and variant specifications: TOML files in, validated frozen dataclasses out.
+
+The gearbox is data. ``model_variants/gearbox.toml`` holds the reference study's parameters
+(each key cites its table or section) and, in tables whose names end in ``_assumed``, every value
+the study does not give. A variant file (``model1.toml`` ... ``model7.toml``) names the gearbox
+file and says, per component, ``"rigid"`` or ``"flexible"`` (Table 3).
+
+Field names carry their unit where the file uses one outside SI (``_mm``, ``_deg``, ``_rpm``);
+the dataclasses expose SI values through properties so that the rest of the package computes
+in SI only. Any error names the file, the field and what is allowed (:class:`SpecError`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import hashlib
+import json
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, get_type_hints
+
+__all__ = [
+    "SpecError",
+    "GearSet",
+    "GearSetAssumed",
+    "Material",
+    "ComponentsAssumed",
+    "Bearing",
+    "Bearings",
+    "Contact",
+    "ContactAssumed",
+    "LoadCase",
+    "SolverSettings",
+    "MeshingSettings",
+    "ReductionSettings",
+    "GearboxSpec",
+    "Variant",
+    "COMPONENTS",
+    "load_gearbox",
+    "load_variant",
+    "spec_hash",
+]
+
+COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
+"""Component names of Table 3, in its column order."""
+
+
+class SpecError(ValueError):
+    """A specification file is wrong: the message names the file, the field and what is allowed."""
+
+    def __init__(self, path: str | Path, fieldname: str, allowed: str, got: Any = None):
+        self.path, self.field, self.allowed = str(path), fieldname, allowed
+        got_text = "" if got is None else f", got {got!r}"
+        super().__init__(f"{path}: field '{fieldname}': {allowed}{got_text}")
+
+
+def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+         integer: bool = False, doc: str = "") -> Any:
+    """Field with a numeric range check (validated on load)."""
+    return field(metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
+
+
+def _choice(*choices: str, doc: str = "") -> Any:
+    return field(metadata={"choices": choices, "doc": doc})
+
+
+def _text(doc: str = "", default: str | None = None) -> Any:
+    if default is None:
+        return field(metadata={"doc": doc})
+    return field(default=default, metadata={"doc": doc})
+
+
+# --------------------------------------------------------------------------- gearbox tables
+@dataclass(frozen=True)
+class GearSet:
+    """Table 1 of the study (and the planet count and arrangement of section 2.1)."""
+
+    sun_teeth: int = _num(3, integer=True)
+    planet_teeth: int = _num(3, integer=True)
+    ring_teeth: int = _num(3, integer=True)
+    planet_count: int = _num(1, 12, integer=True)
+    normal_module_mm: float = _num(0.0, lo_open=True)
+    helix_angle_deg: float = _num(0.0, 45.0)
+    normal_pressure_angle_deg: float = _num(10.0, 30.0)
+    arrangement: str = _choice("star", "planetary")
+
+    @property
+    def normal_module_m(self) -> float:
+        return self.normal_module_mm * 1e-3
+
+    @property
+    def helix_angle_rad(self) -> float:
+        return math.radians(self.helix_angle_deg)
+
+    @property
+    def normal_pressure_angle_rad(self) -> float:
+        return math.radians(self.normal_pressure_angle_deg)
+
+
+@dataclass(frozen=True)
+class GearSetAssumed:
+    """Gear data the study does not give (documented in gearbox.toml)."""
+
+    face_width_mm: float = _num(0.0, lo_open=True)
+    helix_layout: str = _choice("double", "single")
+    half_gap_mm: float = _num(0.0)
+    operating_centre_distance_mm: float = _num(0.0)
+    planet_shift_coefficient: float = _num(-1.0, 1.5)
+    addendum_coefficient: float = _num(0.5, 1.5)
+    dedendum_coefficient: float = _num(0.8, 2.0)
+    root_fillet_coefficient: float = _num(0.0, 0.6)
+    normal_backlash_mm: float = _num(0.0)
+    outer_inner_mesh_phase: float = _num(0.0, 1.0)
+
+    @property
+    def face_width_m(self) -> float:
+        return self.face_width_mm * 1e-3
+
+    @property
+    def half_gap_m(self) -> float:
+        return self.half_gap_mm * 1e-3
+
+    @property
+    def operating_centre_distance_m(self) -> float:
+        return self.operating_centre_distance_mm * 1e-3
+
+    @property
+    def normal_backlash_m(self) -> float:
+        return self.normal_backlash_mm * 1e-3
+
+
+@dataclass(frozen=True)
+class Material:
+    """Gear and shaft material (assumed: through-hardened gear steel)."""
+
+    density_kg_m3: float = _num(0.0, lo_open=True)
+    youngs_modulus_pa: float = _num(0.0, lo_open=True)
+    poisson_ratio: float = _num(0.0, 0.5)
+
+
+@dataclass(frozen=True)
+class ComponentsAssumed:
+    """Bores, rim and shaft dimensions (assumed: the study gives no drawing)."""
+
+    sun_bore_diameter_mm: float = _num(0.0, lo_open=True)
+    planet_bore_diameter_mm: float = _num(0.0, lo_open=True)
+    ring_rim_thickness_mm: float = _num(0.0, lo_open=True)
+    ring_flange_outer_diameter_mm: float = _num(0.0, lo_open=True)
+    ring_flange_thickness_mm: float = _num(0.0, lo_open=True)
+    ring_bolt_count: int = _num(1, integer=True)
+    ring_bolt_hole_diameter_mm: float = _num(0.0, lo_open=True)
+    input_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
+    input_shaft_inner_diameter_mm: float = _num(0.0)
+    input_shaft_length_mm: float = _num(0.0, lo_open=True)
+    output_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
+    output_shaft_inner_diameter_mm: float = _num(0.0)
+    output_shaft_length_mm: float = _num(0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class Bearing:
+    """One bearing (bushing) of Table 2.
+
+    The study's "torsional stiffness" is read as the tilting stiffness about the two axes
+    normal to the shaft (N·m/rad): a bearing leaves the spin free. Damping is assumed
+    stiffness-proportional, c = k · damping_per_stiffness_s.
+    """
+
+    radial_stiffness_n_per_m: float = _num(0.0)
+    axial_stiffness_n_per_m: float = _num(0.0)
+    tilt_stiffness_nm_per_rad: float = _num(0.0)
+    damping_per_stiffness_s: float = _num(0.0)
+
+
+@dataclass(frozen=True)
+class Bearings:
+    """Table 2: input-shaft, output-shaft and planet bearings."""
+
+    input_shaft: Bearing
+    output_shaft: Bearing
+    planet: Bearing
+
+
+@dataclass(frozen=True)
+class Contact:
+    """Gear contact of section 2.1 (ADAMS impact function), one value for both mesh types."""
+
+    stiffness: float = _num(0.0, lo_open=True, doc="N/m^exponent")
+    exponent: float = _num(1.0, 3.0)
+    damping_fraction_of_stiffness: float = _num(0.0)
+    penetration_depth_m: float = _num(0.0, lo_open=True)
+    friction_coefficient: float = _num(0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class ContactAssumed:
+    """Contact modelling choices the study does not give."""
+
+    stiffness_harmonics: int = _num(0, 10, integer=True)
+    stiffness_variation: str = _choice("contact_lines", "constant")
+    friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
+
+
+@dataclass(frozen=True)
+class LoadCase:
+    """Table 5: input speed and load torque as STEP ramps."""
+
+    input_speed_rpm: float = _num()
+    load_torque_nm: float = _num()
+    ramp_time_s: float = _num(0.0, lo_open=True)
+    end_time_s: float = _num(0.0, lo_open=True)
+    step_size_s: float = _num(0.0, lo_open=True)
+
+    @property
+    def input_speed_rad_s(self) -> float:
+        return self.input_speed_rpm * 2.0 * math.pi / 60.0
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    """Time-integration settings (assumed; the study used ADAMS GSTIFF)."""
+
+    spectral_radius: float = _num(0.0, 1.0)
+    newton_max_modified_iterations: int = _num(1, 50, integer=True)
+    record_every_steps: int = _num(1, integer=True)
+
+
+@dataclass(frozen=True)
+class MeshingSettings:
+    """Mesh sizes per level (assumed)."""
+
+    tooth_size_mm: float = _num(0.0, lo_open=True)
+    body_size_mm: float = _num(0.0, lo_open=True)
+    element_order: int = _num(1, 2, integer=True)
+
+
+@dataclass(frozen=True)
+class ReductionSettings:
+    """Component-mode synthesis settings for flexible bodies (assumed)."""
+
+    fixed_interface_modes: int = _num(0, 200, integer=True)
+    interface: str = _choice("rbe3", "rbe2")
+
+
+@dataclass(frozen=True)
+class GearboxSpec:
+    """The whole gearbox: the study's tables plus documented assumptions."""
+
+    source: Path
+    title: str
+    gears: GearSet
+    gears_assumed: GearSetAssumed
+    material_assumed: Material
+    components_assumed: ComponentsAssumed
+    bearings: Bearings
+    contact: Contact
+    contact_assumed: ContactAssumed
+    load_case: LoadCase
+    solver_assumed: SolverSettings
+    meshing_assumed: dict[str, MeshingSettings]
+    reduction_assumed: ReductionSettings
+
+    def with_changes(self, **tables: Any) -> GearboxSpec:
+        """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
+        return dataclasses.replace(self, **tables)
+
+
+@dataclass(frozen=True)
+class Variant:
+    """One row of Table 3: the gearbox plus rigid/flexible per component."""
+
+    source: Path
+    name: str
+    gearbox: GearboxSpec
+    components: dict[str, str]
+    mesh_level: str = "default"
+
+    def is_rigid(self) -> bool:
+        return all(v == "rigid" for v in self.components.values())
+
+
+# --------------------------------------------------------------------------- loading
+def _read_toml(path: Path) -> dict[str, Any]:
+    try:
+        with open(path, "rb") as fh:
+            return tomllib.load(fh)
+    except FileNotFoundError:
+        raise SpecError(path, "<file>", "file does not exist") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SpecError(path, "<file>", f"is not valid TOML ({exc})") from None
+
+
+def _check_value(path: Path, name: str, value: Any, hint: Any, meta: dict) -> Any:
+    if hint is str or "choices" in meta:
+        choices = meta.get("choices")
+        if not isinstance(value, str) or (choices and value not in choices):
+            allowed = f"one of {', '.join(repr(c) for c in choices)}" if choices else "a string"
+            raise SpecError(path, name, f"expected {allowed}", value)
+        return value
+    integer = meta.get("integer", False)
+    if isinstance(value, bool) or not isinstance(value, (int, float)) or (
+        integer and not isinstance(value, int)
+    ):
+        raise SpecError(path, name, "expected an integer" if integer else "expected a number", value)
+    if not math.isfinite(value):
+        raise SpecError(path, name, "expected a finite number", value)
+    lo, hi, lo_open = meta.get("lo"), meta.get("hi"), meta.get("lo_open", False)
+    if lo is not None and (value < lo or (lo_open and value == lo)):
+        rng = f"> {lo}" if lo_open else f">= {lo}"
+        raise SpecError(path, name, f"expected a value {rng}" + (f" and <= {hi}" if hi else ""), value)
+    if hi is not None and value > hi:
+        raise SpecError(path, name, f"expected a value <= {hi}", value)
+    return int(value) if integer else float(value)
+
+
+def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
+    """Build dataclass ``cls`` from a TOML table, validating every field."""
+    if not isinstance(data, dict):
+        raise SpecError(path, prefix, "expected a table", data)
+    hints = get_type_hints(cls)
+    fields = {f.name: f for f in dataclasses.fields(cls)}
+    unknown = sorted(set(data) - set(fields))
+    if unknown:
+        raise SpecError(path, f"{prefix}.{unknown[0]}", f"unknown field; allowed: {', '.join(fields)}")
+    values = {}
+    for name, f in fields.items():
+        full = f"{prefix}.{name}"
+        if name not in data:
+            if f.default is not dataclasses.MISSING:
+                continue
+            raise SpecError(path, full, "missing (required)")
+        hint = hints[name]
+        if dataclasses.is_dataclass(hint):
+            values[name] = _build(hint, data[name], path, full)
+        else:
+            values[name] = _check_value(path, full, data[name], hint, dict(f.metadata))
+    return cls(**values)
+
+
+def load_gearbox(path: str | Path) -> GearboxSpec:
+    """Load and validate a gearbox TOML file (see ``model_variants/gearbox.toml``)."""
+    path = Path(path)
+    raw = _read_toml(path)
+    tables = {f.name for f in dataclasses.fields(GearboxSpec)} - {"source"}
+    unknown = sorted(set(raw) - set(tables))
+    if unknown:
+        raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
+    for name in tables:
+        if name not in raw:
+            raise SpecError(path, name, "missing (required)")
+    if not isinstance(raw["title"], str):
+        raise SpecError(path, "title", "expected a string", raw["title"])
+    meshing = raw["meshing_assumed"]
+    if not isinstance(meshing, dict) or not meshing:
+        raise SpecError(path, "meshing_assumed", "expected a table of levels, e.g. [meshing_assumed.coarse]")
+    hints = get_type_hints(GearboxSpec)
+    kwargs: dict[str, Any] = {"source": path, "title": raw["title"]}
+    for name in tables - {"title", "meshing_assumed"}:
+        kwargs[name] = _build(hints[name], raw[name], path, name)
+    kwargs["meshing_assumed"] = {
+        level: _build(MeshingSettings, table, path, f"meshing_assumed.{level}")
+        for level, table in meshing.items()
+    }
+    spec = GearboxSpec(**kwargs)
+    _check_consistency(spec)
+    return spec
+
+
+def _check_consistency(spec: GearboxSpec) -> None:
+    g, p = spec.gears, spec.source
+    if g.ring_teeth <= g.planet_teeth + g.sun_teeth // 2:
+        raise SpecError(p, "gears.ring_teeth", "expected ring_teeth > sun_teeth/2 + planet_teeth", g.ring_teeth)
+    if (g.sun_teeth + g.ring_teeth) % g.planet_count:
+        raise SpecError(
+            p, "gears.planet_count",
+            "equally spaced planets need (sun_teeth + ring_teeth) divisible by planet_count",
+            g.planet_count,
+        )
+    for level, m in spec.meshing_assumed.items():
+        if m.body_size_mm < m.tooth_size_mm:
+            raise SpecError(p, f"meshing_assumed.{level}.body_size_mm", "expected >= tooth_size_mm",
+                            m.body_size_mm)
+
+
+def load_variant(path: str | Path) -> Variant:
+    """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible."""
+    path = Path(path)
+    raw = _read_toml(path)
+    allowed = {"name", "gearbox", "components", "mesh_level", "description"}
+    unknown = sorted(set(raw) - allowed)
+    if unknown:
+        raise SpecError(path, unknown[0], f"unknown field; allowed: {', '.join(sorted(allowed))}")
+    for key in ("name", "gearbox", "components"):
+        if key not in raw:
+            raise SpecError(path, key, "missing (required)")
+    if not isinstance(raw["gearbox"], str):
+        raise SpecError(path, "gearbox", "expected a path (string) relative to this file", raw["gearbox"])
+    gearbox = load_gearbox(path.parent / raw["gearbox"])
+    comps = raw["components"]
+    if not isinstance(comps, dict):
+        raise SpecError(path, "components", "expected a table")
+    for name in comps:
+        if name not in COMPONENTS:
+            raise SpecError(path, f"components.{name}", f"unknown component; allowed: {', '.join(COMPONENTS)}")
+    components = {}
+    for name in COMPONENTS:
+        if name not in comps:
+            raise SpecError(path, f"components.{name}", "missing; expected 'rigid' or 'flexible'")
+        components[name] = _check_value(path, f"components.{name}", comps[name], str,
+                                        {"choices": ("rigid", "flexible")})
+    level = raw.get("mesh_level", "default")
+    if level not in gearbox.meshing_assumed:
+        raise SpecError(path, "mesh_level", f"expected one of {sorted(gearbox.meshing_assumed)}", level)
+    if not isinstance(raw["name"], str) or not raw["name"]:
+        raise SpecError(path, "name", "expected a non-empty string", raw["name"])
+    return Variant(path, raw["name"], gearbox, components, level)
+
+
+def _plain(obj: Any) -> Any:
+    if dataclasses.is_dataclass(obj):
+        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.name != "source"}
+    if isinstance(obj, dict):
+        return {k: _plain(v) for k, v in sorted(obj.items())}
+    if isinstance(obj, Path):
+        return None
+    return obj
+
+
+def spec_hash(obj: GearboxSpec | Variant | Any, *extra: Any) -> str:
+    """SHA-256 (16 hex digits) of a spec's content (file paths excluded) and any extra values."""
+    payload = json.dumps([_plain(obj), [_plain(e) for e in extra]], sort_keys=True, default=str)
+    return hashlib.sha256(payload.encode()).hexdigest()[:16]

@@ -1,0 +1,87 @@
+"""The study's "theoretical values": kinematics, torques, mesh force, mesh frequency, STEP.
+
+All in SI (rad/s, N, N·m, Hz); ``deg_per_s`` appears only in function names that say so.
+
+- Star arrangement (carrier fixed):  omega_ring / omega_sun = -z_s / z_r
+- Planetary arrangement (ring fixed): omega_carrier / omega_sun = z_s / (z_s + z_r)
+- Power balance (loss-free):          T_in = T_out * |omega_out / omega_in|
+- Normal mesh force per planet:       F_n = T_sun / (N r_b,sun cos(beta_b))
+- Mesh frequency (carrier frame):     f_m = z_s |omega_sun - omega_carrier| / (2 pi)
+- ADAMS STEP(x, x0, h0, x1, h1) = h0 + (h1 - h0) d^2 (3 - 2 d), d = (x - x0)/(x1 - x0) clipped to [0, 1]
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.involute import gear_set_geometry
+from flexgear.spec import GearboxSpec
+
+__all__ = ["step", "step_integral", "Theory", "theory"]
+
+
+def step(x: np.ndarray | float, x0: float, h0: float, x1: float, h1: float) -> np.ndarray | float:
+    """ADAMS STEP function: cubic from (x0, h0) to (x1, h1) with zero slope at both ends."""
+    d = np.clip((np.asarray(x, dtype=float) - x0) / (x1 - x0), 0.0, 1.0)
+    out = h0 + (h1 - h0) * d * d * (3.0 - 2.0 * d)
+    return float(out) if np.ndim(out) == 0 else out
+
+
+def step_integral(t: np.ndarray | float, ramp_time: float, final_value: float) -> np.ndarray | float:
+    """Integral over [0, t] of STEP(tau, 0, 0, ramp_time, final_value).
+
+    For t <= T: final_value * T * (d^3 - d^4 / 2), d = t / T; after it grows linearly:
+    final_value * (t - T/2). This is the prescribed input angle for a STEP speed ramp.
+    """
+    tt = np.asarray(t, dtype=float)
+    d = np.clip(tt / ramp_time, 0.0, 1.0)
+    out = np.where(tt <= ramp_time, final_value * ramp_time * (d**3 - 0.5 * d**4),
+                   final_value * (tt - 0.5 * ramp_time))
+    return float(out) if np.ndim(out) == 0 else out
+
+
+@dataclass(frozen=True)
+class Theory:
+    """Steady-state theoretical values of a single-stage star or planetary gearbox (SI)."""
+
+    input_speed: float  # rad/s (sun)
+    output_speed: float  # rad/s (ring for star, carrier for planetary)
+    ratio: float  # output / input speed
+    input_torque: float  # N·m on the sun
+    output_torque: float  # N·m load at the output
+    mesh_force: float  # N, normal mesh force per planet (both meshes)
+    mesh_frequency: float  # Hz
+    planet_speed: float  # rad/s absolute spin of each planet
+
+    @property
+    def input_speed_deg_per_s(self) -> float:
+        return math.degrees(self.input_speed)
+
+    @property
+    def output_speed_deg_per_s(self) -> float:
+        return math.degrees(self.output_speed)
+
+
+def theory(spec: GearboxSpec) -> Theory:
+    """Theoretical values for the spec's load case at full speed and load (after the ramps)."""
+    g = spec.gears
+    geo = gear_set_geometry(spec)
+    w_in = spec.load_case.input_speed_rad_s
+    zs, zp, zr = g.sun_teeth, g.planet_teeth, g.ring_teeth
+    if g.arrangement == "star":
+        ratio = -zs / zr
+        w_carrier = 0.0
+    else:
+        ratio = zs / (zs + zr)
+        w_carrier = ratio * w_in
+    # Planet spin: in the carrier frame omega_p - omega_c = -(z_s/z_p)(omega_s - omega_c).
+    w_planet = w_carrier - zs / zp * (w_in - w_carrier)
+    t_out = spec.load_case.load_torque_nm
+    t_in = t_out * abs(ratio)
+    cos_bb = math.cos(geo.sun.base_helix_angle)
+    force = t_in / (g.planet_count * geo.sun.base_radius * cos_bb)
+    f_mesh = zs * abs(w_in - w_carrier) / (2 * math.pi)
+    return Theory(w_in, ratio * w_in, ratio, t_in, t_out, force, f_mesh, w_planet)
