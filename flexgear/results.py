@@ -1,0 +1,92 @@
+"""The run-result format shared by every backend (Exudyn multibody, lumped parameter).
+
+A run directory holds ``run.json`` (metadata: variant, backend, status, configuration and its
+hash, wall and CPU time, theory values, versions) and, for a finished run, ``signals.parquet``:
+one row per recorded step, a ``time_s`` column and one column per signal, each named with its
+unit (see :func:`signal_columns`). Files are written atomically (temporary file + rename), so a
+reader never sees a half-written result.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+__all__ = ["RunResult", "signal_columns", "save_result", "load_result", "atomic_write_bytes"]
+
+
+def signal_columns(planet_count: int) -> list[str]:
+    """Column names of the signal table, in order (units in the names).
+
+    - ``time_s``
+    - ``input_speed_deg_per_s``, ``output_speed_deg_per_s``: spin speeds of input and output shaft
+    - ``transmission_ratio``: output / input speed
+    - ``input_torque_nm``: drive torque on the input shaft
+    - ``outer_mesh_force_{i}_n``: normal force of the sun-planet mesh of planet i (1-based)
+    - ``inner_mesh_force_{i}_n``: normal force of the planet-ring mesh of planet i
+    - ``{input,output}_bearing_accel_{x,y}_m_per_s2``: radial acceleration at the shaft bearings
+    """
+    cols = ["time_s", "input_speed_deg_per_s", "output_speed_deg_per_s", "transmission_ratio", "input_torque_nm"]
+    cols += [f"outer_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
+    cols += [f"inner_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
+    cols += [f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y")]
+    return cols
+
+
+@dataclass
+class RunResult:
+    """Signals (``None`` for a failed run) and metadata of one run."""
+
+    meta: dict[str, Any]
+    signals: pd.DataFrame | None = None
+    extra: dict[str, pd.DataFrame] = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return self.meta.get("status") == "ok"
+
+    @property
+    def name(self) -> str:
+        return str(self.meta.get("variant", "?"))
+
+
+def atomic_write_bytes(path: Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            fh.write(data)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def save_result(result: RunResult, run_dir: str | Path) -> Path:
+    """Write ``signals.parquet`` (if any), extra tables and then ``run.json`` into ``run_dir``."""
+    run_dir = Path(run_dir)
+    run_dir.mkdir(parents=True, exist_ok=True)
+    if result.signals is not None:
+        atomic_write_bytes(run_dir / "signals.parquet", result.signals.to_parquet(index=False))
+    for name, table in result.extra.items():
+        atomic_write_bytes(run_dir / f"{name}.parquet", table.to_parquet(index=False))
+    meta = dict(result.meta, extra_tables=sorted(result.extra))
+    atomic_write_bytes(run_dir / "run.json", json.dumps(meta, indent=2, default=str).encode())
+    return run_dir
+
+
+def load_result(run_dir: str | Path) -> RunResult:
+    """Read a run directory written by :func:`save_result`."""
+    run_dir = Path(run_dir)
+    meta = json.loads((run_dir / "run.json").read_text())
+    signals_path = run_dir / "signals.parquet"
+    signals = pd.read_parquet(signals_path) if signals_path.exists() and meta.get("status") == "ok" else None
+    extra = {n: pd.read_parquet(run_dir / f"{n}.parquet") for n in meta.get("extra_tables", [])}
+    return RunResult(meta, signals, extra)
