@@ -1,0 +1,131 @@
+"""Command line: ``flexgear run | matrix | lpm | compare | report | meshes``.
+
+Each subcommand is a thin wrapper over one library function; the heavy modules are imported
+only by the subcommand that needs them.
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+from flexgear.spec import SpecError
+
+__all__ = ["main"]
+
+
+def _cmd_run(a: argparse.Namespace) -> int:
+    from flexgear.results import save_result
+    from flexgear.simulate import run_variant
+    from flexgear.spec import load_variant
+
+    variant = load_variant(a.variant)
+    result = run_variant(variant, t_end_s=a.t_end, progress=True)
+    out = save_result(result, Path(a.out) / variant.name)
+    print(f"{variant.name}: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.1f} s -> {out}")
+    if not result.ok:
+        print(f"reason: {result.meta.get('reason')}", file=sys.stderr)
+        return 1
+    return 0
+
+
+def _cmd_matrix(a: argparse.Namespace) -> int:
+    from flexgear.matrix import run_matrix
+
+    table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end,
+                       workers=a.workers, scheduler=a.scheduler, progress=True)
+    print(table.to_string())
+    return 0
+
+
+def _cmd_lpm(a: argparse.Namespace) -> int:
+    from flexgear.lumped import run_lumped
+    from flexgear.results import save_result
+    from flexgear.spec import load_gearbox
+
+    result = run_lumped(load_gearbox(a.gearbox), t_end_s=a.t_end, progress=True)
+    out = save_result(result, Path(a.out) / "lumped")
+    print(f"lumped: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.2f} s -> {out}")
+    return 0 if result.ok else 1
+
+
+def _cmd_compare(a: argparse.Namespace) -> int:
+    from flexgear.compare import compare_results
+    from flexgear.results import load_result
+
+    table6, table7 = compare_results(load_result(a.result_a), load_result(a.result_b))
+    print(table6.to_string())
+    print()
+    print(table7.to_string())
+    return 0
+
+
+def _cmd_report(a: argparse.Namespace) -> int:
+    from flexgear.report import build_report
+
+    path = build_report(Path(a.results), Path(a.output))
+    print(f"report -> {path}")
+    return 0
+
+
+def _cmd_meshes(a: argparse.Namespace) -> int:
+    from flexgear.meshing import build_meshes
+    from flexgear.spec import load_gearbox
+
+    build_meshes(load_gearbox(a.gearbox), a.level, progress=True)
+    return 0
+
+
+def _parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="flexgear", description=__doc__.splitlines()[0])
+    sub = p.add_subparsers(dest="command", required=True)
+
+    r = sub.add_parser("run", help="run one variant file with the Exudyn backend")
+    r.add_argument("variant")
+    r.add_argument("--t-end", type=float, default=None, help="simulated time [s] (default: the load case's)")
+    r.add_argument("--out", default="results", help="results folder (default: results)")
+    r.set_defaults(func=_cmd_run)
+
+    m = sub.add_parser("matrix", help="run a matrix of variant files and screen them")
+    m.add_argument("variants", nargs="+")
+    m.add_argument("--t-end", type=float, default=None)
+    m.add_argument("--out", default="results")
+    m.add_argument("--workers", type=int, default=2)
+    m.add_argument("--scheduler", default=None, help="Dask scheduler address (default: local processes)")
+    m.set_defaults(func=_cmd_matrix)
+
+    lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox file")
+    lp.add_argument("gearbox")
+    lp.add_argument("--t-end", type=float, default=None)
+    lp.add_argument("--out", default="results")
+    lp.set_defaults(func=_cmd_lpm)
+
+    c = sub.add_parser("compare", help="Tables 6 and 7 from two saved runs")
+    c.add_argument("result_a")
+    c.add_argument("result_b")
+    c.set_defaults(func=_cmd_compare)
+
+    rp = sub.add_parser("report", help="PDF screening report from saved results")
+    rp.add_argument("results")
+    rp.add_argument("--output", default="reports/screening_report.pdf")
+    rp.set_defaults(func=_cmd_report)
+
+    me = sub.add_parser("meshes", help="build (or load from cache) the component meshes")
+    me.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml")
+    me.add_argument("--level", default="default")
+    me.set_defaults(func=_cmd_meshes)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    args = _parser().parse_args(argv)
+    try:
+        return args.func(args)
+    except SpecError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
