@@ -35,6 +35,8 @@ __all__ = [
     "SolverSettings",
     "MeshingSettings",
     "ReductionSettings",
+    "IndicatorWeights",
+    "ScreeningSettings",
     "GearboxSpec",
     "Variant",
     "COMPONENTS",
@@ -245,6 +247,39 @@ class ReductionSettings:
 
 
 @dataclass(frozen=True)
+class IndicatorWeights:
+    """Weights of the study's five screening indicators in the composite point (sum 1).
+
+    Section 2.2: "taking 20 % of each of the five simulation indicators".
+    """
+
+    input_speed: float = _num(0.0, 1.0)
+    output_speed: float = _num(0.0, 1.0)
+    transmission_ratio: float = _num(0.0, 1.0)
+    outer_mesh_force: float = _num(0.0, 1.0)
+    inner_mesh_force: float = _num(0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class ScreeningSettings:
+    """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
+
+    See ``[screening]`` in gearbox.toml and :mod:`flexgear.screening` for each value's meaning.
+    """
+
+    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
+    lines: str = _choice("westgard", "six_sigma")
+    window: str = _choice("after_ramps", "fixed")
+    after_ramp_delay_s: float = _num(0.0)
+    window_start_s: float = _num(0.0)
+    window_end_s: float = _num(0.0, lo_open=True)
+    short_run_fraction: float = _num(0.0, 1.0, lo_open=True)
+    sample_count: int = _num(2, 10000, integer=True)
+    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
+    weights: IndicatorWeights
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -261,6 +296,7 @@ class GearboxSpec:
     solver_assumed: SolverSettings
     meshing_assumed: dict[str, MeshingSettings]
     reduction_assumed: ReductionSettings
+    screening: ScreeningSettings
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
@@ -378,6 +414,12 @@ def _check_consistency(spec: GearboxSpec) -> None:
             "equally spaced planets need (sun_teeth + ring_teeth) divisible by planet_count",
             g.planet_count,
         )
+    weights = dataclasses.astuple(spec.screening.weights)
+    if abs(sum(weights) - 1.0) > 1e-9:
+        raise SpecError(p, "screening.weights", "expected weights that sum to 1", sum(weights))
+    if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
+        raise SpecError(p, "screening.window_end_s", "expected a value > window_start_s",
+                        spec.screening.window_end_s)
     for level, m in spec.meshing_assumed.items():
         if m.body_size_mm < m.tooth_size_mm:
             raise SpecError(p, f"meshing_assumed.{level}.body_size_mm", "expected >= tooth_size_mm",
