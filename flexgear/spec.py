@@ -159,6 +159,9 @@ class ComponentsAssumed:
     output_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
     output_shaft_inner_diameter_mm: float = _num(0.0)
     output_shaft_length_mm: float = _num(0.0, lo_open=True)
+    # geometry details (flexgear.geometry); defaults keep older gearbox files valid
+    relief_groove_depth_mm: float = field(default=1.0, metadata={"lo": 0.0, "doc": "mm beyond the root circle"})
+    bearing_seat_width_mm: float = field(default=20.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
 
 
 @dataclass(frozen=True)
