@@ -1,0 +1,354 @@
+"""Westgard screening of model variants (section 2.2 of the study): inaccuracy, imprecision, zones.
+
+The study screens its seven multibody variants with the Westgard method decision chart and the
+"relative error distance method of speed, transmission ratio and meshing force". This module is
+that arithmetic as small pure functions; everything configurable comes from
+:class:`flexgear.spec.ScreeningSettings` (``[screening]`` in gearbox.toml).
+
+Samples
+    The analysis window [t0, t1] (default: the steady part after the STEP ramps) is cut into
+    ``sample_count`` equal, contiguous time segments. One *sample* of an indicator is the
+    arithmetic mean of its recorded values inside one segment (recording is at a constant step,
+    so this is the segment's time average); the ripple at mesh frequency averages out inside a
+    segment, what remains between samples is drift and slow oscillation: the signal's
+    unsteadiness, which the study says a single window mean hides.
+
+Per indicator (input speed, output speed, transmission ratio, outer and inner mesh force; the
+mesh forces are first averaged over the planets at every step), with the sample means x_k,
+their mean x̄ and the theoretical value x_th:
+
+- inaccuracy  Bias % = |x̄ - x_th| / |x_th| · 100
+- imprecision CV %   = s / |x̄| · 100, s the sample standard deviation (ddof = 1) of the x_k
+
+Composite point of a variant: Bias_c = Σ w_i Bias_i and CV_c = Σ w_i CV_i (w_i = 0.2 each,
+"taking 20 % of each of the five simulation indicators"); its relative error distance is
+d = sqrt(Bias_c² + CV_c²), the distance from the diagram's origin.
+
+Decision lines Bias + m·CV = TEa (m = 2, 3, 4 by default; 2…6 for the Six-Sigma chart) split the
+plane into zones. A point satisfies line m when Bias + m·CV <= TEa; a point exactly on a line
+belongs to the better zone (the line's criterion is met; a relative tolerance of 1e-12 absorbs
+round-off). The zone is the number of lines met: 0 = non-conforming ... The sigma metric is
+(TEa - Bias) / CV. The study draws Bias on x and CV on y; Westgard's charts swap the axes.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from flexgear.results import RunResult
+from flexgear.spec import ScreeningSettings
+
+__all__ = [
+    "INDICATORS",
+    "DecisionLines",
+    "Window",
+    "IndicatorResult",
+    "VariantScreening",
+    "Selection",
+    "analysis_window",
+    "sample_means",
+    "bias_pct",
+    "cv_pct",
+    "sigma_metric",
+    "indicator_signals",
+    "screen_result",
+    "screening_tables",
+    "select_variant",
+]
+
+INDICATORS: dict[str, str] = {
+    "input_speed": "input speed",
+    "output_speed": "output speed",
+    "transmission_ratio": "transmission ratio",
+    "outer_mesh_force": "outer (sun-planet) mesh force",
+    "inner_mesh_force": "inner (planet-ring) mesh force",
+}
+"""The study's five indicators (section 2.2): key -> readable name."""
+
+_THEORY_KEYS = {
+    "input_speed": "input_speed_deg_per_s",
+    "output_speed": "output_speed_deg_per_s",
+    "transmission_ratio": "ratio",
+    "outer_mesh_force": "mesh_force_n",
+    "inner_mesh_force": "mesh_force_n",
+}
+
+_ZONE_NAMES = {
+    (2, 3, 4): ("non-conforming", "critical", "good", "excellent"),
+    (2, 3, 4, 5, 6): ("non-conforming", "poor", "marginal", "good", "excellent", "world-class"),
+}
+_LINE_SETS = {"westgard": (2, 3, 4), "six_sigma": (2, 3, 4, 5, 6)}
+_ON_LINE_RTOL = 1e-12
+
+
+# --------------------------------------------------------------------------- decision lines
+@dataclass(frozen=True)
+class DecisionLines:
+    """Lines Bias + m·CV = TEa (all in %) and the zones between them, worst zone first."""
+
+    tea_pct: float
+    multipliers: tuple[int, ...] = (2, 3, 4)
+
+    @classmethod
+    def from_settings(cls, settings: ScreeningSettings) -> DecisionLines:
+        return cls(settings.allowable_total_error_pct, _LINE_SETS[settings.lines])
+
+    @property
+    def zone_names(self) -> tuple[str, ...]:
+        names = _ZONE_NAMES.get(tuple(self.multipliers))
+        if names is None:
+            names = ("non-conforming", *(f"sigma >= {m}" for m in self.multipliers))
+        return names
+
+    def rank(self, bias: float, cv: float) -> int:
+        """Zone index: the number of lines whose criterion Bias + m·CV <= TEa is met (0 = worst)."""
+        limit = self.tea_pct * (1.0 + _ON_LINE_RTOL)
+        return sum(1 for m in self.multipliers if bias + m * cv <= limit)
+
+    def zone(self, bias: float, cv: float) -> str:
+        return self.zone_names[self.rank(bias, cv)]
+
+    def cv_on_line(self, m: float, bias: np.ndarray | float) -> np.ndarray | float:
+        """CV of line m at a given Bias (the study's axes: Bias on x, CV on y): (TEa - Bias)/m."""
+        return (self.tea_pct - np.asarray(bias, dtype=float)) / m
+
+
+def sigma_metric(bias: float, cv: float, tea: float) -> float:
+    """Sigma metric (TEa - Bias) / CV; +inf for a point with CV = 0 inside TEa."""
+    if cv > 0.0:
+        return (tea - bias) / cv
+    return math.inf if bias < tea else (0.0 if bias == tea else -math.inf)
+
+
+# --------------------------------------------------------------------------- samples
+@dataclass(frozen=True)
+class Window:
+    """Analysis window [start_s, end_s]; ``steady`` is False when the run ended before the ramps."""
+
+    start_s: float
+    end_s: float
+    steady: bool
+    rule: str
+
+
+def analysis_window(meta: dict, t_first: float, t_last: float, settings: ScreeningSettings) -> Window:
+    """The window of a run per ``settings.window`` (see gearbox.toml ``[screening]``)."""
+    if settings.window == "fixed":
+        start, end = max(settings.window_start_s, t_first), min(settings.window_end_s, t_last)
+        if end <= start:
+            raise ValueError(f"screening window [{settings.window_start_s}, {settings.window_end_s}] s lies "
+                             f"outside the run [{t_first}, {t_last}] s")
+        return Window(start, end, True, f"fixed window {start:g}-{end:g} s")
+    ramp = float(meta.get("ramp_time_s", 0.0)) + settings.after_ramp_delay_s
+    if ramp < t_last:
+        start = max(ramp, t_first)
+        return Window(start, t_last, True, f"steady part after the ramps, {start:g}-{t_last:g} s")
+    start = t_last - settings.short_run_fraction * (t_last - t_first)
+    return Window(start, t_last, False,
+                  f"run ends ({t_last:g} s) before the ramps ({ramp:g} s): last "
+                  f"{settings.short_run_fraction:.0%} of the run, {start:g}-{t_last:g} s, NOT steady")
+
+
+def sample_means(t: np.ndarray, y: np.ndarray, window: Window, count: int) -> np.ndarray:
+    """Mean of ``y`` in each of ``count`` equal contiguous segments of the window (the samples)."""
+    t, y = np.asarray(t, dtype=float), np.asarray(y, dtype=float)
+    edges = np.linspace(window.start_s, window.end_s, count + 1)
+    seg = np.searchsorted(edges, t, side="right") - 1
+    seg[t == window.end_s] = count - 1  # the window's end point belongs to the last segment
+    inside = (seg >= 0) & (seg < count)
+    counts = np.bincount(seg[inside], minlength=count)
+    if np.any(counts == 0):
+        raise ValueError(f"window {window.start_s:g}-{window.end_s:g} s is too short for {count} samples "
+                         f"({int(inside.sum())} recorded points)")
+    return np.bincount(seg[inside], weights=y[inside], minlength=count) / counts
+
+
+def bias_pct(mean: float, theory: float) -> float:
+    """Inaccuracy |mean - theory| / |theory| · 100 (%)."""
+    return abs(mean - theory) / abs(theory) * 100.0
+
+
+def cv_pct(samples: np.ndarray) -> float:
+    """Imprecision: sample standard deviation (ddof = 1) / |mean| · 100 (%)."""
+    samples = np.asarray(samples, dtype=float)
+    return float(np.std(samples, ddof=1) / abs(np.mean(samples)) * 100.0)
+
+
+def indicator_signals(signals: pd.DataFrame) -> dict[str, np.ndarray]:
+    """The five indicator signals from a signal table (mesh forces averaged over the planets)."""
+    out = {
+        "input_speed": signals["input_speed_deg_per_s"].to_numpy(),
+        "output_speed": signals["output_speed_deg_per_s"].to_numpy(),
+        "transmission_ratio": signals["transmission_ratio"].to_numpy(),
+    }
+    for mesh in ("outer", "inner"):
+        cols = [c for c in signals.columns if c.startswith(f"{mesh}_mesh_force_") and c.endswith("_n")]
+        if not cols:
+            raise ValueError(f"signal table has no {mesh}_mesh_force_<i>_n columns")
+        out[f"{mesh}_mesh_force"] = signals[cols].to_numpy().mean(axis=1)
+    return out
+
+
+# --------------------------------------------------------------------------- one variant
+@dataclass(frozen=True)
+class IndicatorResult:
+    """One indicator of one run: theory, mean of the samples, Bias %, CV % and the samples."""
+
+    name: str
+    theory: float
+    mean: float
+    bias_pct: float
+    cv_pct: float
+    samples: tuple[float, ...]
+
+
+@dataclass(frozen=True)
+class VariantScreening:
+    """Composite Westgard point of one run."""
+
+    variant: str
+    window: Window
+    indicators: dict[str, IndicatorResult]
+    bias_pct: float
+    cv_pct: float
+    distance_pct: float
+    sigma: float
+    zone: str
+    zone_rank: int
+
+
+def screen_result(result: RunResult, settings: ScreeningSettings) -> VariantScreening:
+    """Screen one finished run against ``result.meta["theory"]``."""
+    if not result.ok or result.signals is None:
+        raise ValueError(f"{result.name}: run did not finish ({result.meta.get('reason')})")
+    t = result.signals["time_s"].to_numpy()
+    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings)
+    theory = result.meta["theory"]
+    weights = dataclasses.asdict(settings.weights)
+    indicators = {}
+    for key, y in indicator_signals(result.signals).items():
+        x = sample_means(t, y, window, settings.sample_count)
+        th = float(theory[_THEORY_KEYS[key]])
+        mean = float(np.mean(x))
+        indicators[key] = IndicatorResult(key, th, mean, bias_pct(mean, th), cv_pct(x), tuple(map(float, x)))
+    bias = sum(weights[k] * r.bias_pct for k, r in indicators.items())
+    cv = sum(weights[k] * r.cv_pct for k, r in indicators.items())
+    lines = DecisionLines.from_settings(settings)
+    return VariantScreening(result.name, window, indicators, bias, cv, math.hypot(bias, cv),
+                            sigma_metric(bias, cv, lines.tea_pct), lines.zone(bias, cv), lines.rank(bias, cv))
+
+
+# --------------------------------------------------------------------------- many variants
+@dataclass(frozen=True)
+class Selection:
+    """The selected variant (None if the rule selects none) and the reasoning, in words."""
+
+    variant: str | None
+    rule: str
+    reasoning: str
+
+
+def _run_time(meta: dict) -> float:
+    """Time a variant is judged by: the runner's wall time of the simulation (s)."""
+    value = meta.get("wall_time_s")
+    return float(value) if value is not None else math.nan
+
+
+def screening_tables(results: Iterable[RunResult], settings: ScreeningSettings
+                     ) -> tuple[pd.DataFrame, pd.DataFrame, Selection]:
+    """Screening table (one row per run), per-indicator table, and the selection.
+
+    Failed runs, and runs whose signals cannot be screened, get a row with status "failed" and
+    their reason; they are not candidates for selection.
+    """
+    lines = DecisionLines.from_settings(settings)
+    rows, ind_rows = [], []
+    for res in results:
+        row = {"variant": res.name, "status": res.meta.get("status", "failed"),
+               "reason": res.meta.get("reason") or "", "time_s": _run_time(res.meta)}
+        if res.ok:
+            try:
+                s = screen_result(res, settings)
+            except (ValueError, KeyError) as exc:
+                row.update(status="failed", reason=f"screening: {exc}")
+            else:
+                row.update(bias_pct=s.bias_pct, cv_pct=s.cv_pct, distance_pct=s.distance_pct, sigma=s.sigma,
+                           zone=s.zone, zone_rank=s.zone_rank, steady_window=s.window.steady,
+                           window_start_s=s.window.start_s, window_end_s=s.window.end_s)
+                for r in s.indicators.values():
+                    ind_rows.append({"variant": res.name, "indicator": r.name, "theory": r.theory, "mean": r.mean,
+                                     "bias_pct": r.bias_pct, "cv_pct": r.cv_pct,
+                                     "sigma": sigma_metric(r.bias_pct, r.cv_pct, lines.tea_pct),
+                                     "zone": lines.zone(r.bias_pct, r.cv_pct)})
+        rows.append(row)
+    columns = ["variant", "status", "reason", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "zone_rank",
+               "time_s", "steady_window", "window_start_s", "window_end_s"]
+    table = pd.DataFrame(rows).reindex(columns=columns)
+    selection = select_variant(table, settings.selection, lines)
+    table["selected"] = table["variant"] == selection.variant
+    indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "theory", "mean", "bias_pct", "cv_pct",
+                                                 "sigma", "zone"])
+    return table, indicators, selection
+
+
+def _names(df: pd.DataFrame) -> str:
+    return ", ".join(df["variant"].astype(str)) or "none"
+
+
+def _pick(candidates: pd.DataFrame, keys: Sequence[str]) -> pd.Series:
+    return candidates.sort_values(list(keys), kind="stable").iloc[0]
+
+
+def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines) -> Selection:
+    """Apply a selection rule to a screening table (columns: variant, status, zone_rank, time_s,
+    distance_pct) and explain the choice.
+
+    - ``fastest_in_best_zone``: among the variants in the best zone reached, the fastest; ties
+      (equal time) by distance from the origin. This is the study's reasoning (section 2.2: of
+      models 4, 6, 7 in the excellent zone, model 4 is the cheapest).
+    - ``closest_to_origin``: the smallest relative error distance; ties by time.
+    - ``fastest_acceptable``: the fastest variant that is not non-conforming; ties by distance.
+    """
+    ok = table[table["status"] == "ok"]
+    failed = table[table["status"] != "ok"]
+    notes = f" Not screened (failed): {_names(failed)}." if len(failed) else ""
+    tea = f"TEa = {lines.tea_pct:g} %"
+    if ok.empty:
+        return Selection(None, rule, "No variant finished, nothing to select." + notes)
+    if rule == "closest_to_origin":
+        best = _pick(ok, ("distance_pct", "time_s"))
+        why = (f"Rule closest_to_origin: {best['variant']} has the smallest relative error distance "
+               f"({best['distance_pct']:.4g} %, zone {best['zone']}, {tea}).")
+    elif rule == "fastest_acceptable":
+        acceptable = ok[ok["zone_rank"] >= 1]
+        if acceptable.empty:
+            return Selection(None, rule, f"Rule fastest_acceptable: no variant meets Bias + 2 CV <= {tea}; "
+                                         "none is selected." + notes)
+        best = _pick(acceptable, ("time_s", "distance_pct"))
+        why = (f"Rule fastest_acceptable: variants meeting Bias + 2 CV <= {tea}: {_names(acceptable)}; "
+               f"the fastest is {best['variant']} ({best['time_s']:.4g} s, zone {best['zone']}).")
+    elif rule == "fastest_in_best_zone":
+        top = int(ok["zone_rank"].max())
+        zone = lines.zone_names[top]
+        in_zone = ok[ok["zone_rank"] == top]
+        best = _pick(in_zone, ("time_s", "distance_pct"))
+        why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {_names(in_zone)}; "
+               f"the fastest of them is {best['variant']} ({best['time_s']:.4g} s, distance "
+               f"{best['distance_pct']:.4g} %).")
+        if len(in_zone) > 1:
+            slower = in_zone[in_zone["variant"] != best["variant"]]
+            why += " It is as accurate as zone '" + zone + "' asks while " + ", ".join(
+                f"{r.variant} takes {r.time_s / best['time_s']:.3g}x as long" for r in slower.itertuples()) + "."
+        if top == 0:
+            why += (f" WARNING: no variant meets even Bias + {lines.multipliers[0]} CV <= {tea}: "
+                    "the selection is not an acceptable model.")
+    else:
+        raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
+                         "fastest_acceptable")
+    return Selection(str(best["variant"]), rule, why + notes)
