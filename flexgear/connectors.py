@@ -127,7 +127,8 @@ def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m
     pen = mx(delta, 0.0)
     ramp = mn(pen / law.penetration_depth, 1.0)
     damp = law.damping_max * ramp * ramp * (3.0 - 2.0 * ramp)
-    force = law.stiffness * factor * m.pow(pen, law.exponent) if m is not np else law.stiffness * factor * pen**law.exponent
+    power = pen**law.exponent if m is np else m.pow(pen, law.exponent)
+    force = law.stiffness * factor * power
     return mx(force + damp * delta_t, 0.0)
 
 
