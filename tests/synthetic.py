@@ -13,6 +13,8 @@ mesh cycles per block (zero mean in each block). So the Bias % is 100 |bias| and
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import pandas as pd
 
@@ -88,3 +90,23 @@ def synthetic_result(name: str, bias: dict[str, float] | None = None, cv: dict[s
 def failed_result(name: str, reason: str = "diverged") -> RunResult:
     return RunResult({"variant": name, "backend": "exudyn", "status": "failed", "reason": reason,
                       "theory": theory_meta(), "wall_time_s": 0.5})
+
+
+def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -> RunResult:
+    """Stand-in for flexgear.simulate.run_variant (picklable, importable by worker processes).
+
+    More flexible components give a smaller bias and a longer time, as in the study; a variant
+    named "boom" raises like a failing solver, "crash" kills its worker process, one named "diverge" returns a failed result.
+    """
+    if variant.name == "boom":
+        raise RuntimeError("solver blew up")
+    if variant.name == "crash":
+        os._exit(3)                                   # a worker process dying (segfault, OOM kill)
+    if variant.name == "diverge":
+        return failed_result(variant.name, "FloatingPointError: the solution diverged")
+    flex = sum(v == "flexible" for v in variant.components.values())
+    keys = ("output_speed", "outer_mesh_force", "inner_mesh_force")
+    res = synthetic_result(variant.name, dict.fromkeys(keys, 0.01 / (1 + flex)), dict.fromkeys(keys, 0.002),
+                           wall_time_s=1.0 + flex)
+    res.meta.update(components=dict(variant.components), t_end_s=t_end_s)
+    return res

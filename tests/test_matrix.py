@@ -1,0 +1,104 @@
+"""Matrix runner: parallel runs, failures recorded, resume by input hash, Dask, end to end."""
+
+from __future__ import annotations
+
+import json
+import shutil
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from synthetic import GEARBOX, fake_runner
+
+from flexgear.matrix import run_matrix
+from flexgear.results import load_result
+
+VARIANTS = Path("model_variants")
+
+
+def _variant(folder: Path, name: str, flexible: tuple[str, ...] = (), sun: str | None = None) -> Path:
+    comps = {c: ("flexible" if c in flexible else "rigid")
+             for c in ("input_shaft", "sun", "planets", "ring", "output_shaft")}
+    if sun is not None:
+        comps["sun"] = sun
+    body = "\n".join(f'{k} = "{v}"' for k, v in comps.items())
+    path = folder / f"{name}.toml"
+    path.write_text(f'name = "{name}"\ngearbox = "gearbox.toml"\n\n[components]\n{body}\n')
+    return path
+
+
+@pytest.fixture()
+def variants(tmp_path: Path) -> dict[str, Path]:
+    shutil.copy(GEARBOX, tmp_path / "gearbox.toml")
+    return {"rigid": _variant(tmp_path, "rigid"),
+            "flex": _variant(tmp_path, "flex", ("sun", "ring")),
+            "bad": _variant(tmp_path, "bad", sun="elastic"),
+            "boom": _variant(tmp_path, "boom"),
+            "diverge": _variant(tmp_path, "diverge"),
+            "crash": _variant(tmp_path, "crash")}
+
+
+def test_matrix_of_three_with_a_bad_file(variants, tmp_path):
+    out = tmp_path / "results"
+    table = run_matrix([variants["rigid"], variants["flex"], variants["bad"]], out, t_end_s=0.6,
+                       workers=2, progress=False, runner=fake_runner)
+    assert list(table["variant"]) == ["rigid", "flex", "bad"]
+    bad = table.set_index("variant").loc["bad"]
+    assert bad["status"] == "failed"
+    assert "bad.toml" in bad["reason"] and "components.sun" in bad["reason"] and "rigid" in bad["reason"]
+    ok = table[table["status"] == "ok"].set_index("variant")
+    assert (ok["total_wall_time_s"] > 0).all() and (ok["total_cpu_time_s"] >= 0).all()
+    # fake runner: Bias 1 % / (1 + flexible count) and CV 0.2 % on 3 of 5 indicators, 20 % weights:
+    # rigid (0.6 %, 0.12 %) meets Bias + 3 CV <= 1 % but not 4 CV (good); flex (0.2 %, 0.12 %) excellent
+    assert ok.loc["rigid", "bias_pct"] == pytest.approx(0.6, rel=1e-6)
+    assert ok.loc["flex", "bias_pct"] == pytest.approx(0.2, rel=1e-6)
+    assert ok.loc["flex", "zone"] == "excellent" and ok.loc["rigid", "zone"] == "good"
+    assert bool(ok.loc["flex", "selected"]) and not bool(ok.loc["rigid", "selected"])
+    for stem in ("matrix_results", "screening", "screening_indicators"):
+        assert pd.read_csv(out / f"{stem}.csv").shape[0] > 0
+        assert pd.read_parquet(out / f"{stem}.parquet").shape[0] > 0
+    assert "selected: flex" in (out / "selection.txt").read_text()
+    saved = load_result(out / "flex")
+    assert saved.ok and len(saved.signals) > 1000 and saved.meta["input_hash"]
+    assert (out / "flex" / "inputs" / "gearbox.toml").exists()
+    assert json.loads((out / "bad" / "run.json").read_text())["status"] == "failed"
+
+
+def test_runner_failures_are_recorded_and_the_others_go_on(variants, tmp_path):
+    table = run_matrix([variants["boom"], variants["diverge"], variants["rigid"]], tmp_path / "r", t_end_s=0.6,
+                       workers=2, progress=False, runner=fake_runner).set_index("variant")
+    assert table.loc["boom", "status"] == "failed" and "RuntimeError: solver blew up" in table.loc["boom", "reason"]
+    assert table.loc["diverge", "status"] == "failed" and "diverged" in table.loc["diverge", "reason"]
+    assert table.loc["rigid", "status"] == "ok" and bool(table.loc["rigid", "selected"])
+
+
+def test_a_dying_worker_process_is_recorded_and_the_others_rerun(variants, tmp_path):
+    table = run_matrix([variants["crash"], variants["rigid"], variants["flex"]], tmp_path / "c", t_end_s=0.6,
+                       workers=2, progress=False, runner=fake_runner).set_index("variant")
+    assert table.loc["crash", "status"] == "failed" and "worker process died" in table.loc["crash", "reason"]
+    assert (table.loc[["rigid", "flex"], "status"] == "ok").all()
+
+
+def test_resume_skips_unchanged_runs(variants, tmp_path):
+    out = tmp_path / "results"
+    paths = [variants["rigid"], variants["flex"]]
+    first = run_matrix(paths, out, t_end_s=0.6, workers=1, progress=False, runner=fake_runner)
+    stamp = (out / "rigid" / "run.json").stat().st_mtime_ns
+    again = run_matrix(paths, out, t_end_s=0.6, workers=1, progress=False, runner=fake_runner)
+    assert again["resumed"].all() and not first["resumed"].any()
+    assert (out / "rigid" / "run.json").stat().st_mtime_ns == stamp
+    pd.testing.assert_series_equal(first["bias_pct"], again["bias_pct"])
+    # a changed input (here: the simulated time) runs again
+    changed = run_matrix(paths[:1], out, t_end_s=0.5, workers=1, progress=False, runner=fake_runner)
+    assert not changed["resumed"].any()
+
+
+def test_dask_local_cluster(variants, tmp_path):
+    distributed = pytest.importorskip("distributed")
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        table = run_matrix([variants["rigid"], variants["flex"], variants["boom"]], tmp_path / "d", t_end_s=0.6,
+                           scheduler=cluster.scheduler_address, progress=False, runner=fake_runner)
+    status = dict(zip(table["variant"], table["status"], strict=True))
+    assert status == {"rigid": "ok", "flex": "ok", "boom": "failed"}
+    assert table.loc[table["variant"] == "flex", "selected"].item()
