@@ -37,6 +37,7 @@ __all__ = [
     "ReductionSettings",
     "IndicatorWeights",
     "ScreeningSettings",
+    "LumpedAssumed",
     "GearboxSpec",
     "Variant",
     "COMPONENTS",
@@ -283,6 +284,26 @@ class ScreeningSettings:
 
 
 @dataclass(frozen=True)
+class LumpedAssumed:
+    """Lumped-parameter model only (flexgear.lumped, section 2.3): values the study does not give.
+
+    See ``[lumped_assumed]`` in gearbox.toml for each value's source.
+    """
+
+    mesh_stiffness_per_width_n_per_mm_um: float = _num(0.0, lo_open=True, doc="C_gamma of eq. 10")
+    mesh_damping_ratio: float = _num(0.0, 1.0, doc="xi of eq. 13")
+    integration_substeps: int = _num(1, 64, integer=True)
+    friction_table_points: int = _num(16, 65536, integer=True)
+    carrier_mass_kg: float = _num(0.0, lo_open=True)
+    carrier_inertia_kg_m2: float = _num(0.0, lo_open=True)
+
+    @property
+    def mesh_stiffness_per_width_n_per_m2(self) -> float:
+        """C_gamma in SI: 1 N/(mm um) = 1e9 N/m^2."""
+        return self.mesh_stiffness_per_width_n_per_mm_um * 1e9
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -300,6 +321,7 @@ class GearboxSpec:
     meshing_assumed: dict[str, MeshingSettings]
     reduction_assumed: ReductionSettings
     screening: ScreeningSettings
+    lumped_assumed: LumpedAssumed
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
