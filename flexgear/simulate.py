@@ -48,6 +48,7 @@ def simulation_settings(variant: Variant, t_end: float, progress: bool):
     ti.generalizedAlpha.spectralRadius = sv.spectral_radius
     ti.newton.useModifiedNewton = True
     ti.newton.maxModifiedNewtonIterations = sv.newton_max_modified_iterations
+    ti.newton.relativeTolerance = sv.newton_relative_tolerance
     ti.verboseMode = 1 if progress else 0
     s.linearSolverType = exu.LinearSolverType.EXUdense
     s.parallel.numberOfThreads = 1

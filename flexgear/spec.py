@@ -230,6 +230,7 @@ class SolverSettings:
 
     spectral_radius: float = _num(0.0, 1.0)
     newton_max_modified_iterations: int = _num(1, 50, integer=True)
+    newton_relative_tolerance: float = _num(0.0, 1e-2, lo_open=True)
     record_every_steps: int = _num(1, integer=True)
 
 

@@ -1,0 +1,90 @@
+"""Configuration: the study's values load, and bad files get one clear error."""
+
+from pathlib import Path
+
+import pytest
+
+from flexgear.spec import COMPONENTS, SpecError, load_gearbox, load_variant, spec_hash
+
+VARIANTS = Path(__file__).resolve().parents[1] / "model_variants"
+
+
+def test_study_values_load(gearbox):
+    g = gearbox.gears
+    assert (g.sun_teeth, g.planet_teeth, g.ring_teeth, g.planet_count) == (44, 45, 136, 5)  # Table 1
+    assert g.normal_module_m == pytest.approx(2.12e-3)
+    assert gearbox.bearings.output_shaft.radial_stiffness_n_per_m == pytest.approx(1.2e8)  # Table 2
+    assert gearbox.contact.stiffness == pytest.approx(1e8) and gearbox.contact.exponent == pytest.approx(1.5)
+    assert gearbox.load_case.input_speed_rpm == pytest.approx(6000.0)  # Table 5
+    assert gearbox.load_case.load_torque_nm == pytest.approx(557.025)
+
+
+TABLE3 = {1: "RRRRR", 2: "RRFRR", 3: "FRRRF", 4: "RFRFR", 5: "FRFRF", 6: "RFFFR", 7: "FFFFF"}
+
+
+@pytest.mark.parametrize("n", range(1, 8))
+def test_variant_files_are_table3(n):
+    v = load_variant(VARIANTS / f"model{n}.toml")
+    assert "".join("R" if v.components[c] == "rigid" else "F" for c in COMPONENTS) == TABLE3[n]
+
+
+def _write(tmp_path: Path, text: str, name: str = "gearbox.toml") -> Path:
+    p = tmp_path / name
+    p.write_text(text)
+    return p
+
+
+def _gearbox_text() -> str:
+    return (VARIANTS / "gearbox.toml").read_text()
+
+
+@pytest.mark.parametrize(
+    ("old", "new", "field", "allowed"),
+    [
+        ("sun_teeth = 44", "sun_teeth = -4", "gears.sun_teeth", ">= 3"),
+        ("sun_teeth = 44", "sun_teeth = 44.5", "gears.sun_teeth", "integer"),
+        ('helix_layout = "double"', 'helix_layout = "triple"', "gears_assumed.helix_layout", "'double', 'single'"),
+        ("exponent = 1.5", 'exponent = "x"', "contact.exponent", "number"),
+        ("planet_count = 5", "planet_count = 7", "gears.planet_count", "divisible"),
+        ("step_size_s = 1.0e-5", "step_size_s = 0.0", "load_case.step_size_s", "> 0"),
+        ("exponent = 1.5", "exponent = 1.5\nexponant = 2", "contact.exponant", "unknown field"),
+    ],
+)
+def test_bad_gearbox_names_file_field_and_allowed(tmp_path, old, new, field, allowed):
+    path = _write(tmp_path, _gearbox_text().replace(old, new, 1))
+    with pytest.raises(SpecError) as err:
+        load_gearbox(path)
+    msg = str(err.value)
+    assert str(path) in msg and f"'{field}'" in msg and allowed in msg
+
+
+def test_missing_table_and_bad_toml(tmp_path):
+    text = _gearbox_text()
+    start = text.index("[load_case]")
+    end = text.index("[solver_assumed]")
+    with pytest.raises(SpecError, match="'load_case': missing"):
+        load_gearbox(_write(tmp_path, text[:start] + text[end:]))
+    with pytest.raises(SpecError, match="not valid TOML"):
+        load_gearbox(_write(tmp_path, "title = "))
+
+
+def test_bad_variant(tmp_path):
+    _write(tmp_path, _gearbox_text())
+    good = 'name = "x"\ngearbox = "gearbox.toml"\n[components]\n' + "".join(f'{c} = "rigid"\n' for c in COMPONENTS)
+    assert load_variant(_write(tmp_path, good, "v.toml")).is_rigid()
+    bad = good.replace('sun = "rigid"', 'sun = "elastic"')
+    with pytest.raises(SpecError, match=r"'components.sun': expected one of 'rigid', 'flexible'"):
+        load_variant(_write(tmp_path, bad, "v.toml"))
+    with pytest.raises(SpecError, match="'components.carrier': unknown component"):
+        load_variant(_write(tmp_path, good + 'carrier = "rigid"\n', "v.toml"))
+    with pytest.raises(SpecError, match="file does not exist"):
+        load_variant(_write(tmp_path, good.replace("gearbox.toml", "nope.toml"), "v.toml"))
+
+
+def test_hash_tracks_content(gearbox, model1):
+    import dataclasses
+
+    assert spec_hash(model1) == spec_hash(load_variant(VARIANTS / "model1.toml"))
+    other = gearbox.with_changes(load_case=dataclasses.replace(gearbox.load_case, load_torque_nm=500.0))
+    assert spec_hash(other) != spec_hash(gearbox)
+    assert spec_hash(model1, 0.1) != spec_hash(model1, 0.2)
