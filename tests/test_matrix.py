@@ -102,3 +102,33 @@ def test_dask_local_cluster(variants, tmp_path):
     status = dict(zip(table["variant"], table["status"], strict=True))
     assert status == {"rigid": "ok", "flex": "ok", "boom": "failed"}
     assert table.loc[table["variant"] == "flex", "selected"].item()
+
+
+def test_quick_matrix_end_to_end_with_the_exudyn_backend(tmp_path):
+    """model1 (rigid) and model2 (flexible planets, coarse mesh) for 0.02 s, through the real runner."""
+    pytest.importorskip("flexgear.simulate")
+    from flexgear.screening import screen_result
+    from flexgear.spec import load_gearbox
+    from flexgear.theory import step
+
+    shutil.copy(GEARBOX, tmp_path / "gearbox.toml")
+    m1 = tmp_path / "model1.toml"
+    m1.write_text((VARIANTS / "model1.toml").read_text())
+    m2 = tmp_path / "model2.toml"
+    m2.write_text((VARIANTS / "model2.toml").read_text().replace("[components]",
+                                                                  'mesh_level = "coarse"\n\n[components]', 1))
+    table = run_matrix([m1, m2], tmp_path / "quick", t_end_s=0.02, workers=2, progress=False).set_index("variant")
+    assert table.loc["model1", "status"] == "ok"
+    assert table.loc["model2", "status"] == "ok" or "not yet available" in table.loc["model2", "reason"]
+    assert table.loc["model1", "wall_time_s"] > 0 and table.loc["model1", "cpu_time_s"] > 0
+    screening = pd.read_csv(tmp_path / "quick" / "screening.csv").set_index("variant")
+    assert screening.loc["model1", "status"] == "ok" and not screening.loc["model1", "steady_window"]
+    # The input speed is prescribed (STEP ramp, Table 5): its screened mean over the window must be
+    # the ramp's own mean there, an independent check of signals -> samples -> Bias.
+    result = load_result(tmp_path / "quick" / "model1")
+    s = screen_result(result, load_gearbox(GEARBOX).screening)
+    t = result.signals["time_s"].to_numpy()
+    inside = (t >= s.window.start_s) & (t <= s.window.end_s)
+    prescribed = step(t[inside], 0.0, 0.0, result.meta["ramp_time_s"], 36000.0).mean()
+    assert s.indicators["input_speed"].mean == pytest.approx(prescribed, rel=1e-3)
+    assert s.indicators["input_speed"].bias_pct == pytest.approx(100 * (1 - prescribed / 36000.0), rel=1e-3)
