@@ -45,8 +45,8 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
     node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{name}_node", referenceCoordinates=[*position, 0.0, 0.0, 0.0]))
     j_ref = inertia_about_point(props)
     obj = mbs.AddObject(ObjectRigidBody(
-        name=name, physicsMass=props.mass, physicsInertia=InertiaTensor2Inertia6D(j_ref),
-        physicsCenterOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
+        name=name, mass=props.mass, inertia=InertiaTensor2Inertia6D(j_ref),
+        centerOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
     ))
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))

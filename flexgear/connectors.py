@@ -127,25 +127,41 @@ def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m
     pen = mx(delta, 0.0)
     ramp = mn(pen / law.penetration_depth, 1.0)
     damp = law.damping_max * ramp * ramp * (3.0 - 2.0 * ramp)
-    power = pen**law.exponent if m is np else m.pow(pen, law.exponent)
+    if law.exponent == 1.5:
+        power = pen * m.sqrt(pen)
+    else:
+        power = pen**law.exponent if m is np else m.pow(pen, law.exponent)
     force = law.stiffness * factor * power
     return mx(force + damp * delta_t, 0.0)
 
 
 def drive_angle(t: Any, ramp_time: float, speed: float, m: Any = np) -> Any:
-    """Angle [rad] of a STEP speed ramp to ``speed`` over ``ramp_time`` (see theory.step_integral)."""
-    mx = m.maximum if m is np else m.max
-    mn = m.minimum if m is np else m.min
-    d = mn(mx(t, 0.0) / ramp_time, 1.0)
-    return speed * ramp_time * (d * d * d - 0.5 * d * d * d * d) + speed * mx(t - ramp_time, 0.0)
+    """Angle [rad] of a STEP speed ramp to ``speed`` over ``ramp_time`` (t >= 0; see theory.step_integral).
+
+    speed T d^3 (1 - d/2) with d = t/T during the ramp, speed (t - T/2) after it.
+    """
+    d = t * (1.0 / ramp_time)
+    during = (speed * ramp_time) * d * d * d * (1.0 - 0.5 * d)
+    after = speed * (t - 0.5 * ramp_time)
+    if m is np:
+        return np.where(np.asarray(t) < ramp_time, during, after)
+    return m.IfThenElse(t < ramp_time, during, after)
 
 
 def stiffness_factor(phase_cycles: Any, coefficients: np.ndarray, phase0: float, m: Any = np) -> Any:
-    """s(phi) = 1 + sum_n c_n cos(2 pi n (phi - phi_0)) (eq. 11-12 with contact-line coefficients)."""
-    out = 1.0
-    for n, c in enumerate(coefficients, start=1):
-        if c != 0.0:
-            out = out + float(c) * m.cos(2.0 * math.pi * n * (phase_cycles - phase0))
+    """s(phi) = 1 + sum_n c_n cos(2 pi n (phi - phi_0)) (eq. 11-12 with contact-line coefficients).
+
+    Evaluated with one cosine and the Chebyshev recurrence cos(n x) = 2 cos(x) cos((n-1) x) - cos((n-2) x),
+    which keeps the compiled expression short.
+    """
+    if len(coefficients) == 0 or not np.any(coefficients):
+        return 1.0
+    c1 = m.cos(2.0 * math.pi * (phase_cycles - phase0))
+    out = 1.0 + float(coefficients[0]) * c1
+    prev, cur = 1.0, c1
+    for c in coefficients[1:]:
+        prev, cur = cur, 2.0 * c1 * cur - prev
+        out = out + float(c) * cur
     return out
 
 

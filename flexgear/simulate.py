@@ -50,12 +50,10 @@ def simulation_settings(variant: Variant, t_end: float, progress: bool):
     ti.newton.maxModifiedNewtonIterations = sv.newton_max_modified_iterations
     ti.newton.relativeTolerance = sv.newton_relative_tolerance
     ti.verboseMode = 1 if progress else 0
-    s.linearSolverType = exu.LinearSolverType.EXUdense
+    s.linearSolver.solverType = exu.LinearSolverType.EXUdense
     s.parallel.numberOfThreads = 1
-    s.solutionSettings.writeSolutionToFile = False
-    s.solutionSettings.sensorsWritePeriod = lc.step_size_s * (sv.record_every_steps - 0.5)
-    s.displayStatistics = False
-    s.displayComputationTime = False
+    s.solution.file.write = False
+    s.solution.sensors.writePeriod = lc.step_size_s * (sv.record_every_steps - 0.5)
     return s
 
 
@@ -97,7 +95,7 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     cols["output_speed_deg_per_s"] = np.degrees(speed_out[:, 3])
     with np.errstate(divide="ignore", invalid="ignore"):
         cols["transmission_ratio"] = np.where(speed_in[:, 3] != 0, speed_out[:, 3] / speed_in[:, 3], np.nan)
-    cols["input_torque_nm"] = data("input_torque")[:, 1]
+    cols["input_torque_nm"] = -data("input_torque")[:, 1]  # constraint reaction -> torque applied by the drive
     for kind in ("outer", "inner"):
         for i in range(1, n + 1):
             halves = [k for k in sensors if k.startswith(f"{kind}_{i}_")]
