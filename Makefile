@@ -1,0 +1,41 @@
+# flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s), make report
+PY ?= python3
+VARIANTS := $(sort $(wildcard model_variants/model*.toml))
+QUICK_T_END ?= 0.02
+RESULTS ?= results
+
+.PHONY: quick install test lint meshes matrix report lpm bench clean
+
+quick: install
+	$(PY) -m flexgear.cli meshes --level coarse
+	$(PY) -m flexgear.cli matrix $(VARIANTS) --t-end $(QUICK_T_END) --out $(RESULTS)/quick
+	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --t-end $(QUICK_T_END) --out $(RESULTS)/quick
+	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf
+
+install:
+	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+
+lint:
+	$(PY) -m ruff check flexgear tests benchmarks
+
+test: lint
+	$(PY) -m pytest -q
+
+meshes:
+	$(PY) -m flexgear.cli meshes --level default
+
+matrix:
+	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full
+	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
+
+report:
+	$(PY) -m flexgear.cli report $(RESULTS)/full --output reports/screening_report.pdf
+
+lpm:
+	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
+
+bench:
+	$(PY) benchmarks/bench_rigid.py --repeat 3
+
+clean:
+	rm -rf $(RESULTS) reports/*.pdf
