@@ -122,9 +122,7 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
     g1 = np.r_[np.full(nplan, geo.sun.base_radius), np.full(nplan, -geo.planet.base_radius)]
     v_reg = spec.contact_assumed.friction_regularisation_m_per_s
     fscale = geo.sun.base_pitch / (np.abs(g1) * v_reg)
-    spin_support = np.zeros(sysm.n)
-    for i in (2, 5, 8):
-        spin_support[i] = sysm.support_stiffness[i, i]
+    spin_support = sysm.ground_spin_stiffness
     ground = np.array([sysm.support_damping[0, 0], sysm.support_damping[3, 3], sysm.support_damping[6, 6]])
     return LumpedModel(
         sysm, fp, ip, np.flatnonzero(sysm.free), presc, coef, np.ascontiguousarray(np.vstack(harm)),

@@ -206,6 +206,7 @@ class LumpedSystem:
     support_stiffness: np.ndarray  # (n, n) bearings and torsional supports
     support_damping: np.ndarray  # (n, n)
     ground_damping: np.ndarray  # (n, n) bearing damping of members supported on the ground (rotating-frame term)
+    ground_spin_stiffness: np.ndarray  # (n,) torsional supports to the ground (act on the absolute spin)
     mesh_G: np.ndarray  # (2N, n) normal deflection per unit coordinate (cos(beta_b) included)
     mesh_stiffness: np.ndarray  # (2N,) mean, along the normal
     mesh_damping: np.ndarray  # (2N,)
@@ -239,6 +240,7 @@ def assemble(params: LumpedParameters, translations: bool = True) -> LumpedSyste
     labels = tuple(f"{nm}.{c}" for nm in names for c in ("x", "y", "theta"))
     mass = np.zeros(n)
     ks, cs, cg = np.zeros((n, n)), np.zeros((n, n)), np.zeros((n, n))
+    kspin = np.zeros(n)
     free = np.ones(n, dtype=bool)
     held = np.zeros(n, dtype=bool)
     a = p.carrier.radius_m
@@ -262,7 +264,8 @@ def assemble(params: LumpedParameters, translations: bool = True) -> LumpedSyste
                     ks[i, i] += m.bearing_stiffness_n_per_m
                     cs[i, i] += m.bearing_damping_n_s_per_m
                     cg[i, i] += m.bearing_damping_n_s_per_m
-            ks[it, it] += m.torsional_stiffness_n_per_m * m.radius_m**2
+            kspin[it] = m.torsional_stiffness_n_per_m * m.radius_m**2
+            ks[it, it] += kspin[it]
             if names[b] in p.fixed:
                 free[it] = False
                 held[it] = True
@@ -315,7 +318,7 @@ def assemble(params: LumpedParameters, translations: bool = True) -> LumpedSyste
                np.full(p.planet_count, p.ring_mesh_stiffness_n_per_m)]
     cm = np.r_[np.full(p.planet_count, p.sun_mesh_damping_n_s_per_m),
                np.full(p.planet_count, p.ring_mesh_damping_n_s_per_m)]
-    return LumpedSystem(p, labels, mass, ks, cs, cg, G, km, cm, direction, bodies, free, held, nominal)
+    return LumpedSystem(p, labels, mass, ks, cs, cg, kspin, G, km, cm, direction, bodies, free, held, nominal)
 
 
 # --------------------------------------------------------------------------- tooth friction
