@@ -84,15 +84,20 @@ def steady_window(result: RunResult) -> tuple[float, float]:
 
     A run that ends before its ramps do is analysed over its last half instead.
     """
+    _check(result)
     t = result.signals["time_s"].to_numpy()
     t0, t1 = float(t[0]), float(t[-1])
     ramp = float(result.meta.get("ramp_time_s", t0))
     return (ramp, t1) if ramp < t1 else (0.5 * (t0 + t1), t1)
 
 
-def _select(result: RunResult, window: tuple[float, float]) -> pd.DataFrame:
+def _check(result: RunResult) -> None:
     if result.signals is None or not result.ok:
         raise ValueError(f"run {result.name!r} has no signals (status {result.meta.get('status')!r})")
+
+
+def _select(result: RunResult, window: tuple[float, float]) -> pd.DataFrame:
+    _check(result)
     s = result.signals
     sel = s[(s["time_s"] >= window[0] - 1e-12) & (s["time_s"] <= window[1] + 1e-12)]
     if len(sel) < 4:
