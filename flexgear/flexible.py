@@ -95,7 +95,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     for itf_name in names:
         itf = reduced.interface(itf_name)
         markers[itf_name] = mbs.AddMarker(MarkerSuperElementRigid(
-            name=f"{name}_{itf_name}", bodyNumber=obj, offset=list(itf.point),
+            name=f"{name}_{itf_name}", bodyNumber=obj, offset=[0.0, 0.0, 0.0],  # at the weighted mean
             meshNodeNumbers=np.asarray(itf.nodes, np.int64), weightingFactors=np.asarray(itf.weights, float),
             useAlternativeApproach=True, visualization={"show": False, "showMarkerNodes": False}))
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
