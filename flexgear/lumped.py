@@ -146,7 +146,8 @@ def _ramp(t: float, T: float) -> tuple[float, float, float, float]:
 
 
 @numba.njit(cache=True)
-def _evaluate(t, y, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, pcentre, pidx, pcoefm, poff,
+def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef, harm, pcentre,
+              pidx, pcoefm, poff,
               backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal, movable, q, qd, acc, f, forces,
               out):
     """Accelerations ``acc`` (all coordinates, rotating frame), forces and the recorded signals ``out``."""
@@ -165,10 +166,11 @@ def _evaluate(t, y, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, p
     for k in range(presc.size):
         q[presc[k]] = pcoef[k] * w * th_in
         qd[presc[k]] = pcoef[k] * w * s
-    for i in range(n):
+    for i in range(n):  # supports: sparse rows (CSR)
         acc_i = -spin_support[i] * th_c
-        for j in range(n):
-            acc_i -= Ks[i, j] * q[j] + Cs[i, j] * qd[j]
+        for k in range(sp_ptr[i], sp_ptr[i + 1]):
+            j = sp_idx[k]
+            acc_i -= sp_k[k] * q[j] + sp_c[k] * qd[j]
         f[i] = acc_i
     for b in range(3):  # ground bearings damp the absolute velocity x' + Omega J x
         f[3 * b] += ground[b] * om * q[3 * b + 1]
@@ -179,9 +181,9 @@ def _evaluate(t, y, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, p
     for m in range(km.size):
         d = 0.0
         dd = 0.0
-        for j in range(n):
-            d += G[m, j] * q[j]
-            dd += G[m, j] * qd[j]
+        for k in range(gidx.shape[1]):  # the (at most 6) coordinates of the mesh's two gears
+            d += gval[m, k] * q[gidx[m, k]]
+            dd += gval[m, k] * qd[gidx[m, k]]
         contact = True
         if d > 0.0:
             fd = d
@@ -198,8 +200,8 @@ def _evaluate(t, y, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, p
         if contact:
             F += cm[m] * dd
         forces[m] = F
-        for j in range(n):
-            f[j] -= F * G[m, j]
+        for k in range(gidx.shape[1]):
+            f[gidx[m, k]] -= F * gval[m, k]
         if mu > 0.0 and F > 0.0:
             ph = (phase - math.floor(phase)) * npts
             i0 = int(ph) % npts
@@ -246,7 +248,8 @@ def _evaluate(t, y, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, p
 
 
 @numba.njit(cache=True)
-def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm,
+def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free,
+               presc, pcoef, harm,
                pcentre, pidx, pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
                movable):
     """RK4 from t0 over n_out recorded steps; rec[k] = signals at t0 + k h_out. Returns the final state."""
@@ -271,7 +274,8 @@ def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, Ks, Cs, G, km, 
                     fac = h if stage == 3 else 0.5 * h
                     for i in range(2 * nf):
                         ytmp[i] = y[i] + fac * kk[stage - 1][i]
-                _evaluate(ts, ytmp, fp, ip, mass, Ks, Cs, G, km, cm, free, presc, pcoef, harm, pcentre, pidx,
+                _evaluate(ts, ytmp, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef,
+                          harm, pcentre, pidx,
                           pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
                           movable, q, qd, acc, f, forces, out)
                 if stage == 0 and sub == 0:
@@ -286,9 +290,29 @@ def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, Ks, Cs, G, km, 
     return y
 
 
+def _sparse_rows(*mats: np.ndarray) -> tuple[np.ndarray, ...]:
+    """CSR pattern (union of the non-zeros) of same-shaped matrices: indptr, indices, one data array each."""
+    pattern = np.any([m != 0.0 for m in mats], axis=0)
+    rows, cols = np.nonzero(pattern)
+    ptr = np.searchsorted(rows, np.arange(pattern.shape[0] + 1)).astype(np.int64)
+    return (ptr, cols.astype(np.int64), *[np.ascontiguousarray(m[rows, cols]) for m in mats])
+
+
+def _sparse_mesh_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Non-zero columns of each mesh row, padded (index 0, value 0) to equal length."""
+    width = max(1, int((G != 0.0).sum(1).max()))
+    idx = np.zeros((G.shape[0], width), dtype=np.int64)
+    val = np.zeros((G.shape[0], width))
+    for m, row in enumerate(G):
+        nz = np.flatnonzero(row)
+        idx[m, :nz.size], val[m, :nz.size] = nz, row[nz]
+    return idx, val
+
+
 def _kernel_args(model: LumpedModel) -> tuple:
     s = model.system
-    return (model.fp, model.ip, s.mass, s.support_stiffness, s.support_damping, s.mesh_G, s.mesh_stiffness,
+    return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
+            *_sparse_mesh_rows(s.mesh_G), s.mesh_stiffness,
             s.mesh_damping, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
             model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
             model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
