@@ -207,8 +207,9 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
                  f"m = {', '.join(map(str, d.lines.multipliers))}, {d.settings.sample_count} samples per window, "
                  f"weights 20 % per indicator unless configured otherwise, rule '{d.settings.selection}'."]
         if unsteady:
-            lines += ["", "CAUTION: the runs " + ", ".join(unsteady) + " end before the load ramps do (quick runs): "
-                      "their windows are not steady, so their Bias/CV measure the ramp, not the model's accuracy."]
+            lines += ["", "CAUTION: these runs end before the load ramps do (quick runs): " + ", ".join(unsteady)
+                      + ". Their windows are not steady, so their Bias and CV measure the ramp, not the model's "
+                      "accuracy."]
         lines += ["", "Contents"] + [f"  page {p:>2}   {t}" for p, t in contents]
         _text_block(ax, "\n".join(lines), width=125, fontsize=9.5)
     return draw
@@ -481,15 +482,22 @@ def _tables_6_7_pages(d: ReportData) -> list[Page]:
         t7 = pd.DataFrame(index=pd.Index(list(_STUDY_T7), name="mesh_harmonic"))
         notes.append("No finished run to compare: only the study's values are shown.")
     else:
-        a, b = (ours * 2)[:2]
-        t6, t7 = compare_results(a, b)
-        keep = 2 if len(ours) == 1 else 3                     # one run only: drop its duplicate column
+        t6 = None
+        if len(ours) == 2:
+            try:
+                t6, t7 = compare_results(*ours)
+            except ValueError as exc:          # e.g. runs of different lengths share no window
+                notes.append(f"The lumped run is not compared ({exc}).")
+                ours = ours[:1]
+        if t6 is None:
+            t6, t7 = compare_results(ours[0], ours[0])
+        w = t6.attrs["window_s"]
+        keep = 1 + len(ours)                   # one run only: drop its duplicate column
         t6 = t6.iloc[:, :keep]
-        t7 = t7.iloc[:, :2 * (keep - 1)]
+        t7 = t7.iloc[:, :2 * len(ours)]
         t6.columns = ["theory"] + [r.name if r.name == r.meta.get("backend") else f"{r.name} ({r.meta.get('backend')})"
                                    for r in ours]
         t7.columns = [f"{r.name}: {side}" for r in ours for side in ("input", "output")]
-        w = t6.attrs["window_s"]
         notes.append(f"flexgear values over the window {w[0]:.4g}–{w[1]:.4g} s (flexgear.compare); Table 7: "
                      "x component of the bearing acceleration, windowed DTFT at each harmonic.")
         if d.lumped is None:
