@@ -332,7 +332,7 @@ def _diagram_page(d: ReportData) -> Callable[[Figure], None]:
             a2 = fig.add_axes([0.56, 0.2, 0.4, 0.68])
             if beyond:
                 decision_diagram(a1, d.screening, d.lines, max(pts[0], zones[0]), max(pts[1], zones[1]),
-                                 title="all variants")
+                                 title="all variants (those near the origin: see the zones on the right)")
                 decision_diagram(a2, d.screening, d.lines, *zones, title="zones at the scale of TEa")
             else:
                 decision_diagram(a1, d.screening, d.lines, *zones, title="zones at the scale of TEa", labels=False)

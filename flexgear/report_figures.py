@@ -138,24 +138,28 @@ def decision_diagram(ax: Axes, screening: pd.DataFrame, lines: DecisionLines,
         below = tea / ms[k + 1] if k + 1 < len(ms) else 0.0
         ax.add_patch(Polygon([(0, tea / m), (tea, 0), (0, below)],
                              color=_ZONE_COLOURS[min(k + 1, len(_ZONE_COLOURS) - 1)], lw=0))
+    # far wider than TEa (points far outside): the zones shrink into a corner; only the far points get labels
+    compact = xmax > 4 * tea or ymax > 2 * tea
     b = np.linspace(0.0, tea, 50)
     for m in ms:
         ax.plot(b, lines.cv_on_line(m, b), color="k", lw=0.9)
-        x_lab = 0.55 * tea
-        ax.annotate(f"Bias + {m}·CV = TEa", (x_lab, (tea - x_lab) / m), fontsize=7, rotation=0,
-                    xytext=(3, 2), textcoords="offset points", clip_on=True)
-    if xmax < 4 * tea:
+        if not compact:
+            x_lab = 0.55 * tea
+            ax.annotate(f"Bias + {m}·CV = TEa", (x_lab, (tea - x_lab) / m), fontsize=7, xytext=(3, 2),
+                        textcoords="offset points", clip_on=True)
+    if not compact:
         for name, (x, y) in zip(names, _zone_label_points(lines), strict=True):
             if y < ymax:
                 ax.text(x, y, name, fontsize=8, style="italic", va="center", color="#333333", clip_on=True)
+        ax.annotate(f"TEa = {tea:g} %", (tea, 0), xytext=(4, 8), textcoords="offset points", fontsize=8)
     ax.axvline(tea, color="#444444", lw=0.8, ls=":")
-    ax.annotate(f"TEa = {tea:g} %", (tea, 0), xytext=(4, 8), textcoords="offset points", fontsize=8)
     for i, row in enumerate(ok.itertuples()):
         if row.bias_pct > xmax or row.cv_pct > ymax:
             continue
         ax.plot(row.bias_pct, row.cv_pct, "o", ms=6, mfc="#1f4e99" if not row.selected else "#d62728", mec="k",
                 clip_on=False, zorder=5)
-        if not labels:
+        near = row.bias_pct <= 1.3 * tea and row.cv_pct <= 0.65 * tea
+        if not labels or (compact and near):
             continue
         dy = 6 + 9 * (i % 3)
         ax.annotate(row.variant + (" (selected)" if row.selected else ""), (row.bias_pct, row.cv_pct),
@@ -258,20 +262,26 @@ def history_panel(ax: Axes, t: np.ndarray, series: dict[str, np.ndarray], ylabel
     reference line (label, value) and the screening window shaded on full-length views; series
     named in ``emphasise`` are drawn thick and black."""
     sel = slice(None) if zoom is None else (t >= zoom[0]) & (t <= zoom[1])
+    lo, hi = np.inf, -np.inf
     for label, y in series.items():
         style = {"color": "k", "lw": 1.4} if label in emphasise else {"lw": 0.7}
-        ax.plot(*envelope(t[sel], np.asarray(y)[sel]), label=label, **style)
+        tt, yy = envelope(t[sel], np.asarray(y)[sel])
+        ax.plot(tt, yy, label=label, **style)
+        if yy.size:
+            lo, hi = min(lo, float(yy.min())), max(hi, float(yy.max()))
     if reference is not None:
-        ax.axhline(reference[1], color="#d62728", ls="--", lw=1.0, label=reference[0])
+        ref = reference[1]
+        span = max(hi - lo, 1e-12 * max(abs(ref), 1.0))
+        if zoom is None or lo - 3 * span <= ref <= hi + 3 * span:
+            ax.axhline(ref, color="#d62728", ls="--", lw=1.0, label=reference[0])
+        else:  # a zoom on data far from the reference: keep the data's scale and say where the reference is
+            above = ref > hi
+            ax.text(0.02, 0.95 if above else 0.05, f"{reference[0]}: {ref:.6g} ({'above' if above else 'below'})",
+                    transform=ax.transAxes, fontsize=7, color="#d62728", va="top" if above else "bottom")
     if window is not None and zoom is None:
         ax.axvspan(window.start_s, window.end_s, color="#2ca02c", alpha=0.12, label="screening window")
     if zoom is not None:
         ax.set_xlim(*zoom)
-        if reference is not None:
-            lo, hi = ax.get_ylim()
-            lo, hi = min(lo, reference[1]), max(hi, reference[1])
-            pad = 0.05 * (hi - lo)
-            ax.set_ylim(lo - pad, hi + pad)
     ax.set_xlabel("time [s]")
     ax.set_ylabel(ylabel)
     ax.set_title(title, fontsize=9)
