@@ -10,13 +10,16 @@ Gear contact (section 2.1 of the study, ADAMS impact function, per helix half h)
 
     delta_h  = g1 . q1 + g2 . q2                           (mesh deflection along the tooth normal)
     F_h      = max(0, k_h s(phi) <delta_h>^e + c_max,h STEP(delta_h, 0, 0, d, 1) d(delta_h)/dt)
+    friction = mu F_h tanh(Omega lambda_mean / v_reg) (kappa(phi), lambda(phi))  on (sliding, relative spin)
 
 with k_h, c_max,h the study's stiffness and damping scaled by the half's share of the face width,
 s(phi) = 1 + sum_n c_n cos(2 pi n (phi - phi_0)) the mesh-stiffness variation of eq. 11-12
 (phi: mesh phase in cycles, from the prescribed drive), and F_h = 0 when the teeth separate.
-The deflection is carried by an auxiliary coordinate per half, tied to the gear coordinates by
-one linear ``ObjectConnectorCoordinateVector`` constraint; the law is a compiled (symbolic)
-user function of a ``ObjectConnectorCoordinateSpringDamper``: no Python runs per step.
+Deflection, pitch-point sliding and relative spin are three auxiliary coordinates per half, tied
+to the gear coordinates by one linear ``ObjectConnectorCoordinateVector`` constraint; the law is a
+compiled (symbolic) user function of an ``ObjectConnectorCartesianSpringDamper`` on them: no
+Python runs per step. Friction (kappa, lambda: see flexgear.involute.contact_line_distribution)
+follows from the contact lines' positions relative to the pitch point.
 """
 
 from __future__ import annotations
@@ -28,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from flexgear.bodies import Body
+from flexgear.involute import PeriodicSeries
 from flexgear.spec import Bearing, Contact
 
 __all__ = [
@@ -35,9 +39,12 @@ __all__ = [
     "ContactLaw",
     "GearContact",
     "impact_force",
-    "stiffness_factor",
+    "periodic_value",
+    "friction_forces",
     "drive_angle",
-    "mesh_deflection_gradients",
+    "relative_displacement_gradient",
+    "contact_gradients",
+    "MeshFriction",
     "add_linear_elements",
     "add_gear_contacts",
     "add_speed_drive",
@@ -94,7 +101,7 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing]) -> tup
         damping[s, s] += e.damping_matrix()
     obj = mbs.AddObject(ObjectGenericODE2(
         name="bushings", nodeNumbers=[b.node for b in bodies], massMatrix=np.zeros((n, n)),
-        stiffnessMatrix=stiffness, dampingMatrix=damping,
+        stiffnessMatrix=stiffness, dampingMatrix=damping, forceVector=np.zeros(n),
     ))
     marker = mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=obj))
     return obj, marker
@@ -127,10 +134,12 @@ def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m
     pen = mx(delta, 0.0)
     ramp = mn(pen / law.penetration_depth, 1.0)
     damp = law.damping_max * ramp * ramp * (3.0 - 2.0 * ramp)
-    if law.exponent == 1.5:
+    if m is np:
+        power = pen**law.exponent
+    elif law.exponent == 1.5:
         power = pen * m.sqrt(pen)
     else:
-        power = pen**law.exponent if m is np else m.pow(pen, law.exponent)
+        power = m.pow(pen, law.exponent)
     force = law.stiffness * factor * power
     return mx(force + damp * delta_t, 0.0)
 
@@ -148,21 +157,41 @@ def drive_angle(t: Any, ramp_time: float, speed: float, m: Any = np) -> Any:
     return m.IfThenElse(t < ramp_time, during, after)
 
 
-def stiffness_factor(phase_cycles: Any, coefficients: np.ndarray, phase0: float, m: Any = np) -> Any:
-    """s(phi) = 1 + sum_n c_n cos(2 pi n (phi - phi_0)) (eq. 11-12 with contact-line coefficients).
+def periodic_value(phase_cycles: Any, series: PeriodicSeries, m: Any = np) -> Any:
+    """Value of a Fourier series in the mesh phase (cycles); ``m`` is numpy or ``exudyn.symbolic``.
 
-    Evaluated with one cosine and the Chebyshev recurrence cos(n x) = 2 cos(x) cos((n-1) x) - cos((n-2) x),
-    which keeps the compiled expression short.
+    Uses one cosine and one sine and the recurrences cos(n x) = 2 cos(x) cos((n-1) x) - cos((n-2) x),
+    sin(n x) = sin(x) U_(n-1)(cos x) with U_n = 2 cos(x) U_(n-1) - U_(n-2): short compiled expressions.
     """
-    if len(coefficients) == 0 or not np.any(coefficients):
-        return 1.0
-    c1 = m.cos(2.0 * math.pi * (phase_cycles - phase0))
-    out = 1.0 + float(coefficients[0]) * c1
-    prev, cur = 1.0, c1
-    for c in coefficients[1:]:
-        prev, cur = cur, 2.0 * c1 * cur - prev
-        out = out + float(c) * cur
+    out = series.mean
+    if len(series.cos_coeffs) == 0 or not (np.any(series.cos_coeffs) or np.any(series.sin_coeffs)):
+        return out
+    x = 2.0 * math.pi * phase_cycles
+    c1, s1 = m.cos(x), m.sin(x)
+    t_prev, t_cur = 1.0, c1  # Chebyshev T_(n-1), T_n
+    u_prev, u_cur = 0.0, 1.0  # U_(n-2), U_(n-1)
+    for a, b in zip(series.cos_coeffs, series.sin_coeffs, strict=True):
+        if np.ndim(a) == 0:  # plain numbers (symbolic expressions need Python floats)
+            a, b = float(a), float(b)
+        out = out + a * t_cur + b * s1 * u_cur
+        t_prev, t_cur = t_cur, 2.0 * c1 * t_cur - t_prev
+        u_prev, u_cur = u_cur, 2.0 * c1 * u_cur - u_prev
     return out
+
+
+def friction_forces(normal_force: Any, relative_spin: Any, sliding: Any, lever: Any, mu: float,
+                    regularisation: float, mean_lever: float, m: Any = np) -> tuple[Any, Any]:
+    """Lumped Coulomb friction of a mesh: forces on the sliding and relative-spin coordinates.
+
+    Each contact line at distance s from the pitch point slides with s * Omega (Omega = relative spin
+    rate omega_1 - omega_2); summed over the lines with the load uniform along them, friction gives
+    mu F sigma kappa(phi) on the sliding coordinate (pitch-point sliding along w = e_z x t) and
+    mu F sigma lambda(phi) on the relative spin (a moment), sigma = tanh(Omega lambda_mean / v_reg)
+    the regularised sign of sliding.
+    """
+    sigma = m.tanh(relative_spin * (mean_lever / regularisation))
+    f = mu * normal_force * sigma
+    return f * sliding, f * lever
 
 
 # --------------------------------------------------------------------------- gear contact
@@ -170,8 +199,10 @@ def stiffness_factor(phase_cycles: Any, coefficients: np.ndarray, phase0: float,
 class GearContact:
     """One contact (helix half) between two gears: linear mesh kinematics plus its contact law.
 
-    ``gradient1``/``gradient2`` are d(delta)/dq of the frame coordinates (6,) of ``body1``/``body2``.
-    The mesh phase in cycles is ``phase_per_drive_angle * drive_angle(t) + phase0``.
+    ``gradient1``/``gradient2`` (3, 6) are the derivatives, with respect to the frame coordinates of
+    ``body1``/``body2``, of the contact's three kinematic coordinates: the mesh deflection along the
+    tooth normal, the sliding displacement at the pitch point along w = e_z x t, and the relative spin
+    angle. The local mesh phase in cycles is ``phase_per_drive_angle * drive_angle(t) - phase_offset``.
     """
 
     name: str
@@ -180,32 +211,46 @@ class GearContact:
     gradient1: np.ndarray
     gradient2: np.ndarray
     law: ContactLaw
-    harmonics: np.ndarray
-    phase0: float
+    stiffness: PeriodicSeries  # normalised mesh stiffness s(phi), eq. 11-12
+    sliding: PeriodicSeries  # kappa(phi): net sliding direction of the load
+    lever: PeriodicSeries  # lambda(phi) [m]: mean distance of the load from the pitch point
+    friction_coefficient: float
+    friction_regularisation: float  # m/s
+    phase_offset: float
     phase_per_drive_angle: float
 
 
-def mesh_deflection_gradients(
-    centre1: np.ndarray, centre2: np.ndarray, contact_point: np.ndarray, normal: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """Gradients of delta = (v1 - v2) . n with v_k = u_k + phi_k x (X - c_k) (small rotations).
+def relative_displacement_gradient(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarray,
+                                   direction: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Gradients of (v1 - v2) . d at ``point``, v_k = u_k + phi_k x (X - c_k) (small rotations).
 
-    d(delta)/d(u1, phi1) = (n, (X - c1) x n);  d(delta)/d(u2, phi2) = -(n, (X - c2) x n).
-    Exact for the spin angle (lever arm = base radius cos(beta_b) for X on the line of action),
-    linearised for translations and tilts.
+    d/d(u1, phi1) = (d, (X - c1) x d);  d/d(u2, phi2) = -(d, (X - c2) x d). For the tooth normal this is
+    the mesh deflection: exact in the spin (lever arm r_b cos(beta_b) on the line of action),
+    linearised in translation and tilt.
     """
-    n = np.asarray(normal, float)
-    x = np.asarray(contact_point, float)
-    g1 = np.concatenate([n, np.cross(x - centre1, n)])
-    g2 = -np.concatenate([n, np.cross(x - centre2, n)])
-    return g1, g2
+    d = np.asarray(direction, float)
+    x = np.asarray(point, float)
+    return np.concatenate([d, np.cross(x - centre1, d)]), -np.concatenate([d, np.cross(x - centre2, d)])
+
+
+def contact_gradients(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarray, normal: np.ndarray,
+                      line_of_action: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(3, 6) gradients of (deflection, pitch-point sliding, relative spin) for both gears."""
+    ez = np.array([0.0, 0.0, 1.0])
+    w = np.cross(ez, line_of_action)
+    n1, n2 = relative_displacement_gradient(centre1, centre2, point, normal)
+    a1, a2 = relative_displacement_gradient(centre1, centre2, point, w)
+    spin = np.concatenate([np.zeros(3), ez])
+    return np.vstack([n1, a1, spin]), np.vstack([n2, a2, -spin])
 
 
 def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts: list[GearContact],
-                      ramp_time: float, drive_speed: float) -> list[int]:
-    """Add the contacts: auxiliary deflection coordinates, one constraint, one compiled law each.
+                      ramp_time: float, drive_speed: float) -> tuple[list[int], int]:
+    """Add the contacts: one auxiliary deflection coordinate each, one linear constraint for all,
+    one compiled normal-force law each.
 
-    Returns the spring-damper object of every contact (their ``Force`` output is the normal force).
+    Returns the spring-damper of every contact (its ``Force`` output is the normal force) and the
+    auxiliary node holding the deflections.
     """
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
@@ -218,47 +263,126 @@ def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts
     )
     from exudyn.utilities import CreateSymbolicUserFunction
 
-    index = {b.name: i for i, b in enumerate(bodies)}
-    n_c, n_q = len(contacts), 6 * len(bodies)
-    gradient = np.zeros((n_c, n_q))
-    for i, c in enumerate(contacts):
-        gradient[i, 6 * index[c.body1]:6 * index[c.body1] + 6] += c.gradient1
-        gradient[i, 6 * index[c.body2]:6 * index[c.body2] + 6] += c.gradient2
+    n_c = len(contacts)
+    gradient = _assemble_rows(bodies, contacts, row=0)
     # MarkerObjectODE2Coordinates measures reference + displacement coordinates: subtract the reference
     q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies])
     aux = mbs.AddNode(NodeGenericODE2(name="mesh_deflections", numberOfODE2Coordinates=n_c,
                                       referenceCoordinates=[0.0] * n_c, initialCoordinates=[0.0] * n_c,
                                       initialCoordinates_t=[0.0] * n_c))
-    m_aux = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux))
     mbs.AddObject(ObjectConnectorCoordinateVector(
-        name="mesh_kinematics", markerNumbers=[m_aux, coordinates_marker],
+        name="mesh_kinematics", markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux)),
+                                               coordinates_marker],
         scalingMarker0=np.eye(n_c), scalingMarker1=gradient, offset=gradient @ q_ref,
     ))
-    ground = mbs.AddNode(NodePointGround())
-    m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
     springs, laws = [], []
     for i, c in enumerate(contacts):
-        m_i = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))
         spring = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
-            name=c.name, markerNumbers=[m_ground, m_i], stiffness=0.0, damping=0.0))
-
-        law = _contact_law_function(c, ramp_time, drive_speed, esym)
+            name=c.name, markerNumbers=[m_ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
+        law = _normal_law_function(c, ramp_time, drive_speed, esym)
         laws.append(CreateSymbolicUserFunction(mbs, law, "springForceUserFunction", spring))
         mbs.SetObjectParameter(spring, "springForceUserFunction", laws[-1])
         springs.append(spring)
     _keep_alive(mbs, laws)
-    return springs
+    return springs, aux
 
 
-def _contact_law_function(c: GearContact, ramp_time: float, drive_speed: float, esym: Any):
-    """The contact law of ``c`` as a spring-force user function (traced once into a symbolic one)."""
+def _assemble_rows(bodies: list[Body], contacts: list[GearContact], row: int) -> np.ndarray:
+    """(n_contacts, 6 n_bodies) matrix of one kinematic row of every contact."""
+    index = {b.name: i for i, b in enumerate(bodies)}
+    out = np.zeros((len(contacts), 6 * len(bodies)))
+    for i, c in enumerate(contacts):
+        out[i, 6 * index[c.body1]:6 * index[c.body1] + 6] += c.gradient1[row]
+        out[i, 6 * index[c.body2]:6 * index[c.body2] + 6] += c.gradient2[row]
+    return out
+
+
+def _normal_law_function(c: GearContact, ramp_time: float, drive_speed: float, esym: Any):
+    """The normal-force law of ``c`` as a spring-force user function (traced once into a symbolic one)."""
 
     def law(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):  # noqa: N803
-        phase = c.phase_per_drive_angle * drive_angle(t, ramp_time, drive_speed, esym) + c.phase0
-        factor = stiffness_factor(phase, c.harmonics, 0.0, esym)
-        return impact_force(displacement, velocity, c.law, factor, esym)
+        phase = c.phase_per_drive_angle * drive_angle(t, ramp_time, drive_speed, esym) - c.phase_offset
+        return impact_force(displacement, velocity, c.law, periodic_value(phase, c.stiffness, esym), esym)
 
     return law
+
+
+def _stack(series: list[PeriodicSeries]) -> PeriodicSeries:
+    """Several series as one with array coefficients (harmonic-major), evaluated element-wise."""
+    width = max(len(x.cos_coeffs) for x in series)
+
+    def pad(v: np.ndarray) -> np.ndarray:
+        return np.pad(np.asarray(v, float), (0, width - len(v)))
+
+    return PeriodicSeries(np.array([x.mean for x in series]), np.array([pad(x.cos_coeffs) for x in series]).T,
+                          np.array([pad(x.sin_coeffs) for x in series]).T)
+
+
+class MeshFriction:
+    """Tooth friction of all contacts as one generalized load, updated once per time step.
+
+    The friction forces (:func:`friction_forces`) need each contact's normal force, which lives in
+    another connector; they are therefore evaluated at the start of every step from the converged
+    state of the previous one (explicit in time, one step h behind; friction is mu = 0.02 of the
+    normal force, whose mesh-frequency content has 22 steps per period at 4400 Hz) and applied as the
+    ``forceVector`` of the frame-element container: Q = -(A f_slide + B f_spin).
+    """
+
+    def __init__(self, mbs, bodies: list[Body], container: int, aux_node: int, contacts: list[GearContact],
+                 ramp_time: float, drive_speed: float):
+        self.mbs, self.container, self.contacts = mbs, container, contacts
+        self.ramp_time, self.drive_speed = ramp_time, drive_speed
+        self.sliding_rows = _assemble_rows(bodies, contacts, row=1)
+        self.spin_rows = _assemble_rows(bodies, contacts, row=2)
+        self.bodies = bodies
+        self.aux_node = aux_node
+        self.mu = np.array([c.friction_coefficient for c in contacts])
+        self.reg = np.array([c.friction_regularisation for c in contacts])
+        self.offsets = np.array([c.phase_offset for c in contacts])
+        self.phase_rate = np.array([c.phase_per_drive_angle for c in contacts])
+        # every contact's law and series stacked into arrays: one vectorised evaluation per step
+        self.law = ContactLaw(*(np.array([getattr(c.law, f) for c in contacts])
+                                for f in ("stiffness", "exponent", "damping_max", "penetration_depth")))
+        self.series = {name: _stack([getattr(c, name) for c in contacts]) for name in ("stiffness", "sliding", "lever")}
+        self._cos = np.ascontiguousarray([np.atleast_2d(self.series[k].cos_coeffs).T
+                                          for k in ("stiffness", "sliding", "lever")])
+        self._sin = np.ascontiguousarray([np.atleast_2d(self.series[k].sin_coeffs).T
+                                          for k in ("stiffness", "sliding", "lever")])
+        self._means = np.array([self.series[k].mean for k in ("stiffness", "sliding", "lever")])
+        self._index: tuple[np.ndarray, np.ndarray] | None = None
+
+    def forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+        """Generalized friction forces on the frame coordinates (reference implementation, numpy)."""
+        phase = self.phase_rate * drive_angle(t, self.ramp_time, self.drive_speed) - self.offsets
+        value = {name: periodic_value(phase, series) for name, series in self.series.items()}
+        normal = impact_force(delta, delta_t, self.law, value["stiffness"])
+        f_slide, f_spin = friction_forces(normal, self.spin_rows @ q_t, value["sliding"], value["lever"],
+                                          self.mu, self.reg, self.series["lever"].mean)
+        return -(self.sliding_rows.T @ f_slide + self.spin_rows.T @ f_spin)
+
+    def fast_forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+        """Same as :meth:`forces`, compiled (flexgear.kernels.mesh_friction_forces)."""
+        from flexgear.kernels import mesh_friction_forces
+
+        phase = self.phase_rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        law = self.law
+        return mesh_friction_forces(
+            phase, delta, delta_t, q_t, law.stiffness, law.exponent, law.damping_max, law.penetration_depth,
+            self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows)
+
+    def __call__(self, mbs, t: float) -> bool:
+        """Pre-step user function: friction from the state at the start of the step."""
+        if self._index is None:
+            self._index = (
+                np.arange(mbs.GetNodeODE2Index(self.aux_node), mbs.GetNodeODE2Index(self.aux_node) + len(self.mu)),
+                np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
+                                for b in self.bodies]),
+            )
+        aux, frames = self._index
+        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        mbs.SetObjectParameter(self.container, "forceVector", self.fast_forces(t, q[aux], q_t[aux], q_t[frames]))
+        return True
 
 
 # --------------------------------------------------------------------------- drive and load

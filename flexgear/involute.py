@@ -37,6 +37,9 @@ __all__ = [
     "solve_profile_shifts",
     "gear_set_geometry",
     "mesh_stiffness_harmonics",
+    "PeriodicSeries",
+    "contact_line_distribution",
+    "contact_line_series",
 ]
 
 
@@ -181,6 +184,18 @@ class Mesh:
         return face_width * math.sin(self.gear1.helix_angle) / (math.pi * self.gear1.normal_module)
 
     @property
+    def approach_length(self) -> float:
+        """Distance [m] along the line of action from the start of contact A to the pitch point C.
+
+        Gear 1 drives, so contact starts on the driven gear's tip circle:
+        external: g_f = sqrt(r_a2^2 - r_b2^2) - r_w2 sin(a_w); internal: g_f = r_w2 sin(a_w) - sqrt(r_a2^2 - r_b2^2).
+        """
+        g2, aw = self.gear2, self.operating_pressure_angle
+        tip = math.sqrt(g2.tip_radius**2 - g2.base_radius**2)
+        pitch = g2.base_radius * math.tan(aw)  # r_w2 sin(a_w) = r_b2 tan(a_w)
+        return pitch - tip if self.internal else tip - pitch
+
+    @property
     def normal_backlash(self) -> float:
         """Normal backlash from the tooth thinning of both gears, j_n = (ds1 + ds2) cos(alpha_n) [m].
 
@@ -288,3 +303,71 @@ def mesh_stiffness_harmonics(eps_alpha: float, eps_beta: float, harmonics: int) 
     """
     n = np.arange(1, harmonics + 1)
     return 2 * np.sinc(n * eps_alpha) * np.sinc(n * eps_beta)
+
+
+@dataclass(frozen=True)
+class PeriodicSeries:
+    """f(phi) = mean + sum_n (cos_coeffs[n-1] cos(2 pi n phi) + sin_coeffs[n-1] sin(2 pi n phi)), phi in cycles."""
+
+    mean: float
+    cos_coeffs: np.ndarray
+    sin_coeffs: np.ndarray
+
+    def __call__(self, phi: np.ndarray | float) -> np.ndarray:
+        phi = np.asarray(phi, dtype=float)
+        out = np.full_like(phi, self.mean)
+        for n, (a, b) in enumerate(zip(self.cos_coeffs, self.sin_coeffs, strict=True), start=1):
+            out = out + a * np.cos(2 * np.pi * n * phi) + b * np.sin(2 * np.pi * n * phi)
+        return out
+
+    @classmethod
+    def fit(cls, samples: np.ndarray, harmonics: int) -> PeriodicSeries:
+        """Truncated Fourier series of samples taken at phi = k / len(samples)."""
+        spec = np.fft.rfft(samples) / len(samples)
+        return cls(float(spec[0].real), 2 * spec[1:harmonics + 1].real, -2 * spec[1:harmonics + 1].imag)
+
+
+def contact_line_distribution(eps_alpha: float, eps_beta: float, pitch_position: float, phases: np.ndarray,
+                              face_samples: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Contact lines in the field of action of a helical mesh as the mesh phase advances.
+
+    The field of action is x in [0, eps_alpha] base pitches along the line of action (x = 0 at the
+    start of contact, the pitch point at ``pitch_position``) by y in [0, 1] of the face width; the
+    contact line of tooth k lies on x = phi + k - eps_beta y. For every phase phi (cycles) returns
+
+    - length(phi): total contact-line length in units of one straight line across the face,
+    - kappa(phi) = integral of sign(s) dL / L: net direction of sliding (s = x - pitch_position),
+    - lever(phi) = integral of |s| dL / L: mean distance of the load from the pitch point [base pitches],
+
+    with the load taken uniform along the contact lines (as the stiffness model assumes).
+    """
+    y = (np.arange(face_samples) + 0.5) / face_samples
+    phases = np.asarray(phases, dtype=float)
+    length = np.zeros_like(phases)
+    signed = np.zeros_like(phases)
+    lever = np.zeros_like(phases)
+    for k in range(-int(eps_beta) - 2, int(eps_alpha) + 3):
+        x = phases[:, None] + k - eps_beta * y[None, :]
+        inside = (x >= 0.0) & (x <= eps_alpha)
+        s = x - pitch_position
+        length += inside.mean(axis=1)
+        signed += (inside * np.sign(s)).mean(axis=1)
+        lever += (inside * np.abs(s)).mean(axis=1)
+    return length, signed / length, lever / length
+
+
+def contact_line_series(mesh: Mesh, face_width: float, harmonics: int, samples: int = 512
+                        ) -> tuple[PeriodicSeries, PeriodicSeries, PeriodicSeries]:
+    """Fourier series (in the mesh phase) of the normalised stiffness, the sliding direction and the lever.
+
+    The stiffness series is the analytic one of :func:`mesh_stiffness_harmonics` (eq. 11-12); the
+    friction series (kappa, lever [m]) are fitted to :func:`contact_line_distribution`.
+    """
+    eps_a, eps_b = mesh.transverse_contact_ratio, mesh.overlap_ratio(face_width)
+    c = mesh_stiffness_harmonics(eps_a, eps_b, harmonics)
+    n = np.arange(1, harmonics + 1)
+    centre = 0.5 * (eps_a + eps_b)
+    stiffness = PeriodicSeries(1.0, c * np.cos(2 * np.pi * n * centre), c * np.sin(2 * np.pi * n * centre))
+    phases = np.arange(samples) / samples
+    _, kappa, lever = contact_line_distribution(eps_a, eps_b, mesh.approach_length / mesh.base_pitch, phases)
+    return stiffness, PeriodicSeries.fit(kappa, harmonics), PeriodicSeries.fit(lever * mesh.base_pitch, harmonics)

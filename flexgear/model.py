@@ -24,13 +24,14 @@ from flexgear.connectors import (
     Bushing,
     ContactLaw,
     GearContact,
+    MeshFriction,
     add_gear_contacts,
     add_linear_elements,
     add_load_torque,
     add_speed_drive,
-    mesh_deflection_gradients,
+    contact_gradients,
 )
-from flexgear.involute import GearSetGeometry, gear_set_geometry, mesh_stiffness_harmonics
+from flexgear.involute import GearSetGeometry, PeriodicSeries, contact_line_series, gear_set_geometry
 from flexgear.massprops import MassProperties, combine_mass_properties
 from flexgear.spec import GearboxSpec, Variant
 from flexgear.theory import Theory, theory
@@ -54,6 +55,7 @@ class GearboxModel:
     drive: int
     load: int
     contacts: list[GearContact] = field(default_factory=list)
+    friction: MeshFriction | None = None
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -80,35 +82,36 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
     Mesh phase of planet i: phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing).
     """
     geo = gear_set_geometry(spec)
-    g = spec.gears
+    g, ca = spec.gears, spec.contact_assumed
     zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
     cos_bb, sin_bb = math.cos(geo.sun.base_helix_angle), math.sin(geo.sun.base_helix_angle)
     sigma = 1.0 if drive_sign >= 0 else -1.0
-    use_ripple = spec.contact_assumed.stiffness_variation == "contact_lines"
-    n_harm = spec.contact_assumed.stiffness_harmonics if use_ripple else 0
-    eps_beta = geo.sun_planet.overlap_ratio(geo.helix_face_width)
+    n_harm = ca.stiffness_harmonics
     meshes = {
         "outer": (geo.sun_planet, aw * zs / (zs + zp), 1.0, 0.0),
         "inner": (geo.planet_ring, aw * zr / (zr - zp), -1.0, spec.gears_assumed.outer_inner_mesh_phase),
     }
+    series = {kind: contact_line_series(m[0], geo.helix_face_width, n_harm) for kind, m in meshes.items()}
+    if ca.stiffness_variation == "constant":
+        series = {k: (PeriodicSeries(1.0, np.zeros(n_harm), np.zeros(n_harm)), *v[1:]) for k, v in series.items()}
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
         for kind, (mesh, r_pitch, t_sign, extra_phase) in meshes.items():
             alpha = mesh.operating_pressure_angle
-            eps_alpha = mesh.transverse_contact_ratio
-            coeffs = mesh_stiffness_harmonics(eps_alpha, eps_beta, n_harm)
-            phase0 = 0.5 * (eps_alpha + eps_beta) + zs * psi / (2 * math.pi) + extra_phase
             t_dir = _rot(psi, (math.sin(alpha), t_sign * sigma * math.cos(alpha)))
             pitch = _rot(psi, (r_pitch, 0.0))
             c1, c2 = (np.zeros(3), c_planet) if kind == "outer" else (c_planet, np.zeros(3))
             b1, b2 = ("sun", f"planet{i + 1}") if kind == "outer" else (f"planet{i + 1}", "ring")
+            stiffness, sliding, lever = series[kind]
             for h, (z_h, hand, share) in enumerate(helix_halves(geo)):
                 normal = cos_bb * t_dir - hand * sin_bb * np.array([0.0, 0.0, 1.0])
-                g1, g2 = mesh_deflection_gradients(c1, c2, pitch + [0.0, 0.0, z_h], normal)
+                g1, g2 = contact_gradients(c1, c2, pitch + [0.0, 0.0, z_h], normal, t_dir)
                 contacts.append(GearContact(
                     f"{kind}_mesh_{i + 1}_half{h + 1}", b1, b2, g1, g2,
-                    ContactLaw.from_contact(spec.contact, share), coeffs, phase0, zs / (2 * math.pi),
+                    ContactLaw.from_contact(spec.contact, share), stiffness, sliding, lever,
+                    spec.contact.friction_coefficient, ca.friction_regularisation_m_per_s,
+                    zs * psi / (2 * math.pi) + extra_phase, zs / (2 * math.pi),
                 ))
     return contacts
 
@@ -147,10 +150,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     b = spec.bearings
     bushings = [Bushing.from_bearing("sun", b.input_shaft), Bushing.from_bearing("ring", b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
-    _, coords = add_linear_elements(mbs, bodies, bushings)
+    frame_elements, coords = add_linear_elements(mbs, bodies, bushings)
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
-    springs = add_gear_contacts(mbs, bodies, coords, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
+    springs, aux = add_gear_contacts(mbs, bodies, coords, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
+    friction = None
+    if spec.contact.friction_coefficient > 0.0:
+        friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
+        mbs.SetPreStepUserFunction(friction)
     by_body = {bd.name: bd for bd in bodies}
     drive = add_speed_drive(mbs, by_body["sun"], lc.ramp_time_s, lc.input_speed_rad_s)
     load = add_load_torque(mbs, by_body["ring"], -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s)
@@ -158,4 +165,4 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts)
+    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, friction)

@@ -99,7 +99,7 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     for kind in ("outer", "inner"):
         for i in range(1, n + 1):
             halves = [k for k in sensors if k.startswith(f"{kind}_{i}_")]
-            cols[f"{kind}_mesh_force_{i}_n"] = sum(np.abs(data(k)[:, 1]) for k in halves)
+            cols[f"{kind}_mesh_force_{i}_n"] = sum(data(k)[:, 1] for k in halves)
     for side, key in (("input", "input_accel"), ("output", "output_accel")):
         acc = data(key)
         cols[f"{side}_bearing_accel_x_m_per_s2"] = acc[:, 1]

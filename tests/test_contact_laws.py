@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.connectors import ContactLaw, drive_angle, impact_force, stiffness_factor
+from flexgear.connectors import ContactLaw, drive_angle, friction_forces, impact_force, periodic_value
+from flexgear.involute import PeriodicSeries
 from flexgear.theory import step, step_integral
 
 LAW = ContactLaw(stiffness=1e8, exponent=1.5, damping_max=1e5, penetration_depth=1e-4)
@@ -24,12 +25,19 @@ def test_impact_law_values():
     assert impact_force(1e-6, -1.0, LAW) == 0.0
 
 
-def test_stiffness_factor_chebyshev_equals_cosine_sum():
-    c = np.array([-0.0158, 0.0087, -0.0012, 0.004])
+def test_periodic_value_recurrences_equal_direct_fourier_sum():
+    series = PeriodicSeries(1.0, np.array([-0.0158, 0.0087, -0.0012, 0.004]), np.array([0.01, -0.002, 0.003, 0.0]))
     phi = np.linspace(0, 3, 301)
-    direct = 1 + sum(cn * np.cos(2 * np.pi * (n + 1) * (phi - 0.37)) for n, cn in enumerate(c))
-    assert np.max(np.abs(stiffness_factor(phi, c, 0.37) - direct)) < 1e-12
-    assert stiffness_factor(phi, np.zeros(3), 0.0) == 1.0
+    assert np.max(np.abs(periodic_value(phi, series) - series(phi))) < 1e-12
+    assert periodic_value(phi, PeriodicSeries(1.0, np.zeros(3), np.zeros(3))) == 1.0
+
+
+def test_friction_law():
+    # full sliding: mu F kappa on the sliding coordinate, mu F lambda on the relative spin; odd in Omega
+    f_slide, f_spin = friction_forces(800.0, 1000.0, 0.25, 3e-3, 0.02, 0.01, 3e-3)
+    assert f_slide == pytest.approx(0.02 * 800 * 0.25) and f_spin == pytest.approx(0.02 * 800 * 3e-3)
+    assert friction_forces(800.0, -1000.0, 0.25, 3e-3, 0.02, 0.01, 3e-3)[1] == pytest.approx(-f_spin)
+    assert friction_forces(800.0, 0.0, 0.25, 3e-3, 0.02, 0.01, 3e-3) == (0.0, 0.0)
 
 
 def test_drive_angle_is_step_integral():
@@ -45,7 +53,21 @@ def test_compiled_forms_match_numpy():
     from exudyn import symbolic as esym
 
     d, v, t = esym.Real(2.5e-4), esym.Real(3e-3), esym.Real(0.31)
-    c = np.array([-0.0158, 0.0087, -0.0012])
-    f_sym = impact_force(d, v, LAW, stiffness_factor(drive_angle(t, 0.5, 628.3) * 7.0, c, 0.2, esym), esym)
-    f_np = impact_force(2.5e-4, 3e-3, LAW, stiffness_factor(drive_angle(0.31, 0.5, 628.3) * 7.0, c, 0.2))
+    c = PeriodicSeries(1.0, np.array([-0.0158, 0.0087, -0.0012]), np.array([0.003, 0.001, -0.002]))
+    f_sym = impact_force(d, v, LAW, periodic_value(drive_angle(t, 0.5, 628.3) * 7.0 - 0.2, c, esym), esym)
+    f_np = impact_force(2.5e-4, 3e-3, LAW, periodic_value(drive_angle(0.31, 0.5, 628.3) * 7.0 - 0.2, c))
     assert f_sym.Evaluate() == pytest.approx(float(f_np), rel=1e-12)
+
+
+def test_compiled_friction_kernel_equals_reference(model1):
+    import exudyn as exu
+
+    from flexgear.model import build_star_gearbox
+
+    mbs = exu.SystemContainer().AddSystem()
+    friction = build_star_gearbox(mbs, model1).friction
+    rng = np.random.default_rng(7)
+    for t in (0.01, 0.3, 0.55):
+        d, dt, qt = rng.uniform(-1e-4, 5e-4, 20), rng.normal(0, 1e-3, 20), rng.normal(0, 300, 42)
+        ref = friction.forces(t, d, dt, qt)
+        assert np.max(np.abs(friction.fast_forces(t, d, dt, qt) - ref)) < 1e-9 * np.max(np.abs(ref))
