@@ -35,7 +35,8 @@ def _cmd_matrix(a: argparse.Namespace) -> int:
 
     table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end,
                        workers=a.workers, scheduler=a.scheduler, progress=True)
-    print(table.to_string())
+    wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
+    print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
     return 0
 
 
@@ -122,7 +123,7 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         return args.func(args)
-    except SpecError as exc:
+    except (SpecError, FileNotFoundError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
 
