@@ -249,6 +249,9 @@ class ReductionSettings:
 
     fixed_interface_modes: int = _num(0, 200, integer=True)
     interface: str = _choice("rbe3", "rbe2")
+    simulation_modes: int = _num(1, 200, integer=True)
+    modal_stiffness_damping_s: float = _num(0.0)
+    contact_fourier_order: int = _num(1, 60, integer=True)
 
 
 @dataclass(frozen=True)
