@@ -183,7 +183,7 @@ def test_tube_static_bending_matches_beam_theory_and_full_fe():
     mbs.AddLoad(LoadForceVector(markerNumber=flex.interface_markers["tip"], loadVector=[force, 0.0, 0.0]))
     mbs.Assemble()
     settings = exu.SimulationSettings()
-    settings.solutionSettings.writeSolutionToFile = False
+    settings.solution.file.write = False
     settings.staticSolver.verboseMode = 0
     exu.SolveStatic(mbs, settings)
     tip_x = mbs.GetMarkerOutput(flex.interface_markers["tip"], exu.OutputVariableType.Position)[0] - tip.point[0]
@@ -211,7 +211,7 @@ def test_spinning_ring_expands_and_keeps_angular_momentum(coarse_ring_fe):
     settings.timeIntegration.numberOfSteps = 500
     settings.timeIntegration.generalizedAlpha.spectralRadius = 0.5
     settings.timeIntegration.verboseMode = 0
-    settings.solutionSettings.writeSolutionToFile = False
+    settings.solution.file.write = False
     exu.SolveDynamic(mbs, settings)
     q = mbs.GetNodeOutput(flex.modal_node, exu.OutputVariableType.Coordinates)
     u = (body.modes @ q).reshape(-1, 3)
