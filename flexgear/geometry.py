@@ -101,6 +101,11 @@ class Section:
     hole_radius: float = 0.0
     hole_circle_radius: float = 0.0
 
+    def hole_centres(self) -> np.ndarray:
+        """(holes, 2) centres of the bolt holes [m]: hole k at polar angle 2 pi k / holes."""
+        a = 2 * np.pi * np.arange(self.holes) / max(self.holes, 1)
+        return self.hole_circle_radius * np.column_stack([np.cos(a), np.sin(a)])
+
 
 @dataclass(frozen=True)
 class Prism:
