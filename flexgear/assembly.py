@@ -196,6 +196,8 @@ def render_assembly_png(spec: GearboxSpec, path: str | Path, level: str = "coars
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.patches import PathPatch
+    from matplotlib.path import Path as MplPath
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
     parts = assembly_trimesh(spec, level)
@@ -213,7 +215,8 @@ def render_assembly_png(spec: GearboxSpec, path: str | Path, level: str = "coars
         poly.set_alpha(1.0)
         ax.add_collection3d(poly)
     lim = 190
-    ax.set(xlim=(-lim, lim), ylim=(-lim, lim), zlim=(-lim, lim), xlabel="x [mm]", ylabel="y [mm]", zlabel="z [mm]")
+    ax.set(xlim=(-lim, lim), ylim=(-lim, lim), zlim=(-140, 60), xlabel="x [mm]", ylabel="y [mm]", zlabel="z [mm]")
+    ax.set_box_aspect((2 * lim, 2 * lim, 200))
     ax.view_init(elev=25, azim=-60)
     ax.set_title("assembly (ring cut away, output shaft hidden)")
     places = nominal_placements(spec)
@@ -222,10 +225,11 @@ def render_assembly_png(spec: GearboxSpec, path: str | Path, level: str = "coars
         for place in places:
             if place.component in ("input_shaft", "output_shaft"):
                 continue
-            sec = _section(spec, place.component, place, z)
-            for poly in sec.to_polygons():
-                p = np.vstack([poly, poly[:1]])
-                axis.fill(p[:, 0], p[:, 1], color=colours[place.component], alpha=0.8, lw=0.3, ec="k")
+            contours = _section(spec, place.component, place, z).to_polygons()
+            verts = np.vstack([np.vstack([c, c[:1]]) for c in contours])
+            codes = np.concatenate([[MplPath.MOVETO] + [MplPath.LINETO] * (len(c) - 1) + [MplPath.CLOSEPOLY]
+                                    for c in contours])
+            axis.add_patch(PathPatch(MplPath(verts, codes), fc=colours[place.component], ec="k", lw=0.3))
         centre = (0.0, 0.0) if k == 0 else (gear_set_geometry(spec).sun.reference_radius * _MM + 1.2, 0.0)
         axis.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
                  aspect="equal", xlabel="x [mm]", ylabel="y [mm]")
