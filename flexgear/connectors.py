@@ -82,16 +82,19 @@ class Bushing:
         return self.damping_per_stiffness * self.stiffness_matrix()
 
 
-def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing]) -> tuple[int, int]:
+def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_nodes: list[int] | None = None,
+                        extra_size: int = 0) -> tuple[int, int]:
     """Sum the elements' matrices into one ``ObjectGenericODE2`` over the bodies' frame nodes.
 
+    ``extra_nodes`` (e.g. the modal nodes of flexible bodies, ``extra_size`` coordinates in all) are
+    appended to the object with zero matrices so that its marker spans them too.
     Returns ``(object, marker)``: the marker (``MarkerObjectODE2Coordinates``) spans all frame
-    coordinates in the order of ``bodies`` and is reused by the gear-contact constraint.
+    coordinates in the order of ``bodies``, then the extra ones, and is reused by the gear contacts.
     """
     from exudyn.itemInterface import MarkerObjectODE2Coordinates, ObjectGenericODE2
 
     index = {b.name: i for i, b in enumerate(bodies)}
-    n = 6 * len(bodies)
+    n = 6 * len(bodies) + extra_size
     stiffness, damping = np.zeros((n, n)), np.zeros((n, n))
     for e in elements:
         if e.body not in index:
@@ -100,8 +103,8 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing]) -> tup
         stiffness[s, s] += e.stiffness_matrix()
         damping[s, s] += e.damping_matrix()
     obj = mbs.AddObject(ObjectGenericODE2(
-        name="bushings", nodeNumbers=[b.node for b in bodies], massMatrix=np.zeros((n, n)),
-        stiffnessMatrix=stiffness, dampingMatrix=damping, forceVector=np.zeros(n),
+        name="frame_elements", nodeNumbers=[b.node for b in bodies] + list(extra_nodes or []),
+        massMatrix=np.zeros((n, n)), stiffnessMatrix=stiffness, dampingMatrix=damping, forceVector=np.zeros(n),
     ))
     marker = mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=obj))
     return obj, marker
@@ -218,6 +221,10 @@ class GearContact:
     friction_regularisation: float  # m/s
     phase_offset: float
     phase_per_drive_angle: float
+    point: np.ndarray | None = None  # contact point (pitch point of the half) in the ground frame [m]
+    normal: np.ndarray | None = None  # tooth normal, force direction on gear 2
+    spin_per_drive_angle: tuple[float, float] = (0.0, 0.0)  # nominal spin of gear 1, 2 per drive angle
+    half_width: float = 0.0  # face width of the contact half [m]
 
 
 def relative_displacement_gradient(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarray,
@@ -245,12 +252,15 @@ def contact_gradients(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarra
 
 
 def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts: list[GearContact],
-                      ramp_time: float, drive_speed: float) -> tuple[list[int], int]:
+                      ramp_time: float, drive_speed: float, extra_columns: int = 0
+                      ) -> tuple[list[int], int, int, np.ndarray]:
     """Add the contacts: one auxiliary deflection coordinate each, one linear constraint for all,
     one compiled normal-force law each.
 
-    Returns the spring-damper of every contact (its ``Force`` output is the normal force) and the
-    auxiliary node holding the deflections.
+    ``extra_columns``: coordinates of ``coordinates_marker`` after the frame coordinates (modal
+    coordinates; their columns start at zero and are filled by flexgear.contact_kinematics).
+    Returns the spring-damper of every contact (its ``Force`` output is the normal force), the
+    auxiliary node holding the deflections, the constraint and its scaling matrix.
     """
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
@@ -264,13 +274,13 @@ def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts
     from exudyn.utilities import CreateSymbolicUserFunction
 
     n_c = len(contacts)
-    gradient = _assemble_rows(bodies, contacts, row=0)
+    gradient = np.hstack([_assemble_rows(bodies, contacts, row=0), np.zeros((n_c, extra_columns))])
     # MarkerObjectODE2Coordinates measures reference + displacement coordinates: subtract the reference
-    q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies])
+    q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies] + [np.zeros(extra_columns)])
     aux = mbs.AddNode(NodeGenericODE2(name="mesh_deflections", numberOfODE2Coordinates=n_c,
                                       referenceCoordinates=[0.0] * n_c, initialCoordinates=[0.0] * n_c,
                                       initialCoordinates_t=[0.0] * n_c))
-    mbs.AddObject(ObjectConnectorCoordinateVector(
+    constraint = mbs.AddObject(ObjectConnectorCoordinateVector(
         name="mesh_kinematics", markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux)),
                                                coordinates_marker],
         scalingMarker0=np.eye(n_c), scalingMarker1=gradient, offset=gradient @ q_ref,
@@ -285,7 +295,7 @@ def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts
         mbs.SetObjectParameter(spring, "springForceUserFunction", laws[-1])
         springs.append(spring)
     _keep_alive(mbs, laws)
-    return springs, aux
+    return springs, aux, constraint, gradient
 
 
 def _assemble_rows(bodies: list[Body], contacts: list[GearContact], row: int) -> np.ndarray:
@@ -351,6 +361,7 @@ class MeshFriction:
                                           for k in ("stiffness", "sliding", "lever")])
         self._means = np.array([self.series[k].mean for k in ("stiffness", "sliding", "lever")])
         self._index: tuple[np.ndarray, np.ndarray] | None = None
+        self._force: np.ndarray | None = None
 
     def forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
         """Generalized friction forces on the frame coordinates (reference implementation, numpy)."""
@@ -380,8 +391,11 @@ class MeshFriction:
                                 for b in self.bodies]),
             )
         aux, frames = self._index
+        if self._force is None:
+            self._force = np.zeros(len(mbs.GetObjectParameter(self.container, "forceVector")))
         q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
-        mbs.SetObjectParameter(self.container, "forceVector", self.fast_forces(t, q[aux], q_t[aux], q_t[frames]))
+        self._force[:len(frames)] = self.fast_forces(t, q[aux], q_t[aux], q_t[frames])
+        mbs.SetObjectParameter(self.container, "forceVector", self._force)
         return True
 
 

@@ -36,11 +36,7 @@ from flexgear.massprops import MassProperties, combine_mass_properties
 from flexgear.spec import GearboxSpec, Variant
 from flexgear.theory import Theory, theory
 
-__all__ = ["FlexibleNotAvailableError", "GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"]
-
-
-class FlexibleNotAvailableError(NotImplementedError):
-    """A variant asks for a flexible component that this version cannot build yet."""
+__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"]
 
 
 @dataclass
@@ -56,6 +52,8 @@ class GearboxModel:
     load: int
     contacts: list[GearContact] = field(default_factory=list)
     friction: MeshFriction | None = None
+    kinematics: object | None = None  # flexgear.contact_kinematics.ContactKinematics for flexible gears
+    aux_node: int = -1  # node of the contacts' deflection coordinates
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -94,6 +92,7 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
     series = {kind: contact_line_series(m[0], geo.helix_face_width, n_harm) for kind, m in meshes.items()}
     if ca.stiffness_variation == "constant":
         series = {k: (PeriodicSeries(1.0, np.zeros(n_harm), np.zeros(n_harm)), *v[1:]) for k, v in series.items()}
+    spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -103,6 +102,7 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
             pitch = _rot(psi, (r_pitch, 0.0))
             c1, c2 = (np.zeros(3), c_planet) if kind == "outer" else (c_planet, np.zeros(3))
             b1, b2 = ("sun", f"planet{i + 1}") if kind == "outer" else (f"planet{i + 1}", "ring")
+            spins = (spin["sun"], spin["planet"]) if kind == "outer" else (spin["planet"], spin["ring"])
             stiffness, sliding, lever = series[kind]
             for h, (z_h, hand, share) in enumerate(helix_halves(geo)):
                 normal = cos_bb * t_dir - hand * sin_bb * np.array([0.0, 0.0, 1.0])
@@ -112,11 +112,13 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
                     ContactLaw.from_contact(spec.contact, share), stiffness, sliding, lever,
                     spec.contact.friction_coefficient, ca.friction_regularisation_m_per_s,
                     zs * psi / (2 * math.pi) + extra_phase, zs / (2 * math.pi),
+                    pitch + [0.0, 0.0, z_h], normal, spins, geo.helix_face_width,
                 ))
     return contacts
 
 
 MassSource = Callable[[GearboxSpec, str], MassProperties]
+ReducedSource = Callable[[GearboxSpec, str, str], object]
 
 
 def _default_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
@@ -125,44 +127,127 @@ def _default_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
     return component_mass_properties(spec, component)
 
 
-def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None) -> GearboxModel:
-    """Assemble the star gearbox of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards)."""
-    flexible = [c for c, form in variant.components.items() if form == "flexible"]
-    if flexible:
-        raise FlexibleNotAvailableError(
-            f"{variant.source}: field 'components.{flexible[0]}': flexible bodies are not yet available "
-            f"in this version; allowed now: 'rigid' (flexible requested for: {', '.join(flexible)})"
-        )
+def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
+    from flexgear.components import component_reduced_body
+
+    return component_reduced_body(spec, component, level, progress=True)
+
+
+def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
+                   level: str, props: MassSource, reduced: ReducedSource) -> Body:
+    """One component as a rigid body or a reduced flexible body of the same geometry."""
+    if form == "rigid":
+        return add_rigid_body(mbs, name, props(spec, geometry), position)
+    from flexgear.flexible import add_flexible_body
+
+    return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
+                             stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
+                             interface_markers=[], show=False)
+
+
+def _fix_frames(mbs, lead: Body, other: Body) -> int:
+    """Fixed joint of two bodies whose frames coincide: equal frame coordinates (linear, exact).
+
+    For a flexible body the frame is its mean-axis frame (Tisserand), so the joint acts on the
+    body's mean motion, not on its interface nodes (see the note in the module docstring).
+    """
+    from exudyn.itemInterface import ObjectConnectorCoordinateVector
+
+    return mbs.AddObject(ObjectConnectorCoordinateVector(
+        name=f"fixed_{lead.name}_{other.name}", markerNumbers=[lead.marker_coordinates, other.marker_coordinates],
+        scalingMarker0=np.eye(6), scalingMarker1=np.eye(6), offset=np.zeros(6)))
+
+
+def _modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: int, radial_band: float) -> list:
+    """Contact-deflection coefficients of the flexible gears' modal coordinates (contact_kinematics)."""
+    from flexgear.contact_kinematics import ModalColumn, modal_contact_coefficients
+
+    columns = []
+    for row, c in enumerate(contacts):
+        for name, sign, spin in ((c.body1, 1.0, c.spin_per_drive_angle[0]), (c.body2, -1.0, c.spin_per_drive_angle[1])):
+            body = bodies[name]
+            if not body.flexible:
+                continue
+            rel = np.asarray(c.point) - body.position
+            values = modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel, c.normal,
+                                                0.5 * c.half_width, radial_band, order)
+            columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
+    return columns
+
+
+def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
+                       reduced_source: ReducedSource | None = None) -> GearboxModel:
+    """Assemble the star gearbox of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards).
+
+    Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
+    ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
+    exact); otherwise they are two bodies whose frames are joined by a fixed joint.
+    """
     spec = variant.gearbox
     if spec.gears.arrangement != "star":
         raise ValueError(f"{spec.source}: field 'gears.arrangement': build_star_gearbox needs 'star'")
     props = mass_source or _default_mass_source
+    reduced = reduced_source or _default_reduced_source
+    form = variant.components
     th = theory(spec)
     geo = gear_set_geometry(spec)
-    sun = combine_mass_properties(props(spec, "sun"), props(spec, "input_shaft"))
-    ring = combine_mass_properties(props(spec, "ring"), props(spec, "output_shaft"))
-    planet = props(spec, "planet")
-    bodies = [add_rigid_body(mbs, "sun", sun, np.zeros(3))]
+    level = variant.mesh_level
+    bodies: list[Body] = []
+    joints = []
+    for gear, shaft in (("sun", "input_shaft"), ("ring", "output_shaft")):
+        if form[gear] == "rigid" and form[shaft] == "rigid":
+            merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
+            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
+        else:
+            lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced)
+            other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced)
+            bodies += [lead, other]
+            joints.append((lead, other))
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
-        bodies.append(add_rigid_body(mbs, f"planet{i + 1}", planet, pos))
-    bodies.append(add_rigid_body(mbs, "ring", ring, np.zeros(3)))
+        bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
+                                     props, reduced))
+    by_body = {bd.name: bd for bd in bodies}
+    for lead, other in joints:
+        _fix_frames(mbs, lead, other)
     b = spec.bearings
     bushings = [Bushing.from_bearing("sun", b.input_shaft), Bushing.from_bearing("ring", b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
-    frame_elements, coords = add_linear_elements(mbs, bodies, bushings)
+    flexible = [bd for bd in bodies if bd.flexible]
+    offsets, n_modal = {}, 6 * len(bodies)
+    for bd in flexible:
+        offsets[bd.name] = n_modal
+        n_modal += bd.reduced.n_modes
+    n_extra = n_modal - 6 * len(bodies)
+    frame_elements, coords = add_linear_elements(mbs, bodies, bushings, [bd.modal_node for bd in flexible], n_extra)
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
-    springs, aux = add_gear_contacts(mbs, bodies, coords, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
+    springs, aux, constraint, base = add_gear_contacts(mbs, bodies, coords, contacts, lc.ramp_time_s,
+                                                       lc.input_speed_rad_s, n_extra)
+    pre_steps = []
+    kinematics = None
+    # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
+    columns = _modal_columns(contacts, by_body, spec.reduction_assumed.contact_fourier_order,
+                             spec.gears.normal_module_m)
+    if columns:
+        from flexgear.contact_kinematics import ContactKinematics
+
+        kinematics = ContactKinematics(constraint, base, columns, offsets, lc.ramp_time_s, lc.input_speed_rad_s,
+                                       lc.step_size_s)
+        mbs.SetObjectParameter(constraint, "scalingMarker1", kinematics.matrix_at(0.0))
+        pre_steps.append(kinematics)
     friction = None
     if spec.contact.friction_coefficient > 0.0:
         friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
-        mbs.SetPreStepUserFunction(friction)
-    by_body = {bd.name: bd for bd in bodies}
+        pre_steps.append(friction)
+    if pre_steps:
+        from flexgear.contact_kinematics import PreStepChain
+
+        mbs.SetPreStepUserFunction(PreStepChain(pre_steps) if len(pre_steps) > 1 else pre_steps[0])
     drive = add_speed_drive(mbs, by_body["sun"], lc.ramp_time_s, lc.input_speed_rad_s)
     load = add_load_torque(mbs, by_body["ring"], -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s)
     halves = len(helix_halves(geo))
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, friction)
+    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, friction, kinematics, aux)

@@ -18,7 +18,7 @@ from importlib import metadata
 import numpy as np
 import pandas as pd
 
-from flexgear.model import GearboxModel, MassSource, build_star_gearbox
+from flexgear.model import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.results import RunResult, signal_columns
 from flexgear.spec import Variant, spec_hash
 
@@ -75,6 +75,13 @@ def _add_sensors(mbs, model: GearboxModel) -> dict[str, int]:
         "output_accel": mbs.AddSensor(SensorNode(nodeNumber=ring, outputVariableType=ovt.Acceleration,
                                                  storeInternal=True)),
     }
+    if model.kinematics is not None:
+        sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
+                                                          outputVariableType=ovt.Coordinates, storeInternal=True))
+        for name, body in model.bodies.items():
+            if body.flexible:
+                sensors[f"modes_{name}"] = mbs.AddSensor(SensorNode(
+                    nodeNumber=body.modal_node, outputVariableType=ovt.Coordinates, storeInternal=True))
     for kind, groups in (("outer", model.outer_contacts), ("inner", model.inner_contacts)):
         for i, halves in enumerate(groups):
             for h, obj in enumerate(halves):
@@ -107,6 +114,27 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     return pd.DataFrame({c: cols[c] for c in signal_columns(n)})
 
 
+def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], window_start: float) -> dict[str, float]:
+    """Share of the mesh approach taken up by the flexible gears' elastic deformation, per mesh kind.
+
+    The contact coordinate is the penetration delta = (rigid approach) + (elastic terms), where the
+    elastic terms are negative when the gears yield under the mesh force: share = -mean(elastic) / mean(delta).
+    """
+    kin = model.kinematics
+    defl = np.asarray(mbs.GetSensorStoredData(sensors["deflections"]))
+    keep = np.flatnonzero(defl[:, 0] >= window_start)[::10]
+    modal = [np.asarray(mbs.GetSensorStoredData(sensors[k]))[:, 1:] for k in sensors if k.startswith("modes_")]
+    q = np.hstack(modal)
+    first = kin.base.shape[1] - q.shape[1]
+    elastic = np.array([kin.matrix_at(defl[k, 0])[:, first:] @ q[k] for k in keep])
+    total = defl[keep, 1:]
+    out = {}
+    for kind in ("outer", "inner"):
+        rows = [i for i, c in enumerate(model.contacts) if c.name.startswith(kind)]
+        out[f"elastic_share_{kind}"] = float(-elastic[:, rows].mean() / total[:, rows].mean())
+    return out
+
+
 def _meta(variant: Variant, t_end: float) -> dict:
     from flexgear.theory import theory
 
@@ -136,7 +164,7 @@ def _plain(obj):
 
 
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
-                mass_source: MassSource | None = None) -> RunResult:
+                mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None) -> RunResult:
     """Run ``variant`` for ``t_end_s`` (default: the load case's end time).
 
     Never raises for a model or solver failure: the result then has status "failed" and the reason.
@@ -151,13 +179,16 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
         sc = exu.SystemContainer()
         mbs = sc.AddSystem()
-        model = build_star_gearbox(mbs, variant, mass_source)
+        model = build_star_gearbox(mbs, variant, mass_source, reduced_source)
         sensors = _add_sensors(mbs, model)
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
         mbs.SolveDynamic(simulation_settings(variant, t_end, progress),
                          solverType=exu.DynamicSolverType.GeneralizedAlpha)
         signals = _signals(mbs, model, sensors)
+        if model.kinematics is not None:
+            lc = variant.gearbox.load_case
+            meta.update(elastic_share(mbs, model, sensors, min(lc.ramp_time_s, 0.8 * t_end)))
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
             raise FloatingPointError("the solution diverged (non-finite signals)")
         meta.update(status="ok", reason="", build_time_s=build_s)

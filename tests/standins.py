@@ -1,0 +1,46 @@
+"""Small stand-in flexible bodies for fast tests: plain annuli instead of the toothed gears.
+
+Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm. Coarse first-order
+meshes (a few hundred nodes, about a second each) with the bore (ring: outer surface) as the RBE3
+interface. They exercise the flexible-gear machinery; the real components come from
+flexgear.components.component_reduced_body.
+"""
+
+from functools import cache
+
+import numpy as np
+
+from flexgear.involute import gear_set_geometry
+
+
+@cache
+def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int):
+    import ngsolve as ngs
+    from netgen.occ import Cylinder, OCCGeometry, Pnt, Z
+
+    from flexgear.cms import interface, reduce
+    from flexgear.fem import fe_model
+
+    solid = Cylinder(Pnt(0, 0, -width / 2), Z, r=r_out, h=width) - Cylinder(Pnt(0, 0, -width / 2), Z, r=r_in, h=width)
+    fe = fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), material, 1)
+    r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
+    sel = np.flatnonzero(np.abs(r - (r_out if interface_outer else r_in)) < 1e-6)
+    return reduce(fe, [interface(fe, sel, "bore")], 20, n_compare=0, keep_modes=modes)
+
+
+def annulus_source(spec, component: str, level: str):
+    """A ``reduced_source`` for flexgear.model.build_star_gearbox."""
+    geo = gear_set_geometry(spec)
+    width = spec.gears_assumed.face_width_m + spec.gears_assumed.half_gap_m
+    modes = spec.reduction_assumed.simulation_modes
+    if component == "ring":
+        return _annulus(geo.ring.reference_radius, geo.ring.root_radius + 0.008, width, True,
+                        spec.material_assumed, modes)
+    if component in ("sun", "planet"):
+        gear = geo.sun if component == "sun" else geo.planet
+        bore = getattr(spec.components_assumed, f"{component}_bore_diameter_mm") * 0.5e-3
+        return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes)
+    c = spec.components_assumed
+    outer = getattr(c, f"{component}_outer_diameter_mm") * 0.5e-3
+    inner = getattr(c, f"{component}_inner_diameter_mm") * 0.5e-3
+    return _annulus(inner, outer, getattr(c, f"{component}_length_mm") * 1e-3, False, spec.material_assumed, modes)
