@@ -4,8 +4,8 @@ Interfaces (where a component is connected; RBE3, distributing, by default):
 - sun, planet: the bore (shaft-sun joint, planet bearing seat);
 - ring: the 12 bolt holes of the flange (ring-output shaft joint, section 2.1);
 - shafts: both end faces.
-The mesh uses the level's body size everywhere (global modes do not need tooth-resolved meshes;
-the tooth compliance is in the contact law). Results are cached by a hash of the geometry, the
+The mesh is the component's cached mesh at the variant's level (flexgear.meshing); the tooth
+compliance itself is in the contact law. Results are cached by a hash of the geometry, the
 mesh level and the reduction settings (flexgear.flexible.cached_reduced_body).
 """
 
@@ -59,17 +59,13 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
                         red.simulation_modes, _REDUCTION_VERSION)
 
     def build() -> ReducedBody:
-        import ngsolve as ngs
-        from netgen.occ import OCCGeometry
-
         from flexgear.fem import fe_model
-        from flexgear.solids import component_solid
+        from flexgear.meshing import component_mesh
 
         if progress:
             print(f"[flexgear] building reduced body of {name} ({level} mesh) ...", flush=True)
-        solid = component_solid(spec, name)
-        mesh = ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=mesh_settings.body_size_mm * 1e-3))
-        fe = fe_model(mesh, spec.material_assumed, mesh_settings.element_order)
+        mesh = component_mesh(spec, name, level, progress=progress)
+        fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh.order)
         return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
                       n_compare=0, keep_modes=red.simulation_modes)
 
