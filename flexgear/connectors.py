@@ -49,6 +49,7 @@ __all__ = [
     "add_gear_contacts",
     "add_speed_drive",
     "add_load_torque",
+    "add_fixed_joint",
 ]
 
 
@@ -440,6 +441,37 @@ def add_load_torque(mbs, body: Body, torque: float, ramp_time: float) -> int:
     mbs.SetLoadParameter(load, "loadUserFunction", fn)
     _keep_alive(mbs, [fn])
     return load
+
+
+def add_fixed_joint(mbs, body: Body, other: Body | None = None, coordinates: tuple[int, ...] = (0, 1, 2, 3, 4, 5),
+                    name: str | None = None) -> list[int]:
+    """Fixed joint on frame coordinates (linear, exact): ``body`` to ``other``, or to ground if ``other`` is None.
+
+    Joins the selected frame coordinates (0-2 translation, 3-5 rotation, 5 = spin) of two bodies whose
+    frames coincide in the reference configuration: q_body = q_other (one constraint). For a flexible
+    body the frame is its mean-axis frame (Tisserand), so the joint acts on the body's mean motion, not
+    on its interface nodes. To ground: each selected displacement coordinate is held at zero (one
+    constraint each; e.g. ``coordinates=(5,)`` holds a ring's spin and leaves its bearing compliance to
+    a bushing). Returns the constraints.
+    """
+    from exudyn.itemInterface import (
+        MarkerNodeCoordinate,
+        NodePointGround,
+        ObjectConnectorCoordinate,
+        ObjectConnectorCoordinateVector,
+    )
+
+    label = name or f"fixed_{body.name}_{other.name if other is not None else 'ground'}"
+    if other is not None:
+        rows = np.eye(6)[list(coordinates)]
+        return [mbs.AddObject(ObjectConnectorCoordinateVector(
+            name=label, markerNumbers=[body.marker_coordinates, other.marker_coordinates],
+            scalingMarker0=rows, scalingMarker1=rows, offset=np.zeros(len(rows))))]
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    return [mbs.AddObject(ObjectConnectorCoordinate(
+        name=f"{label}_{k}", markerNumbers=[ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node,
+                                                                                       coordinate=k))]))
+        for k in coordinates]
 
 
 def _keep_alive(mbs, functions: list) -> None:

@@ -22,19 +22,19 @@ import numpy as np
 from flexgear.bodies import Body, add_rigid_body
 from flexgear.connectors import (
     Bushing,
-    ContactLaw,
     GearContact,
     MeshFriction,
-    add_gear_contacts,
-    add_linear_elements,
+    add_fixed_joint,
     add_load_torque,
     add_speed_drive,
-    contact_gradients,
 )
-from flexgear.involute import GearSetGeometry, PeriodicSeries, contact_line_series, gear_set_geometry
+from flexgear.gearpair import helix_halves as pair_helix_halves
+from flexgear.gearpair import pair_contacts
+from flexgear.involute import GearSetGeometry, gear_set_geometry
 from flexgear.massprops import MassProperties, combine_mass_properties
 from flexgear.spec import GearboxSpec, Variant
 from flexgear.theory import Theory, theory
+from flexgear.train import add_gear_train
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"]
 
@@ -58,62 +58,36 @@ class GearboxModel:
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
     """(axial position z_h [m], planet hand H, face-width share) of each helix half."""
-    if geo.helix_layout == "single":
-        return [(0.0, 1, 1.0)]
-    z = 0.5 * (geo.helix_face_width + geo.half_gap)
-    return [(z, 1, 0.5), (-z, -1, 0.5)]
-
-
-def _rot(psi: float, v: tuple[float, float]) -> np.ndarray:
-    c, s = math.cos(psi), math.sin(psi)
-    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1], 0.0])
+    return [(h.z, h.hand, h.share) for h in pair_helix_halves(geo.helix_layout, geo.helix_face_width, geo.half_gap)]
 
 
 def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContact]:
     """Gear contacts of every planet, mesh and helix half, in the order (planet, outer/inner, half).
 
-    Sun-planet (gear 1 = sun): pitch point at the sun's operating pitch radius, transverse line of
-    action t = (sin a_w, sigma cos a_w) rotated by psi_i. Planet-ring (gear 1 = planet): pitch point
-    at the ring's operating pitch radius, t = (sin a_w, -sigma cos a_w). Tooth normal
-    n = cos(beta_b) t - H sin(beta_b) e_z for a half whose planet helix has hand H (the ring has the
-    planet's hand, the sun the opposite), so the planet's axial forces from sun and ring cancel.
-    Mesh phase of planet i: phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing).
+    Built with the generic :func:`flexgear.gearpair.pair_contacts`. Sun-planet: gear 1 = sun, pushing
+    in the drive sense; planet-ring: gear 1 = planet, pushing against the drive sense. The halves'
+    hands (flexgear.gearpair convention, gear 1 in the +z half): sun +1, planet -1, so that the
+    planet's axial forces from sun and ring cancel. Mesh phase of planet i:
+    phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing), plus the configured
+    outer-inner phase on the planet-ring mesh.
     """
     geo = gear_set_geometry(spec)
-    g, ca = spec.gears, spec.contact_assumed
+    g = spec.gears
     zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
-    cos_bb, sin_bb = math.cos(geo.sun.base_helix_angle), math.sin(geo.sun.base_helix_angle)
     sigma = 1.0 if drive_sign >= 0 else -1.0
-    n_harm = ca.stiffness_harmonics
-    meshes = {
-        "outer": (geo.sun_planet, aw * zs / (zs + zp), 1.0, 0.0),
-        "inner": (geo.planet_ring, aw * zr / (zr - zp), -1.0, spec.gears_assumed.outer_inner_mesh_phase),
-    }
-    series = {kind: contact_line_series(m[0], geo.helix_face_width, n_harm) for kind, m in meshes.items()}
-    if ca.stiffness_variation == "constant":
-        series = {k: (PeriodicSeries(1.0, np.zeros(n_harm), np.zeros(n_harm)), *v[1:]) for k, v in series.items()}
     spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
+    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
+                  half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
-        for kind, (mesh, r_pitch, t_sign, extra_phase) in meshes.items():
-            alpha = mesh.operating_pressure_angle
-            t_dir = _rot(psi, (math.sin(alpha), t_sign * sigma * math.cos(alpha)))
-            pitch = _rot(psi, (r_pitch, 0.0))
-            c1, c2 = (np.zeros(3), c_planet) if kind == "outer" else (c_planet, np.zeros(3))
-            b1, b2 = ("sun", f"planet{i + 1}") if kind == "outer" else (f"planet{i + 1}", "ring")
-            spins = (spin["sun"], spin["planet"]) if kind == "outer" else (spin["planet"], spin["ring"])
-            stiffness, sliding, lever = series[kind]
-            for h, (z_h, hand, share) in enumerate(helix_halves(geo)):
-                normal = cos_bb * t_dir - hand * sin_bb * np.array([0.0, 0.0, 1.0])
-                g1, g2 = contact_gradients(c1, c2, pitch + [0.0, 0.0, z_h], normal, t_dir)
-                contacts.append(GearContact(
-                    f"{kind}_mesh_{i + 1}_half{h + 1}", b1, b2, g1, g2,
-                    ContactLaw.from_contact(spec.contact, share), stiffness, sliding, lever,
-                    spec.contact.friction_coefficient, ca.friction_regularisation_m_per_s,
-                    zs * psi / (2 * math.pi) + extra_phase, zs / (2 * math.pi),
-                    pitch + [0.0, 0.0, z_h], normal, spins, geo.helix_face_width,
-                ))
+        phase = zs * psi / (2 * math.pi)
+        contacts += pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", geo.sun_planet, np.zeros(3),
+                                  c_planet, hand=1, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
+                                  phase_offset=phase, **common)
+        contacts += pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", geo.planet_ring, c_planet,
+                                  np.zeros(3), hand=-1, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
+                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
     return contacts
 
 
@@ -143,36 +117,6 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=[], show=False)
-
-
-def _fix_frames(mbs, lead: Body, other: Body) -> int:
-    """Fixed joint of two bodies whose frames coincide: equal frame coordinates (linear, exact).
-
-    For a flexible body the frame is its mean-axis frame (Tisserand), so the joint acts on the
-    body's mean motion, not on its interface nodes (see the note in the module docstring).
-    """
-    from exudyn.itemInterface import ObjectConnectorCoordinateVector
-
-    return mbs.AddObject(ObjectConnectorCoordinateVector(
-        name=f"fixed_{lead.name}_{other.name}", markerNumbers=[lead.marker_coordinates, other.marker_coordinates],
-        scalingMarker0=np.eye(6), scalingMarker1=np.eye(6), offset=np.zeros(6)))
-
-
-def _modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: int, radial_band: float) -> list:
-    """Contact-deflection coefficients of the flexible gears' modal coordinates (contact_kinematics)."""
-    from flexgear.contact_kinematics import ModalColumn, modal_contact_coefficients
-
-    columns = []
-    for row, c in enumerate(contacts):
-        for name, sign, spin in ((c.body1, 1.0, c.spin_per_drive_angle[0]), (c.body2, -1.0, c.spin_per_drive_angle[1])):
-            body = bodies[name]
-            if not body.flexible:
-                continue
-            rel = np.asarray(c.point) - body.position
-            values = modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel, c.normal,
-                                                0.5 * c.half_width, radial_band, order)
-            columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
-    return columns
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -209,45 +153,23 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      props, reduced))
     by_body = {bd.name: bd for bd in bodies}
     for lead, other in joints:
-        _fix_frames(mbs, lead, other)
+        add_fixed_joint(mbs, lead, other)
     b = spec.bearings
     bushings = [Bushing.from_bearing("sun", b.input_shaft), Bushing.from_bearing("ring", b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
-    flexible = [bd for bd in bodies if bd.flexible]
-    offsets, n_modal = {}, 6 * len(bodies)
-    for bd in flexible:
-        offsets[bd.name] = n_modal
-        n_modal += bd.reduced.n_modes
-    n_extra = n_modal - 6 * len(bodies)
-    frame_elements, coords = add_linear_elements(mbs, bodies, bushings, [bd.modal_node for bd in flexible], n_extra)
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
-    springs, aux, constraint, base = add_gear_contacts(mbs, bodies, coords, contacts, lc.ramp_time_s,
-                                                       lc.input_speed_rad_s, n_extra)
-    pre_steps = []
-    kinematics = None
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
-    columns = _modal_columns(contacts, by_body, spec.reduction_assumed.contact_fourier_order,
-                             spec.gears.normal_module_m)
-    if columns:
-        from flexgear.contact_kinematics import ContactKinematics
-
-        kinematics = ContactKinematics(constraint, base, columns, offsets, lc.ramp_time_s, lc.input_speed_rad_s,
-                                       lc.step_size_s)
-        mbs.SetObjectParameter(constraint, "scalingMarker1", kinematics.matrix_at(0.0))
-        pre_steps.append(kinematics)
-    friction = None
-    if spec.contact.friction_coefficient > 0.0:
-        friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, lc.ramp_time_s, lc.input_speed_rad_s)
-        pre_steps.append(friction)
-    if pre_steps:
-        from flexgear.contact_kinematics import PreStepChain
-
-        mbs.SetPreStepUserFunction(PreStepChain(pre_steps) if len(pre_steps) > 1 else pre_steps[0])
+    train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s,
+                           step_size=lc.step_size_s, friction=spec.contact.friction_coefficient > 0.0,
+                           contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
+                           radial_band=spec.gears.normal_module_m)
+    springs = train.springs
     drive = add_speed_drive(mbs, by_body["sun"], lc.ramp_time_s, lc.input_speed_rad_s)
     load = add_load_torque(mbs, by_body["ring"], -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s)
     halves = len(helix_halves(geo))
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, friction, kinematics, aux)
+    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
+                        train.aux_node)
