@@ -71,10 +71,15 @@ def _cmd_report(a: argparse.Namespace) -> int:
 
 
 def _cmd_meshes(a: argparse.Namespace) -> int:
+    from flexgear.components import component_reduced_body
     from flexgear.meshing import build_meshes
     from flexgear.spec import load_gearbox
 
-    build_meshes(load_gearbox(a.gearbox), a.level, progress=True)
+    spec = load_gearbox(a.gearbox)
+    build_meshes(spec, a.level, progress=True)
+    for component in ("sun", "planet", "ring", "input_shaft", "output_shaft"):
+        body = component_reduced_body(spec, component, a.level, progress=True)
+        print(f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
     return 0
 
 
@@ -112,7 +117,7 @@ def _parser() -> argparse.ArgumentParser:
     rp.add_argument("--output", default="reports/screening_report.pdf")
     rp.set_defaults(func=_cmd_report)
 
-    me = sub.add_parser("meshes", help="build (or load from cache) the component meshes")
+    me = sub.add_parser("meshes", help="build (or load from cache) the component meshes and reduced bodies")
     me.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml")
     me.add_argument("--level", default="default")
     me.set_defaults(func=_cmd_meshes)
