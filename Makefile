@@ -16,7 +16,7 @@ install:
 	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
 
 lint:
-	$(PY) -m ruff check flexgear tests benchmarks
+	$(PY) -m ruff check flexgear tests benchmarks examples
 
 test: lint
 	$(PY) -m pytest -q
