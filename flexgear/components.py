@@ -23,7 +23,7 @@ COMPONENT_GEOMETRY = {"sun": "sun", "planets": "planet", "planet": "planet", "ri
                       "input_shaft": "input_shaft", "output_shaft": "output_shaft"}
 """Variant component name -> geometry component name."""
 
-_REDUCTION_VERSION = 1
+_REDUCTION_VERSION = 2
 _TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
 
 
@@ -64,8 +64,10 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
 
         if progress:
             print(f"[flexgear] building reduced body of {name} ({level} mesh) ...", flush=True)
-        mesh = component_mesh(spec, name, level, progress=progress)
-        fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh.order)
+        # first-order mesh topology; fe_model raises the order itself (a second-order Netgen mesh loaded
+        # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
+        mesh = component_mesh(spec, name, level, order=1, progress=progress)
+        fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
                       n_compare=0, keep_modes=red.simulation_modes)
 
