@@ -45,6 +45,7 @@ __all__ = [
     "relative_displacement_gradient",
     "contact_gradients",
     "MeshFriction",
+    "StiffnessSchedule",
     "add_linear_elements",
     "add_gear_contacts",
     "add_speed_drive",
@@ -261,7 +262,8 @@ def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts
     ``extra_columns``: coordinates of ``coordinates_marker`` after the frame coordinates (modal
     coordinates; their columns start at zero and are filled by flexgear.contact_kinematics).
     Returns the spring-damper of every contact (its ``Force`` output is the normal force), the
-    auxiliary node holding the deflections, the constraint and its scaling matrix.
+    auxiliary node holding the deflections, the constraint, its scaling matrix and the
+    :class:`StiffnessSchedule` (a pre-step function; None for constant stiffness).
     """
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
@@ -287,16 +289,20 @@ def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts
         scalingMarker0=np.eye(n_c), scalingMarker1=gradient, offset=gradient @ q_ref,
     ))
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
-    springs, laws = [], []
+    springs, laws, factors = [], [], []
+    varying = any(np.any(c.stiffness.cos_coeffs) or np.any(c.stiffness.sin_coeffs) for c in contacts)
     for i, c in enumerate(contacts):
         spring = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=c.name, markerNumbers=[m_ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
-        law = _normal_law_function(c, ramp_time, drive_speed, esym)
+        if varying:
+            factors.append(esym.Real(f"mesh_stiffness_factor_{id(mbs)}_{spring}", 1.0))
+        law = _normal_law_function(c, factors[-1] if varying else 1.0, esym)
         laws.append(CreateSymbolicUserFunction(mbs, law, "springForceUserFunction", spring))
         mbs.SetObjectParameter(spring, "springForceUserFunction", laws[-1])
         springs.append(spring)
-    _keep_alive(mbs, laws)
-    return springs, aux, constraint, gradient
+    _keep_alive(mbs, laws + factors)
+    schedule = StiffnessSchedule(contacts, ramp_time, drive_speed, factors) if varying else None
+    return springs, aux, constraint, gradient, schedule
 
 
 def _assemble_rows(bodies: list[Body], contacts: list[GearContact], row: int) -> np.ndarray:
@@ -309,14 +315,42 @@ def _assemble_rows(bodies: list[Body], contacts: list[GearContact], row: int) ->
     return out
 
 
-def _normal_law_function(c: GearContact, ramp_time: float, drive_speed: float, esym: Any):
-    """The normal-force law of ``c`` as a spring-force user function (traced once into a symbolic one)."""
+def _normal_law_function(c: GearContact, factor: Any, esym: Any):
+    """The normal-force law of ``c`` as a spring-force user function (traced once into a symbolic one).
+
+    ``factor`` is the contact's mesh-stiffness factor: a named symbolic variable that
+    :class:`StiffnessSchedule` sets once per step (or a plain 1.0 for constant stiffness).
+    """
 
     def law(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):  # noqa: N803
-        phase = c.phase_per_drive_angle * drive_angle(t, ramp_time, drive_speed, esym) - c.phase_offset
-        return impact_force(displacement, velocity, c.law, periodic_value(phase, c.stiffness, esym), esym)
+        return impact_force(displacement, velocity, c.law, factor, esym)
 
     return law
+
+
+class StiffnessSchedule:
+    """Mesh-stiffness factors s(phi(t)) of all contacts (eq. 11-12), set once per step into the laws.
+
+    The factor is a function of time only (the mesh phase follows the prescribed drive angle), so
+    setting it for the step's end time before the step is exact; evaluating it once per step in numpy
+    instead of inside every compiled law call halves the cost of a run.
+    """
+
+    def __init__(self, contacts: list[GearContact], ramp_time: float, drive_speed: float, variables: list):
+        self.series = _stack([c.stiffness for c in contacts])
+        self.offsets = np.array([c.phase_offset for c in contacts])
+        self.rate = np.array([c.phase_per_drive_angle for c in contacts])
+        self.ramp_time, self.drive_speed, self.variables = ramp_time, drive_speed, variables
+        self(None, 0.0)
+
+    def values(self, t: float) -> np.ndarray:
+        phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        return np.asarray(periodic_value(phase, self.series), float) * np.ones(len(self.variables))
+
+    def __call__(self, mbs, t: float) -> bool:
+        for var, value in zip(self.variables, self.values(t), strict=True):
+            var.SetValue(float(value))
+        return True
 
 
 def _stack(series: list[PeriodicSeries]) -> PeriodicSeries:

@@ -99,10 +99,10 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         n_total += b.reduced.n_modes
     n_extra = n_total - 6 * len(bodies)
     frame_elements, coords = add_linear_elements(mbs, bodies, elements, [b.modal_node for b in flexible], n_extra)
-    springs, aux, constraint, base = add_gear_contacts(mbs, bodies, coords, contacts, ramp_time, drive_speed,
-                                                       n_extra)
+    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, coords, contacts, ramp_time,
+                                                                 drive_speed, n_extra)
     train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords)
-    pre_steps = []
+    pre_steps = [schedule] if schedule is not None else []
     if flexible and radial_band is None:
         raise ValueError(f"flexible bodies {[b.name for b in flexible]} need radial_band [m] (about one normal module)")
     columns = modal_columns(contacts, by_name, contact_fourier_order, radial_band) if flexible else []
