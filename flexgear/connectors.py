@@ -341,15 +341,26 @@ class StiffnessSchedule:
         self.offsets = np.array([c.phase_offset for c in contacts])
         self.rate = np.array([c.phase_per_drive_angle for c in contacts])
         self.ramp_time, self.drive_speed, self.variables = ramp_time, drive_speed, variables
+        self._cos = np.ascontiguousarray(np.atleast_2d(self.series.cos_coeffs).T)
+        self._sin = np.ascontiguousarray(np.atleast_2d(self.series.sin_coeffs).T)
+        self._means = np.asarray(self.series.mean, float) * np.ones(len(variables))
         self(None, 0.0)
 
     def values(self, t: float) -> np.ndarray:
+        """Factors at time t (reference implementation, numpy)."""
         phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
         return np.asarray(periodic_value(phase, self.series), float) * np.ones(len(self.variables))
 
+    def fast_values(self, t: float) -> np.ndarray:
+        """Same as :meth:`values`, compiled (flexgear.kernels.periodic_values)."""
+        from flexgear.kernels import periodic_values
+
+        phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        return periodic_values(phase, self._means, self._cos, self._sin)
+
     def __call__(self, mbs, t: float) -> bool:
-        for var, value in zip(self.variables, self.values(t), strict=True):
-            var.SetValue(float(value))
+        for var, value in zip(self.variables, self.fast_values(t).tolist(), strict=True):
+            var.SetValue(value)
         return True
 
 

@@ -11,7 +11,7 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["mesh_friction_forces"]
+__all__ = ["mesh_friction_forces", "periodic_values"]
 
 
 @njit(cache=True)
@@ -41,3 +41,14 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
         f = mu[i] * normal * math.tanh(spin_rate[i] * means[2, i] / reg[i])
         q -= sliding_rows[i] * (f * val[1]) + spin_rows[i] * (f * val[2])
     return q
+
+
+@njit(cache=True)
+def periodic_values(phase, means, cos_c, sin_c):  # pragma: no cover - compiled
+    """Fourier series values per contact, as connectors.periodic_value: cos_c, sin_c (n_contacts, n_harmonics)."""
+    out = means.copy()
+    for i in range(phase.shape[0]):
+        for h in range(cos_c.shape[1]):
+            x = 2.0 * math.pi * (h + 1) * phase[i]
+            out[i] += cos_c[i, h] * math.cos(x) + sin_c[i, h] * math.sin(x)
+    return out

@@ -71,3 +71,17 @@ def test_compiled_friction_kernel_equals_reference(model1):
         d, dt, qt = rng.uniform(-1e-4, 5e-4, 20), rng.normal(0, 1e-3, 20), rng.normal(0, 300, 42)
         ref = friction.forces(t, d, dt, qt)
         assert np.max(np.abs(friction.fast_forces(t, d, dt, qt) - ref)) < 1e-9 * np.max(np.abs(ref))
+
+
+def test_compiled_stiffness_schedule_equals_reference(model1):
+    from exudyn import symbolic as esym
+
+    from flexgear.connectors import StiffnessSchedule
+    from flexgear.model import mesh_contacts
+
+    contacts = mesh_contacts(model1.gearbox)
+    variables = [esym.Real(f"test_factor_{i}", 1.0) for i in range(len(contacts))]
+    schedule = StiffnessSchedule(contacts, 0.5, 628.3, variables)
+    for t in (0.0, 0.013, 0.31, 0.55):
+        assert np.max(np.abs(schedule.fast_values(t) - schedule.values(t))) < 1e-12
+        assert 0.9 < schedule.values(t).min() <= schedule.values(t).max() < 1.1
