@@ -1,15 +1,15 @@
 # flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s), make report
 PY ?= python3
 VARIANTS := $(sort $(wildcard model_variants/model*.toml))
-QUICK_T_END ?= 0.02
+QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 RESULTS ?= results
 
 .PHONY: quick install test lint meshes matrix report lpm bench clean
 
 quick: install
 	$(PY) -m flexgear.cli meshes --level coarse
-	$(PY) -m flexgear.cli matrix $(VARIANTS) --t-end $(QUICK_T_END) --out $(RESULTS)/quick
-	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --t-end $(QUICK_T_END) --out $(RESULTS)/quick
+	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick
+	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf
 
 install:

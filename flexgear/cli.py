@@ -41,11 +41,16 @@ def _cmd_matrix(a: argparse.Namespace) -> int:
 
 
 def _cmd_lpm(a: argparse.Namespace) -> int:
+    import tomllib
+
     from flexgear.lumped import run_lumped
     from flexgear.results import save_result
-    from flexgear.spec import load_gearbox
+    from flexgear.spec import load_gearbox, load_variant
 
-    result = run_lumped(load_gearbox(a.gearbox), t_end_s=a.t_end, progress=True)
+    with open(a.gearbox, "rb") as fh:  # a gearbox file, or a variant file (its gearbox with its overrides)
+        is_variant = "components" in tomllib.load(fh)
+    spec = load_variant(a.gearbox).gearbox if is_variant else load_gearbox(a.gearbox)
+    result = run_lumped(spec, t_end_s=a.t_end, progress=True)
     out = save_result(result, Path(a.out) / "lumped")
     print(f"lumped: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.2f} s -> {out}")
     return 0 if result.ok else 1
@@ -101,7 +106,7 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--scheduler", default=None, help="Dask scheduler address (default: local processes)")
     m.set_defaults(func=_cmd_matrix)
 
-    lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox file")
+    lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox (or variant) file")
     lp.add_argument("gearbox")
     lp.add_argument("--t-end", type=float, default=None)
     lp.add_argument("--out", default="results")

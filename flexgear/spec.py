@@ -455,11 +455,33 @@ def _check_consistency(spec: GearboxSpec) -> None:
                             m.body_size_mm)
 
 
+def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> GearboxSpec:
+    """The gearbox with some fields of its tables replaced (``[overrides.load_case]`` etc.), validated."""
+    if not isinstance(overrides, dict):
+        raise SpecError(path, "overrides", "expected tables, e.g. [overrides.load_case]")
+    hints = get_type_hints(GearboxSpec)
+    changes = {}
+    for table, values in overrides.items():
+        current = getattr(gearbox, table, None)
+        if table == "source" or not dataclasses.is_dataclass(current) or not isinstance(values, dict):
+            allowed = sorted(n for n, h in hints.items() if dataclasses.is_dataclass(h))
+            raise SpecError(path, f"overrides.{table}", f"expected one of the tables {', '.join(allowed)}")
+        merged = {f.name: getattr(current, f.name) for f in dataclasses.fields(current)}
+        merged = {k: (dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v) for k, v in merged.items()}
+        merged.update(values)
+        changes[table] = _build(type(current), merged, path, f"overrides.{table}")
+    return gearbox.with_changes(**changes)
+
+
 def load_variant(path: str | Path) -> Variant:
-    """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible."""
+    """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible.
+
+    Optional ``[overrides.<table>]`` replace single fields of the gearbox's tables for this variant
+    (e.g. a shortened ``load_case`` for a quick run), validated like the gearbox file.
+    """
     path = Path(path)
     raw = _read_toml(path)
-    allowed = {"name", "gearbox", "components", "mesh_level", "description"}
+    allowed = {"name", "gearbox", "components", "mesh_level", "description", "overrides"}
     unknown = sorted(set(raw) - allowed)
     if unknown:
         raise SpecError(path, unknown[0], f"unknown field; allowed: {', '.join(sorted(allowed))}")
@@ -469,6 +491,8 @@ def load_variant(path: str | Path) -> Variant:
     if not isinstance(raw["gearbox"], str):
         raise SpecError(path, "gearbox", "expected a path (string) relative to this file", raw["gearbox"])
     gearbox = load_gearbox(path.parent / raw["gearbox"])
+    if "overrides" in raw:
+        gearbox = _apply_overrides(gearbox, raw["overrides"], path)
     comps = raw["components"]
     if not isinstance(comps, dict):
         raise SpecError(path, "components", "expected a table")

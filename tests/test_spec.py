@@ -88,3 +88,26 @@ def test_hash_tracks_content(gearbox, model1):
     other = gearbox.with_changes(load_case=dataclasses.replace(gearbox.load_case, load_torque_nm=500.0))
     assert spec_hash(other) != spec_hash(gearbox)
     assert spec_hash(model1, 0.1) != spec_hash(model1, 0.2)
+
+
+def test_variant_overrides(tmp_path):
+    _write(tmp_path, _gearbox_text())
+    base = 'name = "q"\ngearbox = "gearbox.toml"\n[components]\n' + "".join(f'{c} = "rigid"\n' for c in COMPONENTS)
+    quick = base + "[overrides.load_case]\nramp_time_s = 0.02\nend_time_s = 0.06\n"
+    v = load_variant(_write(tmp_path, quick, "q.toml"))
+    lc = v.gearbox.load_case
+    assert lc.ramp_time_s == pytest.approx(0.02) and lc.end_time_s == pytest.approx(0.06)
+    assert v.gearbox.load_case.load_torque_nm == pytest.approx(557.025)  # untouched fields stay the study's
+    with pytest.raises(SpecError, match=r"'overrides.load_case.ramp_time_s': expected a value > 0"):
+        load_variant(_write(tmp_path, quick.replace("0.02", "-1.0"), "q.toml"))
+    with pytest.raises(SpecError, match=r"'overrides.load_case.ramp': unknown field"):
+        load_variant(_write(tmp_path, quick.replace("ramp_time_s", "ramp"), "q.toml"))
+    with pytest.raises(SpecError, match=r"'overrides.nothing': expected one of the tables"):
+        load_variant(_write(tmp_path, base + "[overrides.nothing]\nx = 1\n", "q.toml"))
+
+
+def test_quick_variants_match_table3():
+    for n in range(1, 8):
+        quick = load_variant(VARIANTS / "quick" / f"model{n}.toml")
+        full = load_variant(VARIANTS / f"model{n}.toml")
+        assert quick.components == full.components and quick.gearbox.load_case.end_time_s < 0.1
