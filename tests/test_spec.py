@@ -110,4 +110,4 @@ def test_quick_variants_match_table3():
     for n in range(1, 8):
         quick = load_variant(VARIANTS / "quick" / f"model{n}.toml")
         full = load_variant(VARIANTS / f"model{n}.toml")
-        assert quick.components == full.components and quick.gearbox.load_case.end_time_s < 0.1
+        assert quick.components == full.components and quick.gearbox.load_case.end_time_s <= 0.1
