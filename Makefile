@@ -22,7 +22,8 @@ test: lint
 	$(PY) -m pytest -q
 
 meshes:
-	$(PY) -m flexgear.cli meshes --level default
+	$(PY) -m flexgear.cli meshes --level coarse
+	$(PY) -m flexgear.cli meshes --level default --no-reduce
 
 matrix:
 	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full

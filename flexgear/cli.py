@@ -82,6 +82,8 @@ def _cmd_meshes(a: argparse.Namespace) -> int:
 
     spec = load_gearbox(a.gearbox)
     build_meshes(spec, a.level, progress=True)
+    if a.no_reduce:
+        return 0
     for component in ("sun", "planet", "ring", "input_shaft", "output_shaft"):
         body = component_reduced_body(spec, component, a.level, progress=True)
         print(f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
@@ -124,7 +126,8 @@ def _parser() -> argparse.ArgumentParser:
 
     me = sub.add_parser("meshes", help="build (or load from cache) the component meshes and reduced bodies")
     me.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml")
-    me.add_argument("--level", default="default")
+    me.add_argument("--level", default="coarse", help="mesh level of gearbox.toml [meshing_assumed] (default: coarse)")
+    me.add_argument("--no-reduce", action="store_true", help="meshes only, no reduced flexible bodies")
     me.set_defaults(func=_cmd_meshes)
     return p
 
