@@ -50,7 +50,8 @@ def simulation_settings(variant: Variant, t_end: float, progress: bool):
     ti.newton.maxModifiedNewtonIterations = sv.newton_max_modified_iterations
     ti.newton.relativeTolerance = sv.newton_relative_tolerance
     ti.verboseMode = 1 if progress else 0
-    s.linearSolver.solverType = exu.LinearSolverType.EXUdense
+    s.linearSolver.solverType = (exu.LinearSolverType.EigenSparse if sv.linear_solver == "sparse"
+                                 else exu.LinearSolverType.EXUdense)
     s.parallel.numberOfThreads = 1
     s.solution.file.write = False
     s.solution.sensors.writePeriod = lc.step_size_s * (sv.record_every_steps - 0.5)

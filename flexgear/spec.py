@@ -231,6 +231,7 @@ class SolverSettings:
     spectral_radius: float = _num(0.0, 1.0)
     newton_max_modified_iterations: int = _num(1, 50, integer=True)
     newton_relative_tolerance: float = _num(0.0, 1e-2, lo_open=True)
+    linear_solver: str = _choice("sparse", "dense")
     record_every_steps: int = _num(1, integer=True)
 
 
