@@ -10,8 +10,6 @@ import argparse
 import sys
 from pathlib import Path
 
-from flexgear.spec import SpecError
-
 __all__ = ["main"]
 
 
