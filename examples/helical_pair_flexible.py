@@ -59,7 +59,7 @@ def build(mbs, spec):
     bushings = [fg.Bushing(name, RADIAL_N_PER_M, AXIAL_N_PER_M, TILT_NM_PER_RAD, DAMPING_PER_STIFFNESS_S)
                 for name in ("pinion", "wheel")]
     w_in = INPUT_SPEED_RPM * 2 * math.pi / 60
-    train = fg.add_gear_train(mbs, [pinion, wheel], bushings, contacts, RAMP_S, w_in, step_size=STEP_S,
+    train = fg.add_gear_train(mbs, [pinion, wheel], bushings, contacts, RAMP_S, w_in,
                               contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                               radial_band=MODULE_M)
     drive = fg.add_speed_drive(mbs, pinion, RAMP_S, w_in)

@@ -63,7 +63,7 @@ def build(mbs, spec):
     bushings = [fg.Bushing.from_bearing("sun", b.input_shaft), fg.Bushing.from_bearing("ring", b.output_shaft),
                 fg.Bushing.from_bearing("carrier", b.output_shaft)]
     w_in = INPUT_SPEED_RPM * 2 * math.pi / 60
-    train = fg.add_gear_train(mbs, bodies, bushings, contacts, RAMP_S, w_in, step_size=STEP_S,
+    train = fg.add_gear_train(mbs, bodies, bushings, contacts, RAMP_S, w_in,
                               carrier=fg.Carrier("carrier", ratio))
     for i in range(N_PLANETS):
         fg.add_planet_bearing(mbs, by["carrier"], by[f"planet{i + 1}"], b.planet)

@@ -93,9 +93,9 @@ class ContactKinematics:
     """
 
     def __init__(self, constraint: int, base: np.ndarray, columns: list[ModalColumn],
-                 column_offsets: dict[str, int], ramp_time: float, drive_speed: float, step_size: float):
+                 column_offsets: dict[str, int], ramp_time: float, drive_speed: float):
         self.constraint, self.base = constraint, base
-        self.ramp_time, self.drive_speed, self.step_size = ramp_time, drive_speed, step_size
+        self.ramp_time, self.drive_speed = ramp_time, drive_speed
         width = max(c.values.shape[1] for c in columns)
         self.n_grid = columns[0].values.shape[0]
         self.tables = np.stack([np.pad(c.values, ((0, 0), (0, width - c.values.shape[1]))) for c in columns])

@@ -161,7 +161,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
     train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s,
-                           step_size=lc.step_size_s, friction=spec.contact.friction_coefficient > 0.0,
+                           friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m)
     springs = train.springs

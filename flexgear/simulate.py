@@ -7,7 +7,6 @@ one thread, no solution file; sensors store every ``record_every_steps``-th step
 
 from __future__ import annotations
 
-import dataclasses
 import datetime as _dt
 import math
 import platform
@@ -20,7 +19,7 @@ import pandas as pd
 
 from flexgear.model import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.results import RunResult, signal_columns
-from flexgear.spec import Variant, spec_hash
+from flexgear.spec import Variant, as_dict, spec_hash
 
 __all__ = ["run_variant", "simulation_settings", "versions"]
 
@@ -151,17 +150,9 @@ def _meta(variant: Variant, t_end: float) -> dict:
             "ratio": th.ratio, "input_torque_nm": th.input_torque, "output_torque_nm": th.output_torque,
             "mesh_force_n": th.mesh_force, "mesh_frequency_hz": th.mesh_frequency,
         },
-        "spec": _plain(variant.gearbox), "versions": versions(),
+        "spec": as_dict(variant.gearbox), "versions": versions(),
         "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
     }
-
-
-def _plain(obj):
-    if dataclasses.is_dataclass(obj):
-        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj)}
-    if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in obj.items()}
-    return obj if isinstance(obj, (int, float, str, bool)) or obj is None else str(obj)
 
 
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,

@@ -44,6 +44,7 @@ __all__ = [
     "load_gearbox",
     "load_variant",
     "spec_hash",
+    "as_dict",
 ]
 
 COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
@@ -514,11 +515,12 @@ def load_variant(path: str | Path) -> Variant:
     return Variant(path, raw["name"], gearbox, components, level)
 
 
-def _plain(obj: Any) -> Any:
+def as_dict(obj: Any) -> Any:
+    """A spec (or any of its tables) as plain JSON-able data; file paths are left out."""
     if dataclasses.is_dataclass(obj):
-        return {f.name: _plain(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.name != "source"}
+        return {f.name: as_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.name != "source"}
     if isinstance(obj, dict):
-        return {k: _plain(v) for k, v in sorted(obj.items())}
+        return {k: as_dict(v) for k, v in sorted(obj.items())}
     if isinstance(obj, Path):
         return None
     return obj
@@ -526,5 +528,5 @@ def _plain(obj: Any) -> Any:
 
 def spec_hash(obj: GearboxSpec | Variant | Any, *extra: Any) -> str:
     """SHA-256 (16 hex digits) of a spec's content (file paths excluded) and any extra values."""
-    payload = json.dumps([_plain(obj), [_plain(e) for e in extra]], sort_keys=True, default=str)
+    payload = json.dumps([as_dict(obj), [as_dict(e) for e in extra]], sort_keys=True, default=str)
     return hashlib.sha256(payload.encode()).hexdigest()[:16]

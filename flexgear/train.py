@@ -69,7 +69,7 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
 
 
 def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearContact], ramp_time: float,
-                   drive_speed: float, *, step_size: float = 1e-5, friction: bool = True,
+                   drive_speed: float, *, friction: bool = True,
                    carrier: Carrier | None = None, contact_fourier_order: int = 8,
                    radial_band: float | None = None) -> GearTrain:
     """Add the bushings ``elements``, the gear ``contacts`` and their per-step updates for ``bodies``.
@@ -79,7 +79,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; rigid gears only).
     Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
     from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
-    tooth height). ``step_size`` [s]: the integrator's. Sets the system's pre-step user function if
+    tooth height). Sets the system's pre-step user function if
     any update is needed.
     """
     by_name = {b.name: b for b in bodies}
@@ -109,7 +109,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     if columns:
         from flexgear.contact_kinematics import ContactKinematics
 
-        train.kinematics = ContactKinematics(constraint, base, columns, offsets, ramp_time, drive_speed, step_size)
+        train.kinematics = ContactKinematics(constraint, base, columns, offsets, ramp_time, drive_speed)
         mbs.SetObjectParameter(constraint, "scalingMarker1", train.kinematics.matrix_at(0.0))
         pre_steps.append(train.kinematics)
     if friction and any(c.friction_coefficient > 0.0 for c in contacts):
