@@ -26,7 +26,8 @@ def variant(planets: int = PLANETS, ramp_time_s: float = 0.04, end_time_s: float
         raise ValueError(f"{planets} planets cannot be equally spaced: (z_s + z_r) / N must be an integer")
     g = g.with_changes(gears=dataclasses.replace(g.gears, planet_count=planets),
                        load_case=dataclasses.replace(g.load_case, ramp_time_s=ramp_time_s, end_time_s=end_time_s))
-    return dataclasses.replace(v, name=f"{v.name}_{planets}_planets", gearbox=g)
+    # rigid bodies with the exact geometry's mass properties: no meshes or reduced bodies to build
+    return dataclasses.replace(v, name=f"{v.name}_{planets}_planets", gearbox=g, rigid_mass_properties="exact")
 
 
 def main(planets: int = PLANETS, t_end: float = 0.25, progress: bool = False):

@@ -48,7 +48,7 @@ from threadpoolctl import threadpool_limits
 from flexgear.fem import FEModel, rigid_body_modes
 from flexgear.massprops import MassProperties
 
-__all__ = ["Interface", "ReducedBody", "interface", "reduce", "full_free_modes", "ffrf_invariants"]
+__all__ = ["Interface", "ReducedBody", "interface", "rbe3_weights", "reduce", "full_free_modes", "ffrf_invariants"]
 
 _EPS = np.zeros((3, 3, 3))
 _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
@@ -90,9 +90,13 @@ def interface(fe: FEModel, where: str | np.ndarray, name: str | None = None) -> 
     return Interface(name, np.asarray(nodes, np.int64), w, w @ fe.nodes[nodes])
 
 
-def _rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
-    """Rows (6, 3n) of C: weighted mean translation and least-squares rotation of the interface."""
-    r = fe.nodes[itf.nodes] - itf.point
+def rbe3_weights(nodes: np.ndarray, itf: Interface) -> np.ndarray:
+    """Local RBE3 rows (k, 6, 3) of ``itf``: (t, theta) = sum_i rows[i] @ u_i over its k nodes.
+
+    t = sum w_i u_i (weighted mean translation), theta = A^-1 sum w_i r_i x u_i with
+    A = sum w_i (|r_i|^2 I - r_i r_i^T), r_i = x_i - p (least-squares rotation); ``nodes`` (n, 3) [m].
+    """
+    r = nodes[itf.nodes] - itf.point
     w = itf.weights
     a = np.einsum("i,ij,ik->jk", w, r, r)
     a = np.trace(a) * np.eye(3) - a
@@ -100,11 +104,15 @@ def _rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
         raise ValueError(f"interface {itf.name!r}: nodes are collinear, rotation undefined")
     a_inv = np.linalg.inv(a)
     skew = np.einsum("ejk,ij->iek", _EPS, r)  # skew(r_i)[e, k] = eps_ejk r_j  (skew(r) u = r x u)
-    rot = np.einsum("de,i,iek->idk", a_inv, w, skew)  # (nodes, 3 rows, 3 comps)
-    n_loc = len(itf.nodes)
-    rows = np.zeros((n_loc, 6, 3))
+    rows = np.zeros((len(itf.nodes), 6, 3))
     rows[:, 0:3, :] = w[:, None, None] * np.eye(3)[None]
-    rows[:, 3:6, :] = rot
+    rows[:, 3:6, :] = np.einsum("de,i,iek->idk", a_inv, w, skew)
+    return rows
+
+
+def _rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
+    """Rows (6, 3n) of C: weighted mean translation and least-squares rotation of the interface."""
+    rows = rbe3_weights(fe.nodes, itf)
     cols = (3 * itf.nodes[:, None, None] + np.arange(3)[None, None, :]).repeat(6, axis=1)
     rr = np.broadcast_to(np.arange(6)[None, :, None], rows.shape)
     return sp.csr_matrix((rows.ravel(), (rr.ravel(), cols.ravel())), shape=(6, fe.n_dof))
@@ -220,6 +228,17 @@ class ReducedBody:
             if itf.name == name:
                 return itf
         raise KeyError(f"no interface {name!r}; have {[i.name for i in self.interfaces]}")
+
+    def interface_motion(self, name: str) -> np.ndarray:
+        """(6, m): RBE3 translation [m] and rotation [rad] of interface ``name`` per modal coordinate.
+
+        The interface's six motions in the body frame are ``interface_motion(name) @ q`` (eq. of
+        :func:`rbe3_weights` applied to the mode shapes); exact for the RBE3 Craig-Bampton basis.
+        """
+        itf = self.interface(name)
+        rows = rbe3_weights(self.nodes, itf)
+        shapes = self.modes.reshape(len(self.nodes), 3, -1)[itf.nodes]  # (k, 3, m)
+        return np.einsum("idc,icm->dm", rows, shapes)
 
     def save(self) -> bytes:
         """The body as ``.npz`` bytes (write them with flexgear.results.atomic_write_bytes)."""

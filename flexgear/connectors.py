@@ -51,6 +51,7 @@ __all__ = [
     "add_speed_drive",
     "add_load_torque",
     "add_fixed_joint",
+    "add_interface_joint",
 ]
 
 
@@ -517,6 +518,31 @@ def add_fixed_joint(mbs, body: Body, other: Body | None = None, coordinates: tup
         name=f"{label}_{k}", markerNumbers=[ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node,
                                                                                        coordinate=k))]))
         for k in coordinates]
+
+
+def add_interface_joint(mbs, body: Body, other: Body, interfaces: tuple[str, str], point, name: str = "") -> int:
+    """Fixed joint of two bodies at their interfaces, at ``point`` [m, ground frame, reference configuration].
+
+    A flexible body joins through the ``MarkerSuperElementRigid`` of its interface (the RBE3 motion
+    of the interface node set, see flexgear.flexible.add_flexible_body, which must have placed that
+    marker at ``point``); a rigid body through a body-fixed marker at ``point``. All six relative
+    motions are constrained (``ObjectJointGeneric``); its ``Force``/``Torque`` outputs are the
+    forces [N] and moments [N·m] the joint transmits. Returns the joint.
+    """
+    from exudyn.itemInterface import MarkerBodyRigid, ObjectJointGeneric, VObjectJointGeneric
+
+    markers = []
+    for b, itf in zip((body, other), interfaces, strict=True):
+        if b.flexible:
+            if itf not in b.interface_markers:
+                raise KeyError(f"flexible body {b.name!r} has no marker on interface {itf!r}; "
+                               f"have {sorted(b.interface_markers)}")
+            markers.append(b.interface_markers[itf])
+        else:
+            local = np.asarray(point, float) - b.position
+            markers.append(mbs.AddMarker(MarkerBodyRigid(bodyNumber=b.obj, localPosition=list(map(float, local)))))
+    return mbs.AddObject(ObjectJointGeneric(name=name or f"joint_{body.name}_{other.name}", markerNumbers=markers,
+                                            constrainedAxes=[1] * 6, visualization=VObjectJointGeneric(show=False)))
 
 
 def _keep_alive(mbs, functions: list) -> None:

@@ -4,8 +4,9 @@ The body's reference frame is a ``NodeRigidBodyRxyz`` node exactly like a rigid 
 (flexgear.bodies): bushings, drives and gear contacts attach to the frame coordinates whatever the
 body's form. The flexible coordinates are the reduced free-free modes, M-orthogonal to the rigid
 modes (Tisserand mean axes), on a ``NodeGenericODE2``. Interfaces get ``MarkerSuperElementRigid``
-markers (weighted node sets) for fixed joints; keep drives and bushings off them (a marker over
-~1 400 nodes cost 230x a frame bushing per step in the prototype).
+markers for fixed joints. A marker over an interface's real node set (~1 400 nodes) cost 230x a
+frame bushing per step in the prototype, so the marker acts on six virtual nodes that carry the
+interface's RBE3 motion exactly (:func:`interface_virtual_nodes`).
 
 Cache: ``cached_reduced_body(key, build)`` stores the reduced body as ``meshes/reduced-<key>.npz``
 (atomic write); the key must hash every input (geometry, mesh, reduction settings, versions).
@@ -24,7 +25,7 @@ from flexgear.bodies import Body
 from flexgear.cms import ReducedBody
 from flexgear.results import atomic_write_bytes
 
-__all__ = ["FlexibleBody", "add_flexible_body", "cached_reduced_body", "reduced_cache_path"]
+__all__ = ["FlexibleBody", "add_flexible_body", "interface_virtual_nodes", "cached_reduced_body", "reduced_cache_path"]
 
 CACHE_FORMAT_VERSION = 1  # bump when ReducedBody's content or the reduction changes
 
@@ -38,16 +39,44 @@ class FlexibleBody(Body):
     reduced: ReducedBody | None = None
 
 
+def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):
+    """Six virtual mesh nodes that carry the RBE3 motion of interface ``name`` as a rigid pattern.
+
+    Nodes at ``point`` +- ``arm`` e_k (body frame [m]; default the interface's RBE3 point) whose
+    displacements are the interface's rigid motion u = t + theta x (x - p) with (t, theta) =
+    ``reduced.interface_motion(name) @ q``. A ``MarkerSuperElementRigid`` with equal weights on them
+    moves exactly as the RBE3 marker over the interface's real node set (same weighted least-squares
+    rotation), at the cost of six nodes instead of hundreds. Returns (positions (6, 3), modes (18, m)).
+    """
+    itf = reduced.interface(name)
+    p = itf.point if point is None else np.asarray(point, float)
+    motion = reduced.interface_motion(name)
+    t, th = motion[:3], motion[3:]
+    positions, rows = [], []
+    for k in range(3):
+        for sign in (1.0, -1.0):
+            x = p + sign * arm * np.eye(3)[k]
+            d = x - itf.point
+            skew = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
+            positions.append(x)
+            rows.append(t - skew @ th)  # theta x d = -d x theta
+    return np.array(positions), np.vstack(rows)
+
+
 def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_matrix=None,
                       velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                       stiffness_damping_s: float = 0.0, mass_damping_per_s: float = 0.0,
-                      interface_markers: list[str] | None = None, show: bool = True) -> FlexibleBody:
+                      interface_markers: list[str] | dict[str, np.ndarray] | None = None,
+                      show: bool = True) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
     ``angular_velocity`` [rad/s, ground frame] are initial values of the frame. Damping of the
     flexible coordinates D = mass_damping_per_s * M_r + stiffness_damping_s * K_r (Rayleigh).
-    ``interface_markers``: names of interfaces that get a ``MarkerSuperElementRigid`` (default all).
+    ``interface_markers``: interfaces that get a ``MarkerSuperElementRigid`` (default all), as names
+    (marker at the interface's RBE3 point) or as {name: marker point in the body frame [m]}. The
+    markers act on six virtual nodes per interface (:func:`interface_virtual_nodes`) appended to the
+    mode basis; the floating-frame inertia terms come from the real mesh only.
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -76,13 +105,25 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         mc.SetWithDenseMatrix(np.diag(diag), useDenseMatrix=False)
         return mc
 
+    if interface_markers is None:
+        interface_markers = [i.name for i in reduced.interfaces]
+    points = (dict(interface_markers) if isinstance(interface_markers, dict)
+              else {n: None for n in interface_markers})
+    positions, modes, first = [reduced.nodes], [reduced.modes], {}
+    count = len(reduced.nodes)
+    for itf_name, point in points.items():
+        x, rows = interface_virtual_nodes(reduced, itf_name, point)
+        first[itf_name] = count
+        positions.append(x)
+        modes.append(rows)
+        count += len(x)
     damping = mass_damping_per_s + stiffness_damping_s * reduced.stiffness
     inv = reduced.invariants
     obj = mbs.AddObject(ObjectFFRFreducedOrder(
         name=name, nodeNumbers=[node, modal],
         massMatrixReduced=container(np.ones(m)), stiffnessMatrixReduced=container(reduced.stiffness),
         dampingMatrixReduced=container(damping) if np.any(damping) else [],
-        modeBasis=reduced.modes, referencePositions=reduced.nodes.ravel(),
+        modeBasis=np.vstack(modes), referencePositions=np.vstack(positions).ravel(),
         mass=float(inv["mass"]), inertia=inv["inertia"], centerOfMass=inv["centerOfMass"],
         mPsiTildePsi=inv["mPsiTildePsi"], mPsiTildePsiTilde=inv["mPsiTildePsiTilde"],
         mPhitTPsi=inv["mPhitTPsi"], mPhitTPsiTilde=inv["mPhitTPsiTilde"],
@@ -91,12 +132,10 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
     markers = {}
-    names = [i.name for i in reduced.interfaces] if interface_markers is None else interface_markers
-    for itf_name in names:
-        itf = reduced.interface(itf_name)
+    for itf_name, start in first.items():
         markers[itf_name] = mbs.AddMarker(MarkerSuperElementRigid(
-            name=f"{name}_{itf_name}", bodyNumber=obj, offset=[0.0, 0.0, 0.0],  # at the weighted mean
-            meshNodeNumbers=np.asarray(itf.nodes, np.int64), weightingFactors=np.asarray(itf.weights, float),
+            name=f"{name}_{itf_name}", bodyNumber=obj, offset=[0.0, 0.0, 0.0],
+            meshNodeNumbers=np.arange(start, start + 6, dtype=np.int64), weightingFactors=np.full(6, 1.0 / 6.0),
             useAlternativeApproach=True, visualization={"show": False, "showMarkerNodes": False}))
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))

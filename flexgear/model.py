@@ -24,7 +24,7 @@ from flexgear.connectors import (
     Bushing,
     GearContact,
     MeshFriction,
-    add_fixed_joint,
+    add_interface_joint,
     add_load_torque,
     add_speed_drive,
 )
@@ -54,6 +54,9 @@ class GearboxModel:
     friction: MeshFriction | None = None
     kinematics: object | None = None  # flexgear.contact_kinematics.ContactKinematics for flexible gears
     aux_node: int = -1  # node of the contacts' deflection coordinates
+    input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
+    output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
+    joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -95,7 +98,7 @@ MassSource = Callable[[GearboxSpec, str], MassProperties]
 ReducedSource = Callable[[GearboxSpec, str, str], object]
 
 
-def _default_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
+def _exact_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
     from flexgear.geometry import component_mass_properties
 
     return component_mass_properties(spec, component)
@@ -107,16 +110,27 @@ def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
     return component_reduced_body(spec, component, level, progress=True)
 
 
+def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
+    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's."""
+    if variant.rigid_mass_properties == "exact":
+        return _exact_mass_source
+    return lambda spec, component: reduced(spec, component, variant.mesh_level).props
+
+
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
-                   level: str, props: MassSource, reduced: ReducedSource) -> Body:
-    """One component as a rigid body or a reduced flexible body of the same geometry."""
+                   level: str, props: MassSource, reduced: ReducedSource,
+                   joint: tuple[str, np.ndarray] | None = None) -> Body:
+    """One component as a rigid body or a reduced flexible body of the same geometry.
+
+    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point.
+    """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
     from flexgear.flexible import add_flexible_body
 
     return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
-                             interface_markers=[], show=False)
+                             interface_markers={joint[0]: joint[1]} if joint else [], show=False)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -125,37 +139,51 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
     ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
-    exact); otherwise they are two bodies whose frames are joined by a fixed joint.
+    exact); otherwise they are two bodies joined by a fixed joint at their interfaces
+    (flexgear.components.JOINT_INTERFACES, at flexgear.components.joint_point): a flexible body
+    through its interface node set's RBE3 motion, a rigid one at the point. The input bearing and the
+    drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
+    body when shaft and gear are one), on the frame coordinates at the frame origin (gear mid-plane).
+    Rigid components carry the mass properties of the variant's ``rigid_mass_properties``: "mesh",
+    those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
+    "exact", the exact geometry's; ``mass_source`` overrides both.
     """
+    from flexgear.components import JOINT_INTERFACES, joint_point
+
     spec = variant.gearbox
     if spec.gears.arrangement != "star":
         raise ValueError(f"{spec.source}: field 'gears.arrangement': build_star_gearbox needs 'star'")
-    props = mass_source or _default_mass_source
     reduced = reduced_source or _default_reduced_source
+    props = mass_source or _mass_source(variant, reduced)
     form = variant.components
     th = theory(spec)
     geo = gear_set_geometry(spec)
     level = variant.mesh_level
     bodies: list[Body] = []
-    joints = []
+    pairs = []
+    ends = {}
     for gear, shaft in (("sun", "input_shaft"), ("ring", "output_shaft")):
         if form[gear] == "rigid" and form[shaft] == "rigid":
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
             bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
+            ends[gear] = gear
         else:
-            lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced)
-            other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced)
+            point = joint_point(spec, gear)
+            lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
+                                  (JOINT_INTERFACES[gear], point))
+            other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
+                                   (JOINT_INTERFACES[shaft], point))
             bodies += [lead, other]
-            joints.append((lead, other))
+            pairs.append((lead, other, (JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft]), point))
+            ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced))
     by_body = {bd.name: bd for bd in bodies}
-    for lead, other in joints:
-        add_fixed_joint(mbs, lead, other)
+    joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
     b = spec.bearings
-    bushings = [Bushing.from_bearing("sun", b.input_shaft), Bushing.from_bearing("ring", b.output_shaft)]
+    bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
@@ -165,11 +193,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m)
     springs = train.springs
-    drive = add_speed_drive(mbs, by_body["sun"], lc.ramp_time_s, lc.input_speed_rad_s)
-    load = add_load_torque(mbs, by_body["ring"], -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s)
+    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s)
+    load = add_load_torque(mbs, by_body[ends["ring"]], -math.copysign(lc.load_torque_nm, th.output_speed),
+                           lc.ramp_time_s)
     halves = len(helix_halves(geo))
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        train.aux_node)
+                        train.aux_node, ends["sun"], ends["ring"], joints)

@@ -62,7 +62,7 @@ def _add_sensors(mbs, model: GearboxModel) -> dict[str, int]:
     from exudyn.itemInterface import SensorNode, SensorObject
 
     ovt = exu.OutputVariableType
-    sun, ring = model.bodies["sun"].node, model.bodies["ring"].node
+    sun, ring = model.bodies[model.input_body].node, model.bodies[model.output_body].node
     sensors = {
         "input_speed": mbs.AddSensor(SensorNode(nodeNumber=sun, outputVariableType=ovt.AngularVelocity,
                                                 storeInternal=True)),
@@ -75,6 +75,9 @@ def _add_sensors(mbs, model: GearboxModel) -> dict[str, int]:
         "output_accel": mbs.AddSensor(SensorNode(nodeNumber=ring, outputVariableType=ovt.Acceleration,
                                                  storeInternal=True)),
     }
+    for gear, joint in model.joints.items():
+        sensors[f"joint_{gear}"] = mbs.AddSensor(SensorObject(objectNumber=joint, outputVariableType=ovt.TorqueLocal,
+                                                              storeInternal=True))
     if model.kinematics is not None:
         sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
                                                           outputVariableType=ovt.Coordinates, storeInternal=True))
@@ -178,9 +181,12 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         mbs.SolveDynamic(simulation_settings(variant, t_end, progress),
                          solverType=exu.DynamicSolverType.GeneralizedAlpha)
         signals = _signals(mbs, model, sensors)
+        window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:
-            lc = variant.gearbox.load_case
-            meta.update(elastic_share(mbs, model, sensors, min(lc.ramp_time_s, 0.8 * t_end)))
+            meta.update(elastic_share(mbs, model, sensors, window_start))
+        for gear in model.joints:  # torque about the axis that each gear-shaft joint transmits
+            torque = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}"]))
+            meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
             raise FloatingPointError("the solution diverged (non-finite signals)")
         meta.update(status="ok", reason="", build_time_s=build_s)

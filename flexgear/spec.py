@@ -343,6 +343,10 @@ class Variant:
     gearbox: GearboxSpec
     components: dict[str, str]
     mesh_level: str = "default"
+    # Mass properties of the rigid components: "mesh" = those of the reduced flexible body built from
+    # the same mesh at mesh_level (rigid and flexible twins identical, the variant matrix compares like
+    # with like); "exact" = the exact geometry's volume integrals (no mesh needed).
+    rigid_mass_properties: str = "mesh"
 
     def is_rigid(self) -> bool:
         return all(v == "rigid" for v in self.components.values())
@@ -483,7 +487,7 @@ def load_variant(path: str | Path) -> Variant:
     """
     path = Path(path)
     raw = _read_toml(path)
-    allowed = {"name", "gearbox", "components", "mesh_level", "description", "overrides"}
+    allowed = {"name", "gearbox", "components", "mesh_level", "rigid_mass_properties", "description", "overrides"}
     unknown = sorted(set(raw) - allowed)
     if unknown:
         raise SpecError(path, unknown[0], f"unknown field; allowed: {', '.join(sorted(allowed))}")
@@ -512,7 +516,9 @@ def load_variant(path: str | Path) -> Variant:
         raise SpecError(path, "mesh_level", f"expected one of {sorted(gearbox.meshing_assumed)}", level)
     if not isinstance(raw["name"], str) or not raw["name"]:
         raise SpecError(path, "name", "expected a non-empty string", raw["name"])
-    return Variant(path, raw["name"], gearbox, components, level)
+    masses = _check_value(path, "rigid_mass_properties", raw.get("rigid_mass_properties", "mesh"), str,
+                          {"choices": ("mesh", "exact")})
+    return Variant(path, raw["name"], gearbox, components, level, masses)
 
 
 def as_dict(obj: Any) -> Any:

@@ -2,7 +2,8 @@
 
 Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm. Coarse first-order
 meshes (a few hundred nodes, about a second each) with the bore (ring: outer surface) as the RBE3
-interface. They exercise the flexible-gear machinery; the real components come from
+interface, named as the gearbox's joints expect (flexgear.components.JOINT_INTERFACES).
+They exercise the flexible-gear machinery; the real components come from
 flexgear.components.component_reduced_body.
 """
 
@@ -14,7 +15,7 @@ from flexgear.involute import gear_set_geometry
 
 
 @cache
-def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int):
+def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int, name: str):
     import ngsolve as ngs
     from netgen.occ import Cylinder, OCCGeometry, Pnt, Z
 
@@ -25,22 +26,26 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     fe = fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), material, 1)
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
     sel = np.flatnonzero(np.abs(r - (r_out if interface_outer else r_in)) < 1e-6)
-    return reduce(fe, [interface(fe, sel, "bore")], 20, n_compare=0, keep_modes=modes)
+    return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes)
 
 
 def annulus_source(spec, component: str, level: str):
     """A ``reduced_source`` for flexgear.model.build_star_gearbox."""
+    from flexgear.components import JOINT_INTERFACES
+
     geo = gear_set_geometry(spec)
+    name = JOINT_INTERFACES.get(component, "bore")
     width = spec.gears_assumed.face_width_m + spec.gears_assumed.half_gap_m
     modes = spec.reduction_assumed.simulation_modes
     if component == "ring":
         return _annulus(geo.ring.reference_radius, geo.ring.root_radius + 0.008, width, True,
-                        spec.material_assumed, modes)
+                        spec.material_assumed, modes, name)
     if component in ("sun", "planet"):
         gear = geo.sun if component == "sun" else geo.planet
         bore = getattr(spec.components_assumed, f"{component}_bore_diameter_mm") * 0.5e-3
-        return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes)
+        return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes, name)
     c = spec.components_assumed
     outer = getattr(c, f"{component}_outer_diameter_mm") * 0.5e-3
     inner = getattr(c, f"{component}_inner_diameter_mm") * 0.5e-3
-    return _annulus(inner, outer, getattr(c, f"{component}_length_mm") * 1e-3, False, spec.material_assumed, modes)
+    length = getattr(c, f"{component}_length_mm") * 1e-3
+    return _annulus(inner, outer, length, False, spec.material_assumed, modes, name)

@@ -239,3 +239,34 @@ def test_cache_builds_once_and_loads_fast(coarse_ring_fe, tmp_path):
     assert np.allclose(first.full_frequencies_hz, again.full_frequencies_hz)
     cached_reduced_body("def456", build, tmp_path)  # another key (changed input) rebuilds
     assert len(calls) == 2
+
+
+def test_virtual_interface_marker_moves_as_rbe3_marker_over_the_real_nodes(coarse_ring_fe):
+    """The six-node interface marker equals Exudyn's own weighted marker over the interface's
+    real node set (same RBE3 weights) in position and rotation, for a deformed, moved body."""
+    import exudyn as exu
+    from exudyn.itemInterface import MarkerSuperElementRigid
+
+    body = reduce(coarse_ring_fe, ["top"], 8, n_compare=0)
+    itf = body.interface("top")
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    flex = add_flexible_body(mbs, "ring", body, [0.01, -0.02, 0.03], rotation_matrix=_rot_z(0.7), show=False)
+    real = mbs.AddMarker(MarkerSuperElementRigid(bodyNumber=flex.obj, offset=[0.0, 0.0, 0.0],
+                                                 meshNodeNumbers=itf.nodes, weightingFactors=itf.weights,
+                                                 useAlternativeApproach=True))
+    q = 1.0 * np.random.default_rng(1).standard_normal(body.n_modes)
+    assert np.abs(body.interface_motion("top") @ q).max() > 1e-5  # the modes move and turn the interface
+    mbs.SetNodeParameter(flex.modal_node, "initialCoordinates", list(q))
+    mbs.Assemble()
+    ovt = exu.OutputVariableType
+    virtual = flex.interface_markers["top"]
+    for var in (ovt.Position, ovt.RotationMatrix):
+        a = np.asarray(mbs.GetMarkerOutput(real, var, exu.ConfigurationType.Initial))
+        b = np.asarray(mbs.GetMarkerOutput(virtual, var, exu.ConfigurationType.Initial))
+        assert np.abs(a - b).max() < 1e-12 + 1e-9 * np.abs(a).max()
+
+
+def _rot_z(angle: float) -> np.ndarray:
+    c, s = np.cos(angle), np.sin(angle)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])

@@ -59,3 +59,42 @@ def test_modal_coefficients_of_a_rigid_translation_mode():
     alpha = 2 * np.pi * np.arange(360) / 360
     expected = np.cos(alpha - psi) * normal[0] - np.sin(alpha - psi) * normal[1]
     assert np.max(np.abs(c[:, 0] - expected)) < 1e-10
+
+
+def test_gear_shaft_joints_carry_the_shaft_torques(flex_run):
+    """Model 4: the flexible sun and ring are joined to their rigid shafts at the interfaces; the drive
+    and the load act on the shafts, so the sun-shaft joint carries the input torque and the
+    ring-output shaft joint the load torque (Table 5), about the axis."""
+    th = flex_run.meta["theory"]
+    s = flex_run.signals
+    drive = s[s.time_s >= 0.08].input_torque_nm.mean()  # includes the tooth-friction loss
+    assert abs(flex_run.meta["joint_torque_sun_nm"]) == pytest.approx(abs(drive), rel=5e-3)
+    assert abs(drive) == pytest.approx(th["input_torque_nm"], rel=5e-3)
+    assert abs(flex_run.meta["joint_torque_ring_nm"]) == pytest.approx(th["output_torque_nm"], rel=5e-3)
+
+
+def test_rigid_and_flexible_twins_carry_identical_mass_properties():
+    """Issue 4: a component has the same mass, centre of mass and inertia in either form. With
+    rigid_mass_properties = "mesh" the rigid planet takes the reduced body's (FE) mass properties."""
+    import exudyn as exu
+    from exudyn.rigidBodyUtilities import Inertia6D2InertiaTensor
+
+    from flexgear.model import build_star_gearbox
+
+    v = load_variant(VARIANTS / "model2.toml")  # flexible planets
+    props = {}
+    for form in ("rigid", "flexible"):
+        sc = exu.SystemContainer()
+        mbs = sc.AddSystem()
+        variant = dataclasses.replace(v, components={**v.components, "planets": form})
+        assert variant.rigid_mass_properties == "mesh"
+        planet = build_star_gearbox(mbs, variant, reduced_source=annulus_source).bodies["planet1"]
+        get = lambda name: np.asarray(mbs.GetObjectParameter(planet.obj, name))  # noqa: E731
+        if form == "rigid":  # inertia about the frame origin, Exudyn's 6-vector
+            props[form] = get("physicsMass"), get("physicsCenterOfMass"), Inertia6D2InertiaTensor(get("physicsInertia"))
+        else:
+            props[form] = get("mass"), get("centerOfMass"), get("inertia")
+    (m_r, c_r, j_r), (m_f, c_f, j_f) = props["rigid"], props["flexible"]
+    assert m_f == pytest.approx(m_r, rel=1e-12)
+    assert np.abs(c_f - c_r).max() < 1e-12
+    assert np.abs(j_f - j_r).max() < 1e-9 * np.abs(j_r).max()

@@ -84,7 +84,9 @@ def test_bad_variant(tmp_path):
 def test_hash_tracks_content(gearbox, model1):
     import dataclasses
 
-    assert spec_hash(model1) == spec_hash(load_variant(VARIANTS / "model1.toml"))
+    assert spec_hash(model1) == spec_hash(dataclasses.replace(load_variant(VARIANTS / "model1.toml"),
+                                                              rigid_mass_properties="exact"))
+    assert spec_hash(model1) != spec_hash(load_variant(VARIANTS / "model1.toml"))
     other = gearbox.with_changes(load_case=dataclasses.replace(gearbox.load_case, load_torque_nm=500.0))
     assert spec_hash(other) != spec_hash(gearbox)
     assert spec_hash(model1, 0.1) != spec_hash(model1, 0.2)
