@@ -60,7 +60,7 @@ class CarrierKinematics:
     in place (the friction's sliding rows), given as arrays to overwrite.
     """
 
-    def __init__(self, constraint: int, rows: np.ndarray, bodies: list[Body], carrier: Carrier, ramp_time: float,
+    def __init__(self, constraint, rows: np.ndarray, bodies: list[Body], carrier: Carrier, ramp_time: float,
                  drive_speed: float, extra_rows: list[np.ndarray] | None = None):
         self.constraint, self.carrier = constraint, carrier
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
@@ -102,8 +102,7 @@ class CarrierKinematics:
 
     def __call__(self, mbs, t: float) -> bool:
         g, offset = self.matrix_and_offset(t)
-        mbs.SetObjectParameter(self.constraint, "scalingMarker1", g)
-        mbs.SetObjectParameter(self.constraint, "offset", offset)
+        self.constraint.set(mbs, g, offset)
         theta = self.theta(t)
         for target, rows0 in self.extra:
             target[:] = self.turned(rows0, theta)

@@ -47,6 +47,7 @@ __all__ = [
     "MeshFriction",
     "StiffnessSchedule",
     "add_linear_elements",
+    "MeshConstraint",
     "add_gear_contacts",
     "add_speed_drive",
     "add_load_torque",
@@ -254,41 +255,90 @@ def contact_gradients(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarra
     return np.vstack([n1, a1, spin]), np.vstack([n2, a2, -spin])
 
 
-def add_gear_contacts(mbs, bodies: list[Body], coordinates_marker: int, contacts: list[GearContact],
-                      ramp_time: float, drive_speed: float, extra_columns: int = 0
-                      ) -> tuple[list[int], int, int, np.ndarray]:
-    """Add the contacts: one auxiliary deflection coordinate each, one linear constraint for all,
-    one compiled normal-force law each.
+class MeshConstraint:
+    """The contacts' linear kinematics, delta = G (q - q_ref), as one Exudyn constraint per gear pair.
 
-    ``extra_columns``: coordinates of ``coordinates_marker`` after the frame coordinates (modal
-    coordinates; their columns start at zero and are filled by flexgear.contact_kinematics).
+    ``matrix`` G (n_contacts, n_coordinates) acts on the global coordinate vector (frame coordinates
+    of every body in order, then the modal coordinates of the flexible ones at ``modal_offsets``).
+    Exudyn's ``ObjectConnectorCoordinateVector`` multiplies its scaling matrix by the marker's dense
+    identity Jacobian in every Newton iteration, O(rows cols^2): one constraint over all coordinates
+    of model 7 (20 x 162) took half of the run time. Each gear pair's rows therefore get their own
+    constraint whose marker spans only the two gears' coordinates (an empty ``ObjectGenericODE2``
+    over their nodes). :meth:`set` writes a new G (and offset) into the blocks.
+    """
+
+    def __init__(self, mbs, bodies: list[Body], contacts: list[GearContact], aux_node: int, matrix: np.ndarray,
+                 q_ref: np.ndarray, modal_offsets: dict[str, int]):
+        from exudyn.itemInterface import (
+            MarkerNodeCoordinates,
+            MarkerObjectODE2Coordinates,
+            ObjectConnectorCoordinateVector,
+            ObjectGenericODE2,
+        )
+
+        index = {b.name: i for i, b in enumerate(bodies)}
+        by_name = {b.name: b for b in bodies}
+        aux_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux_node))
+        self.q_ref = q_ref
+        self.blocks: list[tuple[int, np.ndarray, np.ndarray]] = []  # (constraint, rows, columns)
+        pairs = list(dict.fromkeys((c.body1, c.body2) for c in contacts))
+        for pair in pairs:
+            rows = np.array([i for i, c in enumerate(contacts) if (c.body1, c.body2) == pair])
+            nodes = [by_name[n].node for n in pair]
+            cols = [np.arange(6 * index[n], 6 * index[n] + 6) for n in pair]
+            for n in pair:
+                if by_name[n].flexible:
+                    nodes.append(by_name[n].modal_node)
+                    cols.append(np.arange(modal_offsets[n], modal_offsets[n] + by_name[n].reduced.n_modes))
+            cols = np.concatenate(cols)
+            span = mbs.AddObject(ObjectGenericODE2(name=f"mesh_span_{pair[0]}_{pair[1]}", nodeNumbers=nodes))
+            block = mbs.AddObject(ObjectConnectorCoordinateVector(
+                name=f"mesh_kinematics_{pair[0]}_{pair[1]}",
+                markerNumbers=[aux_marker, mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
+                scalingMarker0=np.eye(len(contacts))[rows], scalingMarker1=matrix[np.ix_(rows, cols)],
+                offset=matrix[rows] @ q_ref))
+            self.blocks.append((block, rows, cols))
+
+    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
+        """Write G (and the offset, default G q_ref) into the constraints."""
+        for block, rows, cols in self.blocks:
+            mbs.SetObjectParameter(block, "scalingMarker1", matrix[np.ix_(rows, cols)])
+            if offset is not None:
+                mbs.SetObjectParameter(block, "offset", offset[rows])
+
+
+def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp_time: float, drive_speed: float,
+                      modal_offsets: dict[str, int] | None = None, n_coordinates: int | None = None
+                      ) -> tuple[list[int], int, MeshConstraint, np.ndarray, StiffnessSchedule | None]:
+    """Add the contacts: one auxiliary deflection coordinate each, their linear kinematics
+    (:class:`MeshConstraint`), one compiled normal-force law each.
+
+    ``modal_offsets``, ``n_coordinates``: first global column of each flexible body's modal
+    coordinates and the total number of columns (frame coordinates first; the modal columns start
+    at zero and are filled by flexgear.contact_kinematics).
     Returns the spring-damper of every contact (its ``Force`` output is the normal force), the
-    auxiliary node holding the deflections, the constraint, its scaling matrix and the
+    auxiliary node holding the deflections, the constraint, its (frame) gradient matrix and the
     :class:`StiffnessSchedule` (a pre-step function; None for constant stiffness).
     """
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
         MarkerNodeCoordinate,
-        MarkerNodeCoordinates,
         NodeGenericODE2,
         NodePointGround,
         ObjectConnectorCoordinateSpringDamper,
-        ObjectConnectorCoordinateVector,
     )
     from exudyn.utilities import CreateSymbolicUserFunction
 
     n_c = len(contacts)
-    gradient = np.hstack([_assemble_rows(bodies, contacts, row=0), np.zeros((n_c, extra_columns))])
-    # MarkerObjectODE2Coordinates measures reference + displacement coordinates: subtract the reference
-    q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies] + [np.zeros(extra_columns)])
+    n_frames = 6 * len(bodies)
+    extra = (n_coordinates or n_frames) - n_frames
+    gradient = np.hstack([_assemble_rows(bodies, contacts, row=0), np.zeros((n_c, extra))])
+    # the markers measure reference + displacement coordinates: subtract the reference
+    q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies] + [np.zeros(extra)])
     aux = mbs.AddNode(NodeGenericODE2(name="mesh_deflections", numberOfODE2Coordinates=n_c,
                                       referenceCoordinates=[0.0] * n_c, initialCoordinates=[0.0] * n_c,
                                       initialCoordinates_t=[0.0] * n_c))
-    constraint = mbs.AddObject(ObjectConnectorCoordinateVector(
-        name="mesh_kinematics", markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux)),
-                                               coordinates_marker],
-        scalingMarker0=np.eye(n_c), scalingMarker1=gradient, offset=gradient @ q_ref,
-    ))
+    constraint = MeshConstraint(mbs, bodies, contacts, aux, gradient, q_ref, modal_offsets or {})
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
     springs, laws, factors = [], [], []
     varying = any(np.any(c.stiffness.cos_coeffs) or np.any(c.stiffness.sin_coeffs) for c in contacts)

@@ -92,7 +92,7 @@ class ContactKinematics:
     modal coefficients go (``column_offsets[body]``: first column of that body's modal coordinates).
     """
 
-    def __init__(self, constraint: int, base: np.ndarray, columns: list[ModalColumn],
+    def __init__(self, constraint, base: np.ndarray, columns: list[ModalColumn],
                  column_offsets: dict[str, int], ramp_time: float, drive_speed: float):
         self.constraint, self.base = constraint, base
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
@@ -123,7 +123,7 @@ class ContactKinematics:
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        mbs.SetObjectParameter(self.constraint, "scalingMarker1", self.matrix_at(t))
+        self.constraint.set(mbs, self.matrix_at(t))
         return True
 
 

@@ -4,9 +4,9 @@
 flexgear.model and the examples alike). Given the bodies (rigid or flexible, each on its frame
 node), the linear frame elements (bushings) and the gear contacts, it adds
 
-- one ``ObjectGenericODE2`` with all bushing matrices over the frame (and modal) coordinates,
+- one ``ObjectGenericODE2`` with all bushing matrices over the frame coordinates,
 - the contacts (flexgear.connectors.add_gear_contacts): one auxiliary deflection coordinate each,
-  one linear constraint, one compiled impact law each,
+  their linear kinematics (one constraint per gear pair), one compiled impact law each,
 - for flexible gears, the per-step modal columns of the constraint (flexgear.contact_kinematics),
 - for a rotating carrier, the per-step turning of the contact geometry (flexgear.carrier),
 - tooth friction as a per-step generalized load (flexgear.connectors.MeshFriction), if mu > 0,
@@ -23,7 +23,7 @@ import numpy as np
 
 from flexgear.bodies import Body
 from flexgear.carrier import Carrier, CarrierKinematics
-from flexgear.connectors import GearContact, MeshFriction, add_gear_contacts, add_linear_elements
+from flexgear.connectors import GearContact, MeshConstraint, MeshFriction, add_gear_contacts, add_linear_elements
 
 __all__ = ["GearTrain", "add_gear_train", "modal_columns"]
 
@@ -36,7 +36,7 @@ class GearTrain:
     contacts: list[GearContact]
     springs: list[int]  # per contact: spring-damper whose Force output is the normal force [N]
     aux_node: int  # node of the contacts' deflection coordinates
-    constraint: int  # the linear mesh-kinematics constraint
+    constraint: MeshConstraint  # the linear mesh kinematics (one Exudyn constraint per gear pair)
     frame_elements: int  # ObjectGenericODE2 of the bushings
     coordinates_marker: int
     kinematics: object | None = None  # flexgear.contact_kinematics.ContactKinematics (flexible gears)
@@ -97,10 +97,9 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     for b in flexible:
         offsets[b.name] = n_total
         n_total += b.reduced.n_modes
-    n_extra = n_total - 6 * len(bodies)
-    frame_elements, coords = add_linear_elements(mbs, bodies, elements, [b.modal_node for b in flexible], n_extra)
-    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, coords, contacts, ramp_time,
-                                                                 drive_speed, n_extra)
+    frame_elements, coords = add_linear_elements(mbs, bodies, elements)
+    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
+                                                                 offsets, n_total)
     train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords)
     pre_steps = [schedule] if schedule is not None else []
     if flexible and radial_band is None:
@@ -110,7 +109,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         from flexgear.contact_kinematics import ContactKinematics
 
         train.kinematics = ContactKinematics(constraint, base, columns, offsets, ramp_time, drive_speed)
-        mbs.SetObjectParameter(constraint, "scalingMarker1", train.kinematics.matrix_at(0.0))
+        constraint.set(mbs, train.kinematics.matrix_at(0.0))
         pre_steps.append(train.kinematics)
     if friction and any(c.friction_coefficient > 0.0 for c in contacts):
         train.friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, ramp_time, drive_speed)
@@ -118,8 +117,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         extra = [train.friction.sliding_rows] if train.friction is not None else []
         train.carrier = CarrierKinematics(constraint, base, bodies, carrier, ramp_time, drive_speed, extra)
         g, offset = train.carrier.matrix_and_offset(0.0)
-        mbs.SetObjectParameter(constraint, "scalingMarker1", g)
-        mbs.SetObjectParameter(constraint, "offset", offset)
+        constraint.set(mbs, g, offset)
         pre_steps.append(train.carrier)  # before friction: friction uses the turned sliding rows
     if train.friction is not None:
         pre_steps.append(train.friction)

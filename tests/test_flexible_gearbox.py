@@ -89,11 +89,10 @@ def test_rigid_and_flexible_twins_carry_identical_mass_properties():
         variant = dataclasses.replace(v, components={**v.components, "planets": form})
         assert variant.rigid_mass_properties == "mesh"
         planet = build_star_gearbox(mbs, variant, reduced_source=annulus_source).bodies["planet1"]
-        get = lambda name: np.asarray(mbs.GetObjectParameter(planet.obj, name))  # noqa: E731
-        if form == "rigid":  # inertia about the frame origin, Exudyn's 6-vector
-            props[form] = get("physicsMass"), get("physicsCenterOfMass"), Inertia6D2InertiaTensor(get("physicsInertia"))
-        else:
-            props[form] = get("mass"), get("centerOfMass"), get("inertia")
+        mass, com, inertia = (np.asarray(mbs.GetObjectParameter(planet.obj, k)) for k in ("mass", "centerOfMass",
+                                                                                          "inertia"))
+        # rigid: inertia about the frame origin as Exudyn's 6-vector; flexible: the 3x3 tensor
+        props[form] = mass, com, Inertia6D2InertiaTensor(inertia) if form == "rigid" else inertia
     (m_r, c_r, j_r), (m_f, c_f, j_f) = props["rigid"], props["flexible"]
     assert m_f == pytest.approx(m_r, rel=1e-12)
     assert np.abs(c_f - c_r).max() < 1e-12
