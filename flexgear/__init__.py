@@ -2,11 +2,12 @@
 
 The public API (``__all__``) builds any gearbox in a few lines: gear geometry (``gear_pair_geometry``),
 bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``), bearings
-(``Bushing``, ``add_planet_bearing``), fixed joints (``add_fixed_joint``), gear contacts for external and
-internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally on a rotating ``Carrier``),
-drive and load (``add_speed_drive``, ``add_load_torque``) and signals (``Recorder``, ``solve``). The GTF star
-gearbox of the reference study is built from the same parts (``build_star_gearbox``, ``run_variant``).
-Modules that pull in Exudyn, NGSolve or pandas are imported on first use, so ``import flexgear`` stays light.
+(``Bushing``, ``add_planet_bearing``), fixed joints (``add_fixed_joint``, ``add_interface_joint``), gear
+contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
+on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
+(``Recorder``, ``solve``). The GTF star gearbox of the reference study is built from the same parts
+(``build_star_gearbox``, ``run_variant``). Modules that pull in Exudyn, NGSolve or pandas are imported on
+first use, so ``import flexgear`` stays light.
 """
 
 from importlib import import_module
@@ -28,7 +29,8 @@ _LAZY = {
     "fe_model": "fem", "ReducedBody": "cms", "interface": "cms", "reduce": "cms",
     # connectors
     "Bushing": "connectors", "ContactLaw": "connectors", "GearContact": "connectors",
-    "add_fixed_joint": "connectors", "add_speed_drive": "connectors", "add_load_torque": "connectors",
+    "add_fixed_joint": "connectors", "add_interface_joint": "connectors", "add_speed_drive": "connectors",
+    "add_load_torque": "connectors",
     "drive_angle": "connectors",
     "Carrier": "carrier", "add_planet_bearing": "carrier",
     "GearTrain": "train", "add_gear_train": "train",
