@@ -61,9 +61,9 @@ class SpecError(ValueError):
 
 
 def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
-         integer: bool = False, doc: str = "") -> Any:
-    """Field with a numeric range check (validated on load)."""
-    return field(metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
+         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
+    """Field with a numeric range check (validated on load); optional when ``default`` is given."""
+    return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
 
 
 def _choice(*choices: str, doc: str = "") -> Any:
@@ -243,6 +243,10 @@ class MeshingSettings:
     tooth_size_mm: float = _num(0.0, lo_open=True)
     body_size_mm: float = _num(0.0, lo_open=True)
     element_order: int = _num(1, 2, integer=True)
+    # Netgen curvaturesafety: element size <= curvature radius / this on curved faces and edges.
+    elements_per_curvature_radius: float = _num(0.0, lo_open=True, default=0.3)
+    # Netgen optsteps2d and optsteps3d: smoothing/swapping passes after surface and volume meshing.
+    optimisation_steps: int = _num(0, 10, integer=True, default=3)
 
 
 @dataclass(frozen=True)
