@@ -69,7 +69,7 @@ GEAR_COMPONENTS = ("sun", "planet", "ring")
 SHAFT_COMPONENTS = ("input_shaft", "output_shaft")
 ALL_COMPONENTS = GEAR_COMPONENTS + SHAFT_COMPONENTS
 _HANDS = {"sun": 1.0, "planet": -1.0, "ring": -1.0}
-_GEOMETRY_VERSION = 1  # bump when the construction changes: invalidates every cache entry
+_GEOMETRY_VERSION = 2  # bump when the construction changes: invalidates every cache entry
 
 
 def cache_dir() -> Path:
