@@ -280,7 +280,7 @@ class MeshConstraint:
         by_name = {b.name: b for b in bodies}
         aux_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux_node))
         self.q_ref = q_ref
-        self.blocks: list[tuple[int, np.ndarray, np.ndarray]] = []  # (constraint, rows, columns)
+        self.blocks: list[tuple[int, np.ndarray, tuple]] = []  # (constraint, rows, np.ix_(rows, columns))
         pairs = list(dict.fromkeys((c.body1, c.body2) for c in contacts))
         for pair in pairs:
             rows = np.array([i for i, c in enumerate(contacts) if (c.body1, c.body2) == pair])
@@ -297,12 +297,12 @@ class MeshConstraint:
                 markerNumbers=[aux_marker, mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
                 scalingMarker0=np.eye(len(contacts))[rows], scalingMarker1=matrix[np.ix_(rows, cols)],
                 offset=matrix[rows] @ q_ref))
-            self.blocks.append((block, rows, cols))
+            self.blocks.append((block, rows, np.ix_(rows, cols)))
 
     def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
-        """Write G (and the offset, default G q_ref) into the constraints."""
-        for block, rows, cols in self.blocks:
-            mbs.SetObjectParameter(block, "scalingMarker1", matrix[np.ix_(rows, cols)])
+        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
+        for block, rows, sub in self.blocks:
+            mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
             if offset is not None:
                 mbs.SetObjectParameter(block, "offset", offset[rows])
 

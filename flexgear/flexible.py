@@ -56,10 +56,8 @@ def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: fl
     for k in range(3):
         for sign in (1.0, -1.0):
             x = p + sign * arm * np.eye(3)[k]
-            d = x - itf.point
-            skew = np.array([[0.0, -d[2], d[1]], [d[2], 0.0, -d[0]], [-d[1], d[0], 0.0]])
             positions.append(x)
-            rows.append(t - skew @ th)  # theta x d = -d x theta
+            rows.append(t + np.cross(th, x - itf.point, axis=0))  # u = t + theta x (x - p), per mode
     return np.array(positions), np.vstack(rows)
 
 

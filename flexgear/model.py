@@ -153,7 +153,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     spec = variant.gearbox
     if spec.gears.arrangement != "star":
         raise ValueError(f"{spec.source}: field 'gears.arrangement': build_star_gearbox needs 'star'")
-    reduced = reduced_source or _default_reduced_source
+    source = reduced_source or _default_reduced_source
+    loaded: dict[tuple[str, str], object] = {}
+
+    def reduced(spec: GearboxSpec, component: str, level: str):  # each component loaded once per build
+        if (component, level) not in loaded:
+            loaded[component, level] = source(spec, component, level)
+        return loaded[component, level]
+
     props = mass_source or _mass_source(variant, reduced)
     form = variant.components
     th = theory(spec)
