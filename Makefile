@@ -17,6 +17,7 @@ install:
 
 lint:
 	$(PY) -m ruff check flexgear tests benchmarks examples
+	$(PY) -c "from importlinter.cli import lint_imports; raise SystemExit(lint_imports(no_cache=True, no_logo=True))"
 
 test: lint
 	$(PY) -m pytest -q

@@ -3,7 +3,7 @@
     python benchmarks/bench_flexible.py [--level coarse] [--order 2] [--modes 20] [component ...]
 
 Each component runs in its own process (peak memory per build = that process's max RSS).
-Solid: flexgear.solids.component_solid (the geometry engineer's OCC solids); mesh: Netgen with
+Solid: flexgear.geometry.solids.component_solid (the geometry engineer's OCC solids); mesh: Netgen with
 ``maxh`` = the level's body size (global modes do not need tooth-resolved meshes); interfaces
 picked geometrically until the meshing module names its regions:
 sun/planet: bore; ring: the 12 bolt holes; shafts: the two end faces.
@@ -28,7 +28,7 @@ COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft")
 
 
 def _interfaces(fe, spec, component):
-    from flexgear.cms import interface
+    from flexgear.fe.cms import interface
 
     c = spec.components_assumed
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
@@ -38,7 +38,7 @@ def _interfaces(fe, spec, component):
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < tol), "bore")]
     if component == "ring":
-        from flexgear.geometry import component_layout
+        from flexgear.geometry.layout import component_layout
 
         flange = [p for p in component_layout(spec, "ring").prisms if p.section.holes][0].section
         itfs = []
@@ -58,10 +58,10 @@ def run_one(component: str, level: str, order: int, modes: int) -> dict:
     from netgen.meshing import meshsize
     from netgen.occ import OCCGeometry
 
-    from flexgear.cms import reduce
-    from flexgear.fem import fe_model
-    from flexgear.geometry import exact_mass_properties
-    from flexgear.solids import component_solid
+    from flexgear.fe.cms import reduce
+    from flexgear.fe.fem import fe_model
+    from flexgear.geometry.layout import exact_mass_properties
+    from flexgear.geometry.solids import component_solid
     from flexgear.spec import load_gearbox
 
     spec = load_gearbox(ROOT / "model_variants" / "gearbox.toml")

@@ -18,11 +18,11 @@ from pathlib import Path
 
 import pandas as pd
 
-from flexgear.compare import compare_results
-from flexgear.lumped import run_lumped
-from flexgear.modal import modal_analysis
+from flexgear.lumped.modal import modal_analysis
+from flexgear.lumped.run import run_lumped
 from flexgear.results import save_result
 from flexgear.spec import load_gearbox
+from flexgear.study.compare import compare_results
 
 ROOT = Path(__file__).resolve().parents[1]
 

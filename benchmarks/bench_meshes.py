@@ -3,12 +3,12 @@
 Run: python benchmarks/bench_meshes.py [--runs level[:order] ...] [--components sun ring ...] [--keep DIR]
 
 Everything is built in a fresh, temporary cache folder (``FLEXGEAR_CACHE_DIR``), so nothing is
-reused from ``meshes/``. Per component the solid is built once (flexgear.meshing.component_brep)
+reused from ``meshes/``. Per component the solid is built once (flexgear.fe.mesh.component_brep)
 and meshed at each run (default: ``coarse`` at its order, ``coarse:2`` as the geometry tests use
 it, ``default``). Prints one row per component and run: tetrahedra, nodes, solid time, mesh time
 (Netgen, from reading the ``.brep`` to the last node), the smallest element shape quality of the
 vertex tetrahedra (mean ratio 12 (3V)^(2/3) / sum of squared edge lengths: 1 regular, 0 flat) and
-the mesh-vs-exact differences of mass and Izz (flexgear.meshing.mass_check: trimesh on the
+the mesh-vs-exact differences of mass and Izz (flexgear.fe.mesh.mass_check: trimesh on the
 boundary, second-order faces sampled through their quadratic map). The solid's own OCC volume
 against the exact section integrals is printed once per component.
 """
@@ -50,8 +50,8 @@ def main() -> None:
 
     import netgen.occ as occ
 
-    from flexgear.geometry import exact_mass_properties
-    from flexgear.meshing import component_brep, component_mesh, mass_check
+    from flexgear.fe.mesh import component_brep, component_mesh, mass_check
+    from flexgear.geometry.layout import exact_mass_properties
     from flexgear.spec import load_gearbox
 
     spec = load_gearbox(a.gearbox)

@@ -7,7 +7,7 @@ Prints wall and CPU time of each run and the steady values against theory.
 import argparse
 import statistics
 
-from flexgear.simulate import run_variant
+from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 
 

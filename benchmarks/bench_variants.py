@@ -11,8 +11,9 @@ from pathlib import Path
 
 import pandas as pd
 
-from flexgear.results import atomic_write_bytes, save_result
-from flexgear.simulate import run_variant
+from flexgear.cache import atomic_write_bytes
+from flexgear.mbs.run import run_variant
+from flexgear.results import save_result
 from flexgear.spec import load_variant
 
 ADAMS_S = {"model1": 371, "model2": 17948, "model3": 507, "model4": 34903, "model5": 11745, "model6": 35662,

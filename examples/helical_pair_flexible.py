@@ -30,7 +30,7 @@ RAMP_S, STEP_S = 0.02, 1e-5
 DAMPING_FRACTION = 2e-4  # of the contact stiffness (study: 1e-3); settles within this short run
 
 
-def wheel_body(spec, mesh: fg.Mesh, modes: int = 12) -> fg.ReducedBody:
+def wheel_body(spec, mesh: fg.GearMesh, modes: int = 12) -> fg.ReducedBody:
     """Reduced flexible body of the wheel: annulus bore..reference radius, first-order tets, 8 mm."""
     import ngsolve as ngs
     from netgen.occ import Cylinder, OCCGeometry, Pnt, Z

@@ -12,36 +12,39 @@ first use, so ``import flexgear`` stays light.
 
 from importlib import import_module
 
-from flexgear.involute import Gear, GearSetGeometry, Mesh, gear_set_geometry, solve_profile_shifts
+from flexgear.geometry.involute import Gear, GearMesh, GearSetGeometry, Mesh, gear_set_geometry, solve_profile_shifts
+from flexgear.laws.ramps import step, step_integral
 from flexgear.spec import GearboxSpec, SpecError, Variant, load_gearbox, load_variant, spec_hash
-from flexgear.theory import Theory, step, step_integral, theory
+from flexgear.theory import Theory, theory
 
 __version__ = "0.1.0"
 
 _LAZY = {
     # geometry
-    "HelixHalf": "gearpair", "helix_halves": "gearpair", "gear_pair_geometry": "gearpair",
-    "pair_contacts": "gearpair", "annulus_mass_properties": "gearpair",
-    # bodies
-    "MassProperties": "massprops", "combine_mass_properties": "massprops",
-    "Body": "bodies", "add_rigid_body": "bodies",
-    "FlexibleBody": "flexible", "add_flexible_body": "flexible",
-    "fe_model": "fem", "ReducedBody": "cms", "interface": "cms", "reduce": "cms",
-    # connectors
-    "Bushing": "connectors", "ContactLaw": "connectors", "GearContact": "connectors",
-    "add_fixed_joint": "connectors", "add_interface_joint": "connectors", "add_speed_drive": "connectors",
-    "add_load_torque": "connectors",
-    "drive_angle": "connectors",
-    "Carrier": "carrier", "add_planet_bearing": "carrier",
-    "GearTrain": "train", "add_gear_train": "train",
+    "HelixHalf": "geometry.pair", "helix_halves": "geometry.pair", "gear_pair_geometry": "geometry.pair",
+    "annulus_mass_properties": "geometry.massprops",
+    "MassProperties": "geometry.massprops", "combine_mass_properties": "geometry.massprops",
+    # FE and reduction
+    "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.cms",
+    # laws
+    "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",
+    # multibody: bodies, elements, contacts
+    "Body": "mbs.bodies", "add_rigid_body": "mbs.bodies",
+    "FlexibleBody": "mbs.flexible", "add_flexible_body": "mbs.flexible",
+    "Bushing": "mbs.elements", "add_fixed_joint": "mbs.elements", "add_interface_joint": "mbs.elements",
+    "add_speed_drive": "mbs.elements", "add_load_torque": "mbs.elements",
+    "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts",
+    "Carrier": "mbs.carrier", "add_planet_bearing": "mbs.carrier",
+    "GearTrain": "mbs.train", "add_gear_train": "mbs.train",
     # signals and solving
-    "Recorder": "recording", "solve": "recording", "solver_settings": "recording",
+    "Recorder": "mbs.recording", "solve": "mbs.recording", "solver_settings": "mbs.recording",
     # the study's gearbox
-    "build_star_gearbox": "model", "mesh_contacts": "model", "run_variant": "simulate",
+    "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox", "run_variant": "mbs.run",
 }
 
 __all__ = [
     "Gear",
+    "GearMesh",
     "GearSetGeometry",
     "GearboxSpec",
     "Mesh",

@@ -14,8 +14,8 @@ __all__ = ["main"]
 
 
 def _cmd_run(a: argparse.Namespace) -> int:
+    from flexgear.mbs.run import run_variant
     from flexgear.results import save_result
-    from flexgear.simulate import run_variant
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)
@@ -29,7 +29,7 @@ def _cmd_run(a: argparse.Namespace) -> int:
 
 
 def _cmd_matrix(a: argparse.Namespace) -> int:
-    from flexgear.matrix import run_matrix
+    from flexgear.study.matrix import run_matrix
 
     table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end,
                        workers=a.workers, scheduler=a.scheduler, progress=True)
@@ -41,7 +41,7 @@ def _cmd_matrix(a: argparse.Namespace) -> int:
 def _cmd_lpm(a: argparse.Namespace) -> int:
     import tomllib
 
-    from flexgear.lumped import run_lumped
+    from flexgear.lumped.run import run_lumped
     from flexgear.results import save_result
     from flexgear.spec import load_gearbox, load_variant
 
@@ -55,8 +55,8 @@ def _cmd_lpm(a: argparse.Namespace) -> int:
 
 
 def _cmd_compare(a: argparse.Namespace) -> int:
-    from flexgear.compare import compare_results
     from flexgear.results import load_result
+    from flexgear.study.compare import compare_results
 
     table6, table7 = compare_results(load_result(a.result_a), load_result(a.result_b))
     print(table6.to_string())
@@ -66,7 +66,7 @@ def _cmd_compare(a: argparse.Namespace) -> int:
 
 
 def _cmd_report(a: argparse.Namespace) -> int:
-    from flexgear.report import build_report
+    from flexgear.report.pages import build_report
 
     path = build_report(Path(a.results), Path(a.output))
     print(f"report -> {path}")
@@ -74,15 +74,15 @@ def _cmd_report(a: argparse.Namespace) -> int:
 
 
 def _cmd_meshes(a: argparse.Namespace) -> int:
-    from flexgear.components import component_reduced_body
-    from flexgear.meshing import build_meshes
-    from flexgear.spec import load_gearbox
+    from flexgear.fe.mesh import build_meshes
+    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.spec import GEOMETRY_COMPONENTS, load_gearbox
 
     spec = load_gearbox(a.gearbox)
     build_meshes(spec, a.level, progress=True)
     if a.no_reduce:
         return 0
-    for component in ("sun", "planet", "ring", "input_shaft", "output_shaft"):
+    for component in GEOMETRY_COMPONENTS:
         body = component_reduced_body(spec, component, a.level, progress=True)
         print(f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
     return 0

@@ -10,15 +10,15 @@ reader never sees a half-written result.
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
-__all__ = ["RunResult", "signal_columns", "save_result", "load_result", "atomic_write_bytes"]
+from flexgear.cache import atomic_write_bytes
+
+__all__ = ["RunResult", "signal_columns", "save_result", "load_result"]
 
 
 def signal_columns(planet_count: int) -> list[str]:
@@ -56,17 +56,6 @@ class RunResult:
         return str(self.meta.get("variant", "?"))
 
 
-def atomic_write_bytes(path: Path, data: bytes) -> None:
-    """Write ``data`` to ``path`` through a temporary file in the same folder and a rename."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "wb") as fh:
-            fh.write(data)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
 
 
 def save_result(result: RunResult, run_dir: str | Path) -> Path:
@@ -90,3 +79,43 @@ def load_result(run_dir: str | Path) -> RunResult:
     signals = pd.read_parquet(signals_path) if signals_path.exists() and meta.get("status") == "ok" else None
     extra = {n: pd.read_parquet(run_dir / f"{n}.parquet") for n in meta.get("extra_tables", [])}
     return RunResult(meta, signals, extra)
+
+
+def package_versions(packages: tuple[str, ...] = ("flexgear", "exudyn", "numpy", "scipy", "numba", "ngsolve",
+                                                  "pandas")) -> dict[str, str]:
+    """Versions of Python and the packages a result depends on."""
+    import platform
+    from importlib import metadata
+
+    out = {"python": platform.python_version()}
+    for pkg in packages:
+        try:
+            out[pkg] = metadata.version(pkg)
+        except metadata.PackageNotFoundError:
+            out[pkg] = "not installed"
+    return out
+
+
+def run_metadata(name: str, backend: str, config_hash: str, t_end_s: float, load_case, planet_count: int,
+                 components: dict[str, str], theory, **extra) -> dict:
+    """The metadata block every backend writes beside its signals (``run.json``).
+
+    ``load_case``: the spec's LoadCase (step and ramp times [s]); ``theory``: flexgear.theory.Theory of the
+    same spec (the study's theoretical values, SI, speeds in deg/s only in the keys that say so).
+    """
+    import datetime as _dt
+
+    return {
+        "variant": name, "backend": backend, "config_hash": config_hash, "components": dict(components),
+        "t_end_s": t_end_s, "step_size_s": load_case.step_size_s, "ramp_time_s": load_case.ramp_time_s,
+        "planet_count": planet_count,
+        "theory": {
+            "input_speed_deg_per_s": theory.input_speed_deg_per_s,
+            "output_speed_deg_per_s": theory.output_speed_deg_per_s,
+            "ratio": theory.ratio, "input_torque_nm": theory.input_torque, "output_torque_nm": theory.output_torque,
+            "mesh_force_n": theory.mesh_force, "mesh_frequency_hz": theory.mesh_frequency,
+        },
+        "versions": package_versions(),
+        "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"),
+        **extra,
+    }

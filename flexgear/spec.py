@@ -41,6 +41,10 @@ __all__ = [
     "GearboxSpec",
     "Variant",
     "COMPONENTS",
+    "GEAR_COMPONENTS",
+    "SHAFT_COMPONENTS",
+    "GEOMETRY_COMPONENTS",
+    "COMPONENT_GEOMETRY",
     "load_gearbox",
     "load_variant",
     "spec_hash",
@@ -48,7 +52,15 @@ __all__ = [
 ]
 
 COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
-"""Component names of Table 3, in its column order."""
+"""Component names of Table 3, in its column order (a variant sets each rigid or flexible)."""
+
+GEAR_COMPONENTS = ("sun", "planet", "ring")
+SHAFT_COMPONENTS = ("input_shaft", "output_shaft")
+GEOMETRY_COMPONENTS = GEAR_COMPONENTS + SHAFT_COMPONENTS
+"""Distinct component geometries (one planet geometry serves every planet)."""
+
+COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"}
+"""Table 3 component (or geometry) name -> its geometry name."""
 
 
 class SpecError(ValueError):
@@ -161,7 +173,7 @@ class ComponentsAssumed:
     output_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
     output_shaft_inner_diameter_mm: float = _num(0.0)
     output_shaft_length_mm: float = _num(0.0, lo_open=True)
-    # geometry details (flexgear.geometry); defaults keep older gearbox files valid
+    # geometry details (flexgear.geometry.layout); defaults keep older gearbox files valid
     relief_groove_depth_mm: float = field(default=1.0, metadata={"lo": 0.0, "doc": "mm beyond the root circle"})
     bearing_seat_width_mm: float = field(default=20.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
 
@@ -278,7 +290,7 @@ class IndicatorWeights:
 class ScreeningSettings:
     """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
 
-    See ``[screening]`` in gearbox.toml and :mod:`flexgear.screening` for each value's meaning.
+    See ``[screening]`` in gearbox.toml and :mod:`flexgear.study.screening` for each value's meaning.
     """
 
     allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
@@ -295,7 +307,7 @@ class ScreeningSettings:
 
 @dataclass(frozen=True)
 class LumpedAssumed:
-    """Lumped-parameter model only (flexgear.lumped, section 2.3): values the study does not give.
+    """Lumped-parameter model only (flexgear.lumped.run, section 2.3): values the study does not give.
 
     See ``[lumped_assumed]`` in gearbox.toml for each value's source.
     """

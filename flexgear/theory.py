@@ -15,32 +15,14 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-import numpy as np
-
-from flexgear.involute import gear_set_geometry
+from flexgear.geometry.involute import gear_set_geometry
 from flexgear.spec import GearboxSpec
 
-__all__ = ["step", "step_integral", "Theory", "theory"]
+__all__ = [ "Theory", "theory"]
 
 
-def step(x: np.ndarray | float, x0: float, h0: float, x1: float, h1: float) -> np.ndarray | float:
-    """ADAMS STEP function: cubic from (x0, h0) to (x1, h1) with zero slope at both ends."""
-    d = np.clip((np.asarray(x, dtype=float) - x0) / (x1 - x0), 0.0, 1.0)
-    out = h0 + (h1 - h0) * d * d * (3.0 - 2.0 * d)
-    return float(out) if np.ndim(out) == 0 else out
 
 
-def step_integral(t: np.ndarray | float, ramp_time: float, final_value: float) -> np.ndarray | float:
-    """Integral over [0, t] of STEP(tau, 0, 0, ramp_time, final_value).
-
-    For t <= T: final_value * T * (d^3 - d^4 / 2), d = t / T; after it grows linearly:
-    final_value * (t - T/2). This is the prescribed input angle for a STEP speed ramp.
-    """
-    tt = np.asarray(t, dtype=float)
-    d = np.clip(tt / ramp_time, 0.0, 1.0)
-    out = np.where(tt <= ramp_time, final_value * ramp_time * (d**3 - 0.5 * d**4),
-                   final_value * (tt - 0.5 * ramp_time))
-    return float(out) if np.ndim(out) == 0 else out
 
 
 @dataclass(frozen=True)

@@ -2,16 +2,16 @@
 
 Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm. Coarse first-order
 meshes (a few hundred nodes, about a second each) with the bore (ring: outer surface) as the RBE3
-interface, named as the gearbox's joints expect (flexgear.components.JOINT_INTERFACES).
+interface, named as the gearbox's joints expect (flexgear.fe.reduced.JOINT_INTERFACES).
 They exercise the flexible-gear machinery; the real components come from
-flexgear.components.component_reduced_body.
+flexgear.fe.reduced.component_reduced_body.
 """
 
 from functools import cache
 
 import numpy as np
 
-from flexgear.involute import gear_set_geometry
+from flexgear.geometry.involute import gear_set_geometry
 
 
 @cache
@@ -19,8 +19,8 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     import ngsolve as ngs
     from netgen.occ import Cylinder, OCCGeometry, Pnt, Z
 
-    from flexgear.cms import interface, reduce
-    from flexgear.fem import fe_model
+    from flexgear.fe.cms import interface, reduce
+    from flexgear.fe.fem import fe_model
 
     solid = Cylinder(Pnt(0, 0, -width / 2), Z, r=r_out, h=width) - Cylinder(Pnt(0, 0, -width / 2), Z, r=r_in, h=width)
     fe = fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), material, 1)
@@ -30,8 +30,8 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
 
 
 def annulus_source(spec, component: str, level: str):
-    """A ``reduced_source`` for flexgear.model.build_star_gearbox."""
-    from flexgear.components import JOINT_INTERFACES
+    """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox."""
+    from flexgear.fe.reduced import JOINT_INTERFACES
 
     geo = gear_set_geometry(spec)
     name = JOINT_INTERFACES.get(component, "bore")

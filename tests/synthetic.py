@@ -93,7 +93,7 @@ def failed_result(name: str, reason: str = "diverged") -> RunResult:
 
 
 def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -> RunResult:
-    """Stand-in for flexgear.simulate.run_variant (picklable, importable by worker processes).
+    """Stand-in for flexgear.mbs.run.run_variant (picklable, importable by worker processes).
 
     More flexible components give a smaller bias and a longer time, as in the study. A variant
     named "boom" raises like a failing solver, "crash" kills its worker process, and "diverge"

@@ -6,8 +6,8 @@ import numpy as np
 import pandas as pd
 import pytest
 
-from flexgear.compare import amplitude_spectrum, compare_results, harmonic_amplitudes
 from flexgear.results import RunResult, signal_columns
+from flexgear.study.compare import amplitude_spectrum, compare_results, harmonic_amplitudes
 
 F_MESH = 4400.0
 DT = 1e-5

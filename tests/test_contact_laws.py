@@ -5,9 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.connectors import ContactLaw, drive_angle, friction_forces, impact_force, periodic_value
-from flexgear.involute import PeriodicSeries
-from flexgear.theory import step, step_integral
+from flexgear.geometry.involute import PeriodicSeries
+from flexgear.laws.contact import ContactLaw, backlash_linear_force, friction_forces, impact_force, periodic_value
+from flexgear.laws.ramps import drive_angle, step, step_integral
 
 LAW = ContactLaw(stiffness=1e8, exponent=1.5, damping_max=1e5, penetration_depth=1e-4)
 
@@ -49,6 +49,22 @@ def test_drive_angle_is_step_integral():
         step(0.3, 0, 0, 0.5, w), rel=1e-6)
 
 
+def test_numba_twins_equal_the_laws():
+    """Each law's compiled (numba) twin gives the numpy law's force over penetration, separation and play."""
+    from flexgear.laws.compiled import backlash_linear_force as linear_nb
+    from flexgear.laws.compiled import impact_normal_force
+
+    for delta in (-2e-4, -1e-5, 0.0, 3e-5, 1e-4, 4e-4):
+        for rate in (-1e-2, 0.0, 2e-3):
+            assert impact_normal_force(delta, rate, 1e8 * 1.03, 1.5, 1e5, 1e-4) == pytest.approx(
+                float(impact_force(delta, rate, LAW, 1.03)), rel=1e-13, abs=1e-12)
+            assert linear_nb(delta, rate, 5e8, 2e3, 5e-5) == pytest.approx(
+                float(backlash_linear_force(delta, rate, 5e8, 2e3, 5e-5)), rel=1e-13, abs=1e-12)
+    # the linear law is two-sided with zero force inside the play (eq. 11-13)
+    assert backlash_linear_force(-2e-5, 1.0, 5e8, 2e3, 5e-5) == 0.0
+    assert backlash_linear_force(-6e-5, 0.0, 5e8, 2e3, 5e-5) == pytest.approx(-5e8 * 1e-5)
+
+
 def test_compiled_forms_match_numpy():
     from exudyn import symbolic as esym
 
@@ -62,7 +78,7 @@ def test_compiled_forms_match_numpy():
 def test_compiled_friction_kernel_equals_reference(model1):
     import exudyn as exu
 
-    from flexgear.model import build_star_gearbox
+    from flexgear.mbs.gearbox import build_star_gearbox
 
     mbs = exu.SystemContainer().AddSystem()
     friction = build_star_gearbox(mbs, model1).friction
@@ -76,8 +92,8 @@ def test_compiled_friction_kernel_equals_reference(model1):
 def test_compiled_stiffness_schedule_equals_reference(model1):
     from exudyn import symbolic as esym
 
-    from flexgear.connectors import StiffnessSchedule
-    from flexgear.model import mesh_contacts
+    from flexgear.mbs.contacts import StiffnessSchedule
+    from flexgear.mbs.gearbox import mesh_contacts
 
     contacts = mesh_contacts(model1.gearbox)
     variables = [esym.Real(f"test_factor_{i}", 1.0) for i in range(len(contacts))]

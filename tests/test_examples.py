@@ -90,8 +90,8 @@ def test_pair_geometry_reproduces_the_gtf_gear_set(gearbox):
 def test_carrier_rotation_leaves_the_mesh_unloaded():
     """A rigid rotation of the whole stage by eps (gears, carrier, planet orbit) does not deflect the mesh,
     to first order whatever the carrier angle the update uses; the rolling motion of the stage neither."""
-    from flexgear.carrier import Carrier, CarrierKinematics
-    from flexgear.massprops import MassProperties
+    from flexgear.geometry.massprops import MassProperties
+    from flexgear.mbs.carrier import Carrier, CarrierKinematics
 
     mesh = fg.gear_pair_geometry(24, 30, 2e-3, math.radians(20), math.radians(20), 0.03)
     ring = fg.gear_pair_geometry(30, 84, 2e-3, math.radians(20), math.radians(20), 0.03, internal=True)

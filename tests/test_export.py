@@ -4,9 +4,9 @@ import numpy as np
 import pytest
 import trimesh
 
-from flexgear.assembly import export_component
-from flexgear.geometry import exact_mass_properties
-from flexgear.meshing import build_meshes
+from flexgear.fe.export import export_component
+from flexgear.fe.mesh import build_meshes
+from flexgear.geometry.layout import exact_mass_properties
 
 
 def test_export_roundtrip_keeps_the_volume(gearbox, tmp_path):

@@ -1,4 +1,4 @@
-"""Flexible bodies (flexgear.fem, flexgear.cms, flexgear.flexible) against independent results.
+"""Flexible bodies (flexgear.fe.fem, flexgear.fe.cms, flexgear.mbs.flexible) against independent results.
 
 Coarse second-order meshes of plain rings and tubes built here with netgen.occ; each test checks
 a number that theory or an independent computation predicts.
@@ -12,9 +12,10 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as sla
 
-from flexgear.cms import _FreeBodySolver, _rbe3_rows, full_free_modes, interface, reduce
-from flexgear.fem import fe_model
-from flexgear.flexible import add_flexible_body, cached_reduced_body
+from flexgear.fe.cms import _FreeBodySolver, _rbe3_rows, full_free_modes, interface, reduce
+from flexgear.fe.fem import fe_model
+from flexgear.fe.reduced import cached_reduced_body
+from flexgear.mbs.flexible import add_flexible_body
 from flexgear.spec import Material
 
 STEEL = Material(density_kg_m3=7850.0, youngs_modulus_pa=2.1e11, poisson_ratio=0.3)

@@ -11,8 +11,8 @@ import pytest
 from conftest import VARIANTS
 from standins import annulus_source
 
-from flexgear.contact_kinematics import modal_contact_coefficients
-from flexgear.simulate import run_variant
+from flexgear.mbs.contact_kinematics import modal_contact_coefficients
+from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 
 
@@ -79,7 +79,7 @@ def test_rigid_and_flexible_twins_carry_identical_mass_properties():
     import exudyn as exu
     from exudyn.rigidBodyUtilities import Inertia6D2InertiaTensor
 
-    from flexgear.model import build_star_gearbox
+    from flexgear.mbs.gearbox import build_star_gearbox
 
     v = load_variant(VARIANTS / "model2.toml")  # flexible planets
     props = {}

@@ -13,9 +13,9 @@ import numpy as np
 import pytest
 
 from flexgear import gear_set_geometry, load_gearbox
-from flexgear.assembly import assembly_check, measure_backlash
-from flexgear.geometry import component_layout, component_mass_properties, exact_mass_properties, gear_profiles
-from flexgear.meshing import component_mesh
+from flexgear.fe.mesh import component_mesh
+from flexgear.geometry.check import assembly_check, measure_backlash
+from flexgear.geometry.layout import component_layout, component_mass_properties, exact_mass_properties, gear_profiles
 
 SPEC = load_gearbox(Path(__file__).resolve().parents[1] / "model_variants" / "gearbox.toml")
 GS = gear_set_geometry(SPEC)
@@ -106,11 +106,11 @@ def test_mesh_tip_and_root_radii(component):
 
 @pytest.mark.parametrize("component", ["sun", "planet", "ring", "input_shaft", "output_shaft"])
 def test_solid_volume_integrals_match_exact_section_integrals(component):
-    """The sewn OCC solid (flexgear.solids) against Green's-theorem section integrals (flexgear.geometry)."""
+    """The sewn OCC solid (geometry.solids) against Green's-theorem section integrals (geometry.layout)."""
     from netgen.occ import OCCGeometry
 
-    from flexgear.meshing import component_brep
-    from flexgear.solids import occ_mass_properties
+    from flexgear.fe.mesh import component_brep
+    from flexgear.geometry.solids import occ_mass_properties
 
     exact = exact_mass_properties(SPEC, component)
     shape = OCCGeometry(str(component_brep(SPEC, component))).shape
@@ -124,7 +124,7 @@ def test_solid_volume_integrals_match_exact_section_integrals(component):
 @pytest.mark.parametrize("component", ["sun", "planet", "ring", "input_shaft", "output_shaft"])
 def test_mesh_mass_properties_match_exact_integrals(component):
     exact = exact_mass_properties(SPEC, component)
-    from flexgear.meshing import mesh_mass_properties
+    from flexgear.fe.mesh import mesh_mass_properties
 
     got = mesh_mass_properties(component_mesh(SPEC, component, "coarse", order=2), SPEC.material_assumed.density_kg_m3)
     assert got.mass == pytest.approx(exact.mass, rel=1e-3)

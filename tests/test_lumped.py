@@ -9,10 +9,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flexgear.involute import gear_set_geometry, mesh_stiffness_harmonics
-from flexgear.lumped import run_lumped, static_mesh_forces
-from flexgear.lumped_model import LumpedParameters, MemberParameters, mesh_friction_tables
-from flexgear.modal import modal_analysis
+from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
+from flexgear.lumped.modal import modal_analysis
+from flexgear.lumped.model import LumpedParameters, MemberParameters, mesh_friction_tables
+from flexgear.lumped.run import run_lumped, static_mesh_forces
 from flexgear.results import signal_columns
 from flexgear.spec import load_gearbox
 from flexgear.theory import theory
@@ -146,7 +146,7 @@ def test_dynamic_run_settles_to_theory(spec, arrangement):
 def test_phasing_cancels_bearing_harmonics(spec):
     """Sequentially phased planets (z_s = 44, N = 5): the sun's bearing sees only harmonics k with
     k z_s mod N = +-1 (1, 4, 6, 9 ...); 2, 3 and 5 cancel (Parker & Lin)."""
-    from flexgear.compare import harmonic_amplitudes
+    from flexgear.study.compare import harmonic_amplitudes
 
     s = short_case(spec, friction=0.02, variation="contact_lines")
     res = run_lumped(s, t_end_s=0.08)

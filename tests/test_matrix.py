@@ -10,8 +10,8 @@ import pandas as pd
 import pytest
 from synthetic import GEARBOX, fake_runner
 
-from flexgear.matrix import run_matrix
 from flexgear.results import load_result
+from flexgear.study.matrix import run_matrix
 
 VARIANTS = Path("model_variants")
 
@@ -106,10 +106,10 @@ def test_dask_local_cluster(variants, tmp_path):
 
 def test_quick_matrix_end_to_end_with_the_exudyn_backend(tmp_path):
     """model1 (rigid) and model2 (flexible planets, coarse mesh) for 0.02 s, through the real runner."""
-    pytest.importorskip("flexgear.simulate")
-    from flexgear.screening import screen_result
+    pytest.importorskip("flexgear.mbs.run")
+    from flexgear.laws.ramps import step
     from flexgear.spec import load_gearbox
-    from flexgear.theory import step
+    from flexgear.study.screening import screen_result
 
     shutil.copy(GEARBOX, tmp_path / "gearbox.toml")
     m1 = tmp_path / "model1.toml"

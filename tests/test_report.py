@@ -11,10 +11,10 @@ import pytest
 from pypdf import PdfReader
 from synthetic import GEARBOX, fake_runner
 
-from flexgear.matrix import run_matrix
-from flexgear.report import build_report, documented_assumptions
+from flexgear.report.pages import build_report, documented_assumptions
 from flexgear.results import save_result
 from flexgear.spec import load_gearbox, load_variant
+from flexgear.study.matrix import run_matrix
 
 
 @pytest.fixture(scope="module")
@@ -33,8 +33,8 @@ def results(tmp_path_factory) -> Path:
     out = root / "results"
     run_matrix([root / "model3.toml", root / "model6.toml", root / "model9.toml"], out, t_end_s=0.6,
                workers=2, progress=False, runner=fake_runner)
-    from flexgear.lumped import run_lumped
-    from flexgear.simulate import run_variant
+    from flexgear.lumped.run import run_lumped
+    from flexgear.mbs.run import run_variant
 
     rigid = dataclasses.replace(load_variant("model_variants/model1.toml"), rigid_mass_properties="exact")
     model1 = run_variant(rigid, t_end_s=0.02)

@@ -9,7 +9,7 @@ import dataclasses
 import numpy as np
 import pytest
 
-from flexgear.simulate import run_variant
+from flexgear.mbs.run import run_variant
 
 RAMP, END, WINDOW = 0.04, 0.25, 0.2
 
@@ -53,7 +53,7 @@ def test_mesh_forces_and_load_sharing(run, steady):
 
 def test_power_balance_with_tooth_friction(run, steady, model1):
     """T_in w_in = T_out |w_out| + P_friction, P_friction = sum mu F lambda_mean |w1 - w2| (no solver involved)."""
-    from flexgear.model import mesh_contacts
+    from flexgear.mbs.gearbox import mesh_contacts
 
     th = run.meta["theory"]
     w_in = np.radians(th["input_speed_deg_per_s"])

@@ -10,7 +10,8 @@ import pandas as pd
 import pytest
 from synthetic import GEARBOX, failed_result, synthetic_result
 
-from flexgear.screening import (
+from flexgear.spec import SpecError, load_gearbox
+from flexgear.study.screening import (
     DecisionLines,
     Window,
     analysis_window,
@@ -20,7 +21,6 @@ from flexgear.screening import (
     select_variant,
     sigma_metric,
 )
-from flexgear.spec import SpecError, load_gearbox
 
 
 @pytest.fixture(scope="module")

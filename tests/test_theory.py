@@ -5,8 +5,9 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.involute import gear_set_geometry, inv, mesh_stiffness_harmonics
-from flexgear.theory import step, step_integral, theory
+from flexgear.geometry.involute import gear_set_geometry, inv, mesh_stiffness_harmonics
+from flexgear.laws.ramps import step, step_integral
+from flexgear.theory import theory
 
 
 def test_step_function_values():

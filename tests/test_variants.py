@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flexgear.simulate import run_variant
+from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 
 QUICK = Path(__file__).resolve().parents[1] / "model_variants" / "quick"

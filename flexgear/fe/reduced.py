@@ -1,0 +1,142 @@
+"""The study's components as reduced flexible bodies: solid -> mesh -> FE model -> Craig-Bampton -> cache.
+
+Interfaces (where a component is connected; RBE3, distributing, by default):
+- sun, planet: the bore (shaft-sun joint, planet bearing seat);
+- ring: "bolt_circle", the walls of the flange's 12 bolt holes (ring-output shaft joint, section 2.1);
+- input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
+- output shaft: "bolt_circle", the bolt-hole walls of its web, and "bearing_seat" (``bearing_seat_width_mm``
+  at the far end of the tube).
+The mesh is the component's cached mesh at the variant's level (flexgear.fe.mesh); the tooth
+compliance itself is in the contact law. Results are cached by a hash of the geometry, the
+mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
+from flexgear.geometry.layout import component_layout, geometry_hash
+from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
+
+__all__ = ["component_interfaces", "component_reduced_body", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
+           "joint_point"]
+
+"""Variant component name -> geometry component name."""
+
+_REDUCTION_VERSION = 3  # 3: shaft-sun seat, bolt circle and bearing seats as interfaces
+_TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
+
+
+def _bolt_hole_nodes(fe, section, z_range: tuple[float, float]) -> np.ndarray:
+    """Nodes on the walls of the bolt holes of ``section`` within ``z_range`` [m]."""
+    z = fe.nodes[:, 2]
+    hit = np.zeros(len(fe.nodes), bool)
+    for k in range(section.holes):
+        a = 2 * np.pi * k / section.holes
+        d = np.hypot(fe.nodes[:, 0] - section.hole_circle_radius * np.cos(a),
+                     fe.nodes[:, 1] - section.hole_circle_radius * np.sin(a))
+        hit |= np.abs(d - section.hole_radius) < _TOL
+    return np.flatnonzero(hit & (z > z_range[0] - _TOL) & (z < z_range[1] + _TOL))
+
+
+def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
+    """Interface node sets of ``component`` (see the module docstring), found on the exact surfaces."""
+    r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
+    z = fe.nodes[:, 2]
+    c = spec.components_assumed
+    if component in ("sun", "planet"):
+        bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
+        return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
+    if component == "ring":
+        flange = [p for p in component_layout(spec, "ring").prisms if p.section.holes][0]
+        return [interface(fe, _bolt_hole_nodes(fe, flange.section, (flange.z0, flange.z1)), "bolt_circle")]
+    tube = [p for p in component_layout(spec, component).prisms if p.name == "tube"][0]
+    seat = c.bearing_seat_width_mm * 1e-3
+    on_tube = np.abs(r - tube.section.outer) < _TOL
+    if component == "input_shaft":
+        sun = component_layout(spec, "sun").prisms
+        z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
+        joint = interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")
+        far = (z < tube.z0 + seat + _TOL)
+    else:
+        web = [p for p in component_layout(spec, component).prisms if p.section.holes][0]
+        joint = interface(fe, _bolt_hole_nodes(fe, web.section, (web.z0, web.z1)), "bolt_circle")
+        far = (z > tube.z1 - seat - _TOL)
+    return [joint, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
+
+
+def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
+    """Point [m] (component frame = gearbox frame) where ``gear`` ("sun" or "ring") is joined to its shaft.
+
+    Sun-input shaft: on the axis, mid-way along the sun. Ring-output shaft: on the axis, in the plane
+    where the ring's flange meets the shaft's web.
+    """
+    prisms = component_layout(spec, gear).prisms
+    if gear == "sun":
+        return np.array([0.0, 0.0, 0.5 * (min(p.z0 for p in prisms) + max(p.z1 for p in prisms))])
+    if gear == "ring":
+        return np.array([0.0, 0.0, [p for p in prisms if p.section.holes][0].z1])
+    raise ValueError(f"joint_point: gear must be 'sun' or 'ring', got {gear!r}")
+
+
+JOINT_INTERFACES = {"sun": "bore", "input_shaft": "sun_seat", "ring": "bolt_circle", "output_shaft": "bolt_circle"}
+"""Interface of each component in the fixed joints of section 2.1 (input shaft-sun, ring-output shaft)."""
+
+
+def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",
+                           progress: bool = False) -> ReducedBody:
+    """The reduced flexible body of a component (cached): ``component`` as in Table 3 or the geometry."""
+    from flexgear.fe.reduced import cached_reduced_body
+
+    name = COMPONENT_GEOMETRY[component]
+    mesh_settings = spec.meshing_assumed[level]
+    red = spec.reduction_assumed
+    key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
+                        red.simulation_modes, _REDUCTION_VERSION)
+
+    def build() -> ReducedBody:
+        from flexgear.fe.fem import fe_model
+        from flexgear.fe.mesh import component_mesh
+
+        if progress:
+            print(f"[flexgear] building reduced body of {name} ({level} mesh) ...", flush=True)
+        # first-order mesh topology; fe_model raises the order itself (a second-order Netgen mesh loaded
+        # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
+        mesh = component_mesh(spec, name, level, order=1, progress=progress)
+        fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
+        return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
+                      n_compare=0, keep_modes=red.simulation_modes)
+
+    return cached_reduced_body(f"{name}-{level}-{key}", build)
+
+
+CACHE_FORMAT_VERSION = 1  # bump when ReducedBody's content or the reduction changes
+
+
+def reduced_cache_path(key: str, directory: str | Path | None = None) -> Path:
+    """``<directory or $FLEXGEAR_CACHE_DIR or meshes/>/reduced-<key>.npz``."""
+    return Path(cache_dir() if directory is None else directory) / f"reduced-v{CACHE_FORMAT_VERSION}-{key}.npz"
+
+
+def cached_reduced_body(key: str, build: Callable[[], ReducedBody],
+                        directory: str | Path | None = None) -> ReducedBody:
+    """Load the reduced body cached under ``key``, or ``build()`` it and store it atomically.
+
+    ``key`` must be a hash of every input (flexgear.spec.spec_hash of geometry, mesh and reduction
+    settings): a changed input gives a new key and a rebuild; an unreadable file is rebuilt.
+    """
+    path = reduced_cache_path(key, directory)
+    if path.exists():
+        try:
+            return ReducedBody.load(path.read_bytes())
+        except (OSError, ValueError, KeyError):
+            pass  # damaged entry: rebuild and overwrite
+    body = build()
+    path.parent.mkdir(parents=True, exist_ok=True)
+    atomic_write_bytes(path, body.save())
+    return body

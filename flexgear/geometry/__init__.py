@@ -1,0 +1,1 @@
+"""Geometry: involute gear sets, tooth profiles, component layout, solids, mass properties, checks."""

@@ -1,0 +1,388 @@
+"""Involute helical gear relations (ISO 21771 conventions), in SI units.
+
+Internal gears follow the signed convention of ISO 21771: an internal gear has a negative
+tooth count in the mesh equations, and a positive profile-shift coefficient thickens its
+teeth on the reference circle, exactly as for an external gear. Functions take and return
+positive radii and tooth counts; the sign appears only inside the mesh relations.
+
+Equations (ISO 21771:2007 / Niemann-Winter):
+- transverse pressure angle  tan(alpha_t) = tan(alpha_n) / cos(beta)
+- base helix angle           sin(beta_b) = sin(beta) cos(alpha_n)
+- base radius                r_b = m_n z cos(alpha_t) / (2 cos beta)
+- no-backlash mesh           inv(alpha_wt) = inv(alpha_t) + 2 tan(alpha_n) (x1 + x2) / (z1 + z2)
+- centre distance            a_w = a_0 cos(alpha_t) / cos(alpha_wt),  a_0 = m_n (z1 + z2) / (2 cos beta)
+- tooth thickness (normal)   s_n = m_n (pi/2 + 2 x tan(alpha_n)) - thinning
+- transverse contact ratio   eps_alpha = (g_a1 + g_a2 -/+ a_w sin(alpha_wt)) / p_bt
+- overlap ratio              eps_beta = b sin(beta) / (pi m_n)
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.optimize import brentq
+
+from flexgear.spec import GearboxSpec
+
+__all__ = [
+    "inv",
+    "inv_inverse",
+    "transverse_pressure_angle",
+    "base_helix_angle",
+    "Gear",
+    "GearMesh",
+    "Mesh",
+    "GearSetGeometry",
+    "solve_profile_shifts",
+    "gear_set_geometry",
+    "mesh_stiffness_harmonics",
+    "PeriodicSeries",
+    "contact_line_distribution",
+    "contact_line_series",
+]
+
+
+def inv(alpha: float) -> float:
+    """Involute function inv(alpha) = tan(alpha) - alpha (alpha in rad)."""
+    return math.tan(alpha) - alpha
+
+
+def inv_inverse(value: float) -> float:
+    """The angle alpha in (0, pi/2) with inv(alpha) = value (value >= 0)."""
+    if value < 0.0:
+        raise ValueError(f"inv_inverse needs a value >= 0, got {value}")
+    if value == 0.0:
+        return 0.0
+    return brentq(lambda a: inv(a) - value, 1e-9, math.pi / 2 - 1e-9, xtol=1e-15, rtol=1e-15)
+
+
+def transverse_pressure_angle(normal_pressure_angle: float, helix_angle: float) -> float:
+    """alpha_t = atan(tan(alpha_n) / cos(beta)) [rad]."""
+    return math.atan(math.tan(normal_pressure_angle) / math.cos(helix_angle))
+
+
+def base_helix_angle(normal_pressure_angle: float, helix_angle: float) -> float:
+    """beta_b = asin(sin(beta) cos(alpha_n)) [rad]."""
+    return math.asin(math.sin(helix_angle) * math.cos(normal_pressure_angle))
+
+
+@dataclass(frozen=True)
+class Gear:
+    """One involute helical gear (radii in m, angles in rad)."""
+
+    teeth: int
+    internal: bool
+    normal_module: float
+    helix_angle: float
+    normal_pressure_angle: float
+    shift: float
+    thinning: float  # normal tooth-thickness reduction on the reference circle [m]
+    addendum_coefficient: float
+    dedendum_coefficient: float
+    face_width: float
+
+    @property
+    def signed_teeth(self) -> int:
+        return -self.teeth if self.internal else self.teeth
+
+    @property
+    def transverse_module(self) -> float:
+        return self.normal_module / math.cos(self.helix_angle)
+
+    @property
+    def transverse_pressure_angle(self) -> float:
+        return transverse_pressure_angle(self.normal_pressure_angle, self.helix_angle)
+
+    @property
+    def base_helix_angle(self) -> float:
+        return base_helix_angle(self.normal_pressure_angle, self.helix_angle)
+
+    @property
+    def reference_radius(self) -> float:
+        return 0.5 * self.teeth * self.transverse_module
+
+    @property
+    def base_radius(self) -> float:
+        return self.reference_radius * math.cos(self.transverse_pressure_angle)
+
+    @property
+    def tip_radius(self) -> float:
+        """Tip radius; for the internal gear the (inner) radius of its tooth tips."""
+        h = self.normal_module * (self.addendum_coefficient + self.shift)
+        return self.reference_radius - h if self.internal else self.reference_radius + h
+
+    @property
+    def root_radius(self) -> float:
+        """Root radius; for the internal gear the (outer) radius of its tooth spaces."""
+        h = self.normal_module * (self.dedendum_coefficient - self.shift)
+        return self.reference_radius + h if self.internal else self.reference_radius - h
+
+    @property
+    def normal_tooth_thickness(self) -> float:
+        """Normal tooth thickness (arc) on the reference circle [m]."""
+        mn, an = self.normal_module, self.normal_pressure_angle
+        return mn * (math.pi / 2 + 2 * self.shift * math.tan(an)) - self.thinning
+
+    @property
+    def transverse_tooth_thickness(self) -> float:
+        """Transverse tooth thickness (arc) on the reference circle [m]."""
+        return self.normal_tooth_thickness / math.cos(self.helix_angle)
+
+    @property
+    def base_pitch(self) -> float:
+        """Transverse base pitch p_bt = pi m_t cos(alpha_t) [m]."""
+        return math.pi * self.transverse_module * math.cos(self.transverse_pressure_angle)
+
+    @property
+    def lead(self) -> float:
+        """Axial length of one helix turn, 2 pi r / tan(beta) [m] (inf for spur gears)."""
+        t = math.tan(self.helix_angle)
+        return math.inf if t == 0 else 2 * math.pi * self.reference_radius / t
+
+    def tooth_half_angle(self, radius: float) -> float:
+        """Half the angular tooth thickness at ``radius`` in the transverse plane [rad].
+
+        psi(r) = s_t / (2 r_ref) + inv(alpha_t) - inv(alpha_r), cos(alpha_r) = r_b / r.
+        For the internal gear the angle is that of its tooth (material), which grows outward.
+        """
+        alpha_r = math.acos(min(1.0, self.base_radius / radius))
+        half_ref = self.transverse_tooth_thickness / (2 * self.reference_radius)
+        sign = -1.0 if self.internal else 1.0
+        return half_ref + sign * (inv(self.transverse_pressure_angle) - inv(alpha_r))
+
+
+@dataclass(frozen=True)
+class GearMesh:
+    """A gear pair at its operating centre distance (gear1 external, gear2 external or internal)."""
+
+    gear1: Gear
+    gear2: Gear
+    centre_distance: float
+    operating_pressure_angle: float  # transverse, rad
+
+    @property
+    def internal(self) -> bool:
+        return self.gear2.internal
+
+    @property
+    def base_pitch(self) -> float:
+        return self.gear1.base_pitch
+
+    @property
+    def transverse_contact_ratio(self) -> float:
+        """eps_alpha from the tip radii, base radii and operating centre distance."""
+        g1, g2 = self.gear1, self.gear2
+        ga1 = math.sqrt(g1.tip_radius**2 - g1.base_radius**2)
+        ga2 = math.sqrt(g2.tip_radius**2 - g2.base_radius**2)
+        gw = self.centre_distance * math.sin(self.operating_pressure_angle)
+        length = ga1 - ga2 + gw if self.internal else ga1 + ga2 - gw
+        return length / self.base_pitch
+
+    def overlap_ratio(self, face_width: float) -> float:
+        """eps_beta = b sin(beta) / (pi m_n) for the face width b [m] of one helix."""
+        return face_width * math.sin(self.gear1.helix_angle) / (math.pi * self.gear1.normal_module)
+
+    @property
+    def approach_length(self) -> float:
+        """Distance [m] along the line of action from the start of contact A to the pitch point C.
+
+        Gear 1 drives, so contact starts on the driven gear's tip circle:
+        external: g_f = sqrt(r_a2^2 - r_b2^2) - r_w2 sin(a_w); internal: g_f = r_w2 sin(a_w) - sqrt(r_a2^2 - r_b2^2).
+        """
+        g2, aw = self.gear2, self.operating_pressure_angle
+        tip = math.sqrt(g2.tip_radius**2 - g2.base_radius**2)
+        pitch = g2.base_radius * math.tan(aw)  # r_w2 sin(a_w) = r_b2 tan(a_w)
+        return pitch - tip if self.internal else tip - pitch
+
+    @property
+    def normal_backlash(self) -> float:
+        """Normal backlash from the tooth thinning of both gears, j_n = (ds1 + ds2) cos(alpha_n) [m].
+
+        The no-backlash centre distance equation places the unthinned flanks in contact, so the
+        thinning alone opens the backlash.
+        """
+        return (self.gear1.thinning + self.gear2.thinning) * math.cos(self.gear1.normal_pressure_angle)
+
+
+Mesh = GearMesh
+"""Deprecated alias of :class:`GearMesh` (kept for one release; 'mesh' alone also means an FE mesh)."""
+
+
+@dataclass(frozen=True)
+class GearSetGeometry:
+    """Sun, planet, ring and the two meshes of a single-stage planetary/star set."""
+
+    sun: Gear
+    planet: Gear
+    ring: Gear
+    sun_planet: GearMesh
+    planet_ring: GearMesh
+    centre_distance: float
+    planet_count: int
+    helix_layout: str
+    half_gap: float
+
+    @property
+    def helix_face_width(self) -> float:
+        """Face width of one helix: half the total for a double-helical set [m]."""
+        total = self.sun.face_width
+        return total / 2 if self.helix_layout == "double" else total
+
+    @property
+    def planet_angles(self) -> np.ndarray:
+        """Angular positions of the (equally spaced) planets [rad]."""
+        return 2 * math.pi * np.arange(self.planet_count) / self.planet_count
+
+
+def _mesh_angle(z1: int, z2: int, x1: float, x2: float, alpha_n: float, alpha_t: float) -> float:
+    """Operating transverse pressure angle of the no-backlash mesh (signed tooth counts)."""
+    return inv_inverse(inv(alpha_t) + 2 * math.tan(alpha_n) * (x1 + x2) / (z1 + z2))
+
+
+def solve_profile_shifts(
+    z_sun: int, z_planet: int, z_ring: int, normal_module: float, helix_angle: float,
+    normal_pressure_angle: float, centre_distance: float, planet_shift: float,
+) -> tuple[float, float, float, float, float]:
+    """Profile shifts giving one operating centre distance for both meshes.
+
+    With the planet shift chosen, the no-backlash mesh equation fixes the sun shift from the
+    sun-planet operating pressure angle and the ring shift from the planet-ring one.
+
+    Returns ``(x_sun, x_planet, x_ring, alpha_wt_sun_planet, alpha_wt_planet_ring)``.
+    """
+    alpha_t = transverse_pressure_angle(normal_pressure_angle, helix_angle)
+    mt = normal_module / math.cos(helix_angle)
+    tan_an = math.tan(normal_pressure_angle)
+    shifts = []
+    angles = []
+    for z_other in (z_sun, -z_ring):
+        a0 = abs(mt * (z_planet + z_other) / 2)
+        cos_w = a0 * math.cos(alpha_t) / centre_distance
+        if not 0.0 < cos_w < 1.0:
+            raise ValueError(f"centre distance {centre_distance} m cannot be reached (a0 = {a0} m)")
+        alpha_w = math.acos(cos_w)
+        x_sum = (inv(alpha_w) - inv(alpha_t)) * (z_planet + z_other) / (2 * tan_an)
+        shifts.append(x_sum - planet_shift)
+        angles.append(alpha_w)
+    return shifts[0], planet_shift, shifts[1], angles[0], angles[1]
+
+
+def gear_set_geometry(spec: GearboxSpec) -> GearSetGeometry:
+    """Gears and meshes of the spec, profile-shifted to one operating centre distance.
+
+    Computed once per distinct (gears, gears_assumed) content and shared by every stage that asks
+    (geometry, FE, contacts, theory, lumped model): both are frozen dataclasses, so the cache key is
+    their content.
+    """
+    return _gear_set_geometry(spec.gears, spec.gears_assumed)
+
+
+@functools.lru_cache(maxsize=64)
+def _gear_set_geometry(g, a) -> GearSetGeometry:
+    mn, beta, an = g.normal_module_m, g.helix_angle_rad, g.normal_pressure_angle_rad
+    aw = a.operating_centre_distance_m
+    if aw == 0.0:  # 0 selects the mean of the two standard centre distances
+        mt = mn / math.cos(beta)
+        aw = 0.25 * mt * (g.sun_teeth + g.ring_teeth)
+    xs, xp, xr, aw_sp, aw_pr = solve_profile_shifts(
+        g.sun_teeth, g.planet_teeth, g.ring_teeth, mn, beta, an, aw, a.planet_shift_coefficient
+    )
+    thinning = a.normal_backlash_m / (2 * math.cos(an))
+
+    def gear(z: int, x: float, internal: bool) -> Gear:
+        return Gear(z, internal, mn, beta, an, x, thinning, a.addendum_coefficient,
+                    a.dedendum_coefficient, a.face_width_m)
+
+    sun, planet, ring = gear(g.sun_teeth, xs, False), gear(g.planet_teeth, xp, False), gear(g.ring_teeth, xr, True)
+    return GearSetGeometry(
+        sun, planet, ring, GearMesh(sun, planet, aw, aw_sp), GearMesh(planet, ring, aw, aw_pr),
+        aw, g.planet_count, a.helix_layout, a.half_gap_m,
+    )
+
+
+def mesh_stiffness_harmonics(eps_alpha: float, eps_beta: float, harmonics: int) -> np.ndarray:
+    """Fourier coefficients of the normalised mesh stiffness k(phi)/k_mean (eq. 11-12).
+
+    The mesh stiffness is taken proportional to the total length of the contact lines in the
+    field of action (Maatar & Velex). One contact line's length, as the mesh advances, is the
+    convolution of two boxes of widths eps_alpha and eps_beta (in base pitches); summed over all
+    teeth it is periodic in the mesh phase phi (in mesh cycles) with
+
+        k(phi)/k_mean = 1 + sum_n c_n cos(2 pi n (phi - (eps_alpha + eps_beta)/2)),
+        c_n = 2 sinc(n eps_alpha) sinc(n eps_beta),   sinc(u) = sin(pi u)/(pi u).
+
+    Returns ``c`` of shape (harmonics,) for n = 1..harmonics.
+    """
+    n = np.arange(1, harmonics + 1)
+    return 2 * np.sinc(n * eps_alpha) * np.sinc(n * eps_beta)
+
+
+@dataclass(frozen=True)
+class PeriodicSeries:
+    """f(phi) = mean + sum_n (cos_coeffs[n-1] cos(2 pi n phi) + sin_coeffs[n-1] sin(2 pi n phi)), phi in cycles."""
+
+    mean: float
+    cos_coeffs: np.ndarray
+    sin_coeffs: np.ndarray
+
+    def __call__(self, phi: np.ndarray | float) -> np.ndarray:
+        phi = np.asarray(phi, dtype=float)
+        out = np.full_like(phi, self.mean)
+        for n, (a, b) in enumerate(zip(self.cos_coeffs, self.sin_coeffs, strict=True), start=1):
+            out = out + a * np.cos(2 * np.pi * n * phi) + b * np.sin(2 * np.pi * n * phi)
+        return out
+
+    @classmethod
+    def fit(cls, samples: np.ndarray, harmonics: int) -> PeriodicSeries:
+        """Truncated Fourier series of samples taken at phi = k / len(samples)."""
+        spec = np.fft.rfft(samples) / len(samples)
+        return cls(float(spec[0].real), 2 * spec[1:harmonics + 1].real, -2 * spec[1:harmonics + 1].imag)
+
+
+def contact_line_distribution(eps_alpha: float, eps_beta: float, pitch_position: float, phases: np.ndarray,
+                              face_samples: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Contact lines in the field of action of a helical mesh as the mesh phase advances.
+
+    The field of action is x in [0, eps_alpha] base pitches along the line of action (x = 0 at the
+    start of contact, the pitch point at ``pitch_position``) by y in [0, 1] of the face width; the
+    contact line of tooth k lies on x = phi + k - eps_beta y. For every phase phi (cycles) returns
+
+    - length(phi): total contact-line length in units of one straight line across the face,
+    - kappa(phi) = integral of sign(s) dL / L: net direction of sliding (s = x - pitch_position),
+    - lever(phi) = integral of |s| dL / L: mean distance of the load from the pitch point [base pitches],
+
+    with the load taken uniform along the contact lines (as the stiffness model assumes).
+    """
+    y = (np.arange(face_samples) + 0.5) / face_samples
+    phases = np.asarray(phases, dtype=float)
+    length = np.zeros_like(phases)
+    signed = np.zeros_like(phases)
+    lever = np.zeros_like(phases)
+    for k in range(-int(eps_beta) - 2, int(eps_alpha) + 3):
+        x = phases[:, None] + k - eps_beta * y[None, :]
+        inside = (x >= 0.0) & (x <= eps_alpha)
+        s = x - pitch_position
+        length += inside.mean(axis=1)
+        signed += (inside * np.sign(s)).mean(axis=1)
+        lever += (inside * np.abs(s)).mean(axis=1)
+    return length, signed / length, lever / length
+
+
+def contact_line_series(mesh: GearMesh, face_width: float, harmonics: int, samples: int = 512
+                        ) -> tuple[PeriodicSeries, PeriodicSeries, PeriodicSeries]:
+    """Fourier series (in the mesh phase) of the normalised stiffness, the sliding direction and the lever.
+
+    The stiffness series is the analytic one of :func:`mesh_stiffness_harmonics` (eq. 11-12); the
+    friction series (kappa, lever [m]) are fitted to :func:`contact_line_distribution`.
+    """
+    eps_a, eps_b = mesh.transverse_contact_ratio, mesh.overlap_ratio(face_width)
+    c = mesh_stiffness_harmonics(eps_a, eps_b, harmonics)
+    n = np.arange(1, harmonics + 1)
+    centre = 0.5 * (eps_a + eps_b)
+    stiffness = PeriodicSeries(1.0, c * np.cos(2 * np.pi * n * centre), c * np.sin(2 * np.pi * n * centre))
+    phases = np.arange(samples) / samples
+    _, kappa, lever = contact_line_distribution(eps_a, eps_b, mesh.approach_length / mesh.base_pitch, phases)
+    return stiffness, PeriodicSeries.fit(kappa, harmonics), PeriodicSeries.fit(lever * mesh.base_pitch, harmonics)

@@ -1,0 +1,263 @@
+"""Component geometry as axial stacks of (helically twisted) prisms, and their exact mass properties.
+
+Every component is a union of non-overlapping prisms: a transverse section (annulus, external
+gear with bore, internal gear in a rim, annulus with bolt holes) extruded from z0 to z1 and, for
+helical teeth, rotated about the axis at the rate dtheta/dz = hand * tan(beta) / r (lead
+2 pi r / tan beta). The same layout drives the solid modeller (flexgear.geometry.solids) and the exact
+integrals here.
+
+Component frames (z = rotation axis, SI units):
+
+- sun, planet, ring: origin at the gear's axial mid-plane centre. Double-helical (default): the
+  two halves of opposite hand, each half the face width, occupy |z| in [g/2, g/2 + b/2] with the
+  relief groove (gap g, ``relief_groove_depth_mm`` beyond the root circle) between them.
+  Single-helical: one helix over |z| <= b/2. Hands: sun +, planet -, ring - (external pairs have
+  opposite hands, an internal pair the same hand).
+- ring: rim of ``ring_rim_thickness_mm`` below the tooth root; the bolt flange is a collar axially
+  beyond the teeth at the +z end (so the output shaft's web clears the planets), from the groove
+  radius to the flange diameter, with the bolt holes on the circle midway between rim and flange
+  outer radius.
+- input_shaft: origin at the sun's centre; a tube through the sun bore from the sun's +z face
+  along -z for its length; bearing seat at the far (-z) end.
+- output_shaft: origin at the ring's centre; a web of the flange thickness bolted to the ring
+  flange (same bolt holes), then the tube along +z for its length measured from the ring flange
+  face; bearing seat at the far (+z) end.
+
+Mass properties: a section with n >= 3-fold symmetry has its centroid on the axis and equal
+in-plane second moments J/2, and rotating it does not change either, so for a prism
+
+    m = rho A L,  I_zz = rho J L,  I_xx = I_yy = rho (J L / 2 + A (z1^3 - z0^3) / 3)  (about the origin)
+
+exactly, with A and J of the section from Green's theorem on the exact tooth curves
+(flexgear.geometry.profile). Results are cached as JSON under ``meshes/`` keyed by a hash of every input.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+
+from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.geometry.involute import Gear, GearSetGeometry, gear_set_geometry
+from flexgear.geometry.massprops import MassProperties
+from flexgear.geometry.profile import ToothProfile, tooth_profile
+from flexgear.spec import GEAR_COMPONENTS, GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
+
+__all__ = [
+    "Section",
+    "Prism",
+    "ComponentLayout",
+    "gear_profiles",
+    "component_layout",
+    "section_integrals",
+    "exact_mass_properties",
+    "component_mass_properties",
+    "geometry_hash",
+]
+
+_HANDS = {"sun": 1.0, "planet": -1.0, "ring": -1.0}
+_GEOMETRY_VERSION = 2  # bump when the construction changes: invalidates every cache entry
+
+
+
+
+def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
+    """Hash of every spec table the geometry depends on, the construction version and ``extra``."""
+    return spec_hash(spec.gears, spec.gears_assumed, spec.components_assumed, spec.material_assumed,
+                     _GEOMETRY_VERSION, *extra)
+
+
+@dataclass(frozen=True)
+class Section:
+    """Transverse section with n-fold symmetry about the axis (radii in m).
+
+    ``gear`` None: annulus inner..outer; "sun"/"planet": external toothed outline with a bore of
+    radius ``inner``; "ring": rim of radius ``outer`` with the internal toothed outline inside.
+    ``holes`` circular holes of radius ``hole_radius`` equally spaced on ``hole_circle_radius``.
+    """
+
+    inner: float
+    outer: float
+    gear: str | None = None
+    holes: int = 0
+    hole_radius: float = 0.0
+    hole_circle_radius: float = 0.0
+
+    def hole_centres(self) -> np.ndarray:
+        """(holes, 2) centres of the bolt holes [m]: hole k at polar angle 2 pi k / holes."""
+        a = 2 * np.pi * np.arange(self.holes) / max(self.holes, 1)
+        return self.hole_circle_radius * np.column_stack([np.cos(a), np.sin(a)])
+
+
+@dataclass(frozen=True)
+class Prism:
+    """Section extruded from z0 to z1 [m], rotated by ``twist`` [rad/m] * z (helical teeth)."""
+
+    name: str
+    z0: float
+    z1: float
+    section: Section
+    twist: float = 0.0
+
+    @property
+    def length(self) -> float:
+        return self.z1 - self.z0
+
+
+@dataclass(frozen=True)
+class ComponentLayout:
+    """A component as a union of non-overlapping prisms, plus the radii its regions refer to."""
+
+    name: str
+    prisms: tuple[Prism, ...]
+    gear: Gear | None = None
+    profile: ToothProfile | None = None
+
+    @property
+    def z_range(self) -> tuple[float, float]:
+        return min(p.z0 for p in self.prisms), max(p.z1 for p in self.prisms)
+
+    @property
+    def outer_radius(self) -> float:
+        return max(p.section.outer if p.section.gear is None or p.section.gear == "ring"
+                   else self.gear.tip_radius for p in self.prisms)
+
+
+@lru_cache(maxsize=16)
+def _profiles_cached(gs: GearSetGeometry, fillet_coefficient: float) -> dict[str, ToothProfile]:
+    return {name: tooth_profile(getattr(gs, name), fillet_coefficient * getattr(gs, name).normal_module)
+            for name in GEAR_COMPONENTS}
+
+
+def gear_profiles(spec: GearboxSpec) -> dict[str, ToothProfile]:
+    """Tooth profiles of sun, planet and ring (root fillet radius = root_fillet_coefficient * m_n)."""
+    return _profiles_cached(gear_set_geometry(spec), spec.gears_assumed.root_fillet_coefficient)
+
+
+def _gear_half_length(spec: GearboxSpec) -> float:
+    a = spec.gears_assumed
+    return a.face_width_m / 2 + (a.half_gap_m / 2 if a.helix_layout == "double" else 0.0)
+
+
+def _gear_prisms(spec: GearboxSpec, name: str, gear: Gear, inner: float, outer: float) -> list[Prism]:
+    """Toothed prisms (one or two helices) and, for a double helix, the grooved gap between them."""
+    a = spec.gears_assumed
+    twist = _HANDS[name] * math.tan(gear.helix_angle) / gear.reference_radius
+    section = Section(inner, outer, name)
+    if a.helix_layout == "single":
+        return [Prism("teeth", -a.face_width_m / 2, a.face_width_m / 2, section, twist)]
+    g, b = a.half_gap_m, a.face_width_m / 2
+    depth = spec.components_assumed.relief_groove_depth_mm * 1e-3
+    groove = Section(inner, gear.root_radius - depth) if not gear.internal else Section(gear.root_radius + depth, outer)
+    prisms = [Prism("teeth_lower", -g / 2 - b, -g / 2, section, -twist)]
+    if g > 0:
+        prisms.append(Prism("groove", -g / 2, g / 2, groove))
+    prisms.append(Prism("teeth_upper", g / 2, g / 2 + b, section, twist))
+    return prisms
+
+
+def component_layout(spec: GearboxSpec, component: str) -> ComponentLayout:
+    """The prisms of ``component`` (one of GEOMETRY_COMPONENTS) in its component frame."""
+    if component not in GEOMETRY_COMPONENTS:
+        raise ValueError(f"unknown component {component!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
+    gs, c = gear_set_geometry(spec), spec.components_assumed
+    profiles = gear_profiles(spec)
+    mm = 1e-3
+    h = _gear_half_length(spec)
+    if component in ("sun", "planet"):
+        gear = getattr(gs, component)
+        bore = getattr(c, f"{component}_bore_diameter_mm") * mm / 2
+        if bore >= gear.root_radius - c.relief_groove_depth_mm * mm:
+            raise ValueError(f"{component} bore diameter {2 * bore} m does not fit inside the root/groove circle")
+        return ComponentLayout(component, tuple(_gear_prisms(spec, component, gear, bore, 0.0)), gear,
+                               profiles[component])
+    ring = gs.ring
+    rim = ring.root_radius + c.ring_rim_thickness_mm * mm
+    flange_out = c.ring_flange_outer_diameter_mm * mm / 2
+    flange_in = ring.root_radius + c.relief_groove_depth_mm * mm
+    tf = c.ring_flange_thickness_mm * mm
+    holes = dict(holes=c.ring_bolt_count, hole_radius=c.ring_bolt_hole_diameter_mm * mm / 2,
+                 hole_circle_radius=(rim + flange_out) / 2)
+    if flange_out - rim < 2 * holes["hole_radius"]:
+        raise ValueError("ring_flange_outer_diameter_mm leaves no room for the bolt holes outside the rim")
+    if component == "ring":
+        prisms = _gear_prisms(spec, "ring", ring, 0.0, rim)
+        prisms.append(Prism("flange", h, h + tf, Section(flange_in, flange_out, **holes)))
+        return ComponentLayout("ring", tuple(prisms), ring, profiles["ring"])
+    if component == "input_shaft":
+        ri, ro = c.input_shaft_inner_diameter_mm * mm / 2, c.input_shaft_outer_diameter_mm * mm / 2
+        if ri >= ro:
+            raise ValueError("input_shaft_inner_diameter_mm must be smaller than the outer diameter")
+        return ComponentLayout(component, (Prism("tube", h - c.input_shaft_length_mm * mm, h, Section(ri, ro)),))
+    ri, ro = c.output_shaft_inner_diameter_mm * mm / 2, c.output_shaft_outer_diameter_mm * mm / 2
+    length = c.output_shaft_length_mm * mm
+    if ri >= ro or length <= tf:
+        raise ValueError("output shaft: need inner < outer diameter and length > ring_flange_thickness_mm")
+    return ComponentLayout(component, (
+        Prism("web", h + tf, h + 2 * tf, Section(ri, flange_out, **holes)),
+        Prism("tube", h + 2 * tf, h + tf + length, Section(ri, ro)),
+    ))
+
+
+def section_integrals(section: Section, profiles: dict[str, ToothProfile] | None = None) -> tuple[float, float]:
+    """Area A [m^2] and polar second moment J = int r^2 dA [m^4] of a section about the axis."""
+    def disc(r: float) -> tuple[float, float]:
+        return math.pi * r**2, math.pi * r**4 / 2
+
+    if section.gear is None:
+        a_out, j_out = disc(section.outer)
+        a_in, j_in = disc(section.inner)
+    elif section.gear == "ring":
+        a_out, j_out = disc(section.outer)
+        a_in, j_in = profiles["ring"].outline_integrals
+    else:
+        a_out, j_out = profiles[section.gear].outline_integrals
+        a_in, j_in = disc(section.inner)
+    area, polar = a_out - a_in, j_out - j_in
+    if section.holes:
+        a_h, j_h = disc(section.hole_radius)
+        area -= section.holes * a_h
+        polar -= section.holes * (j_h + a_h * section.hole_circle_radius**2)
+    return area, polar
+
+
+def exact_mass_properties(spec: GearboxSpec, component: str) -> MassProperties:
+    """Mass properties of ``component`` from the exact section integrals (no cache)."""
+    layout = component_layout(spec, component)
+    rho = spec.material_assumed.density_kg_m3
+    profiles = gear_profiles(spec)
+    mass = first = i_zz = i_xx = 0.0
+    for p in layout.prisms:
+        area, polar = section_integrals(p.section, profiles)
+        mass += rho * area * p.length
+        first += rho * area * (p.z1**2 - p.z0**2) / 2
+        i_zz += rho * polar * p.length
+        i_xx += rho * (polar * p.length / 2 + area * (p.z1**3 - p.z0**3) / 3)
+    zc = first / mass
+    inertia = np.diag([i_xx - mass * zc**2, i_xx - mass * zc**2, i_zz])
+    return MassProperties(mass, np.array([0.0, 0.0, zc]), inertia)
+
+
+def component_mass_properties(spec: GearboxSpec, component: str) -> MassProperties:
+    """Mass [kg], centre of mass [m] and inertia about it [kg m^2] of ``component`` (cached).
+
+    ``component``: "sun", "planet", "ring", "input_shaft" or "output_shaft"; frames as in the
+    module docstring. The JSON cache ``meshes/massprops-<hash>.json`` is keyed by every input.
+    """
+    path = cache_dir() / f"massprops-{component}-{geometry_hash(spec, component)}.json"
+    if path.exists():
+        try:
+            d = json.loads(path.read_text())
+            return MassProperties(float(d["mass_kg"]), np.array(d["com_m"], float),
+                                  np.array(d["inertia_kg_m2"], float))
+        except (ValueError, KeyError):
+            pass  # unreadable entry: recompute and overwrite
+    props = exact_mass_properties(spec, component)
+    payload = {"component": component, "mass_kg": props.mass, "com_m": props.com.tolist(),
+               "inertia_kg_m2": props.inertia.tolist(), "method": "exact section integrals"}
+    atomic_write_bytes(path, json.dumps(payload, indent=1).encode())
+    return props

@@ -1,0 +1,86 @@
+"""Compiled (numba) kernels for per-step work that cannot be an Exudyn symbolic function.
+
+Each kernel re-implements, for speed, laws defined as plain functions elsewhere; tests check that
+both give the same numbers (tests/test_contact_laws.py).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+__all__ = ["impact_normal_force", "backlash_linear_force", "mesh_friction_forces", "periodic_values", "ramp_state"]
+
+
+@njit(cache=True)
+def impact_normal_force(delta: float, delta_t: float, stiffness: float, exponent: float, damping_max: float,
+                        depth: float) -> float:  # pragma: no cover - compiled
+    """Compiled twin of ``flexgear.laws.contact.impact_force`` [N] (stiffness already times s(phi))."""
+    pen = max(delta, 0.0)
+    ramp = min(pen / depth, 1.0)
+    return max(stiffness * pen**exponent + damping_max * ramp * ramp * (3.0 - 2.0 * ramp) * delta_t, 0.0)
+
+
+@njit(cache=True)
+def backlash_linear_force(delta: float, delta_t: float, stiffness: float, damping: float,
+                          backlash: float) -> float:  # pragma: no cover - compiled
+    """Compiled twin of ``flexgear.laws.contact.backlash_linear_force`` [N]."""
+    if delta > 0.0:
+        return stiffness * delta + damping * delta_t
+    if delta < -backlash:
+        return stiffness * (delta + backlash) + damping * delta_t
+    return 0.0
+
+
+@njit(cache=True)
+def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, damping_max, depth,  # noqa: PLR0913
+                         means, cos_c, sin_c, mu, reg, sliding_rows, spin_rows):  # pragma: no cover - compiled
+    """Generalized friction forces Q = -(A^T f_slide + B^T f_spin) of all contacts.
+
+    Same law as laws.contact.impact_force (normal force with the stiffness series), laws.contact.periodic_value
+    (series index 0: stiffness factor, 1: sliding direction kappa, 2: lever lambda [m]) and
+    laws.contact.friction_forces (f = mu F tanh(Omega lambda_mean / v_reg) (kappa, lambda)).
+    """
+    n_c, n_h = cos_c.shape[1], cos_c.shape[2]
+    spin_rate = spin_rows @ q_t
+    q = np.zeros(sliding_rows.shape[1])
+    for i in range(n_c):
+        val = np.empty(3)
+        for k in range(3):
+            v = means[k, i]
+            for h in range(n_h):
+                x = 2.0 * math.pi * (h + 1) * phase[i]
+                v += cos_c[k, i, h] * math.cos(x) + sin_c[k, i, h] * math.sin(x)
+            val[k] = v
+        normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
+                                     depth[i])
+        f = mu[i] * normal * math.tanh(spin_rate[i] * means[2, i] / reg[i])
+        q -= sliding_rows[i] * (f * val[1]) + spin_rows[i] * (f * val[2])
+    return q
+
+
+@njit(cache=True)
+def periodic_values(phase, means, cos_c, sin_c):  # pragma: no cover - compiled
+    """Fourier series values per contact, as laws.contact.periodic_value: cos_c, sin_c (n_contacts, n_harmonics)."""
+    out = means.copy()
+    for i in range(phase.shape[0]):
+        for h in range(cos_c.shape[1]):
+            x = 2.0 * math.pi * (h + 1) * phase[i]
+            out[i] += cos_c[i, h] * math.cos(x) + sin_c[i, h] * math.sin(x)
+    return out
+
+
+@njit(cache=True)
+def ramp_state(t: float, T: float) -> tuple[float, float, float, float]:
+    """Integral of STEP(t, 0, 0, T, 1) [s], STEP itself and its first two derivatives [1/s, 1/s^2].
+
+    Compiled twin of ``flexgear.laws.ramps.step_integral`` / ``ramp_fraction``.
+    """
+    if t <= 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    if t >= T:
+        return t - 0.5 * T, 1.0, 0.0, 0.0
+    d = t / T
+    return T * (d**3 - 0.5 * d**4), d * d * (3.0 - 2.0 * d), 6.0 * d * (1.0 - d) / T, (6.0 - 12.0 * d) / T**2

@@ -1,0 +1,361 @@
+"""Time integration of the lumped-parameter model (section 2.3, eq. 1-13) for the Table 5 load case.
+
+Equations of motion in the frame rotating with the nominal carrier speed Omega(t) (zero for the
+star arrangement, where they reduce to eq. 1-9 with N planets):
+
+    m (x'' + 2 Omega J x' + Omega' J rho - Omega^2 rho) = F_bearing + F_mesh + F_friction      (translations)
+    I (theta'' + Omega')                                = T_support + T_mesh + T_friction + T_load  (spins)
+
+with rho = nominal centre + x. Each mesh m (flexgear.lumped.run.model) has the normal deflection
+delta = G_m . q and the normal force (eq. 1-13)
+
+    F_n = k_m(t) f(delta) + c_m delta'   (damping only while the teeth touch)
+    k_m(t) = k_mean (1 + sum_n c_n cos(2 pi n (phi_m - (eps_alpha + eps_beta)/2)))   (eq. 11-12)
+    f(delta) = delta (delta > 0), 0 (-j_n <= delta <= 0), delta + j_n (delta < -j_n)   (backlash j_n)
+
+phi_m is the mesh phase (mesh cycles) from the sun or ring spin, each planet phased by its position
+(sun mesh: z_s (theta_s - psi_i) / 2 pi; ring mesh: -z_r (theta_r - psi_i) / 2 pi + outer-inner phase).
+The teeth start in contact with zero load (delta = 0 on the driving flank). Tooth friction
+mu F_n acts across the line of action with arms tabulated over the mesh cycle
+(:class:`flexgear.lumped.run.model.FrictionTables`), its direction set by the running direction,
+regularised as tanh(omega_1 p_bt / v_reg). The input spin follows the STEP speed ramp exactly
+(prescribed); the load torque is the STEP load ramp on the output member (Table 5).
+
+Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps
+per recorded step), the right-hand side compiled with numba. The highest natural frequency of the
+study's set (~8 kHz) gives omega h << 2.8, well inside RK4's stability region.
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+import time
+from dataclasses import dataclass
+
+import numba
+import numpy as np
+import pandas as pd
+
+from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
+from flexgear.laws.compiled import backlash_linear_force, ramp_state
+from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
+from flexgear.results import RunResult, run_metadata, signal_columns
+from flexgear.spec import GearboxSpec, spec_hash
+from flexgear.theory import theory
+
+__all__ = ["LumpedModel", "build_lumped_model", "run_lumped", "static_mesh_forces"]
+
+# layout of the float parameter vector handed to the compiled kernel
+_MU, _W_IN, _T_RAMP, _R_C, _T_LOAD, _LOAD_SIGN, _NFP = range(7)
+# layout of the integer parameter vector
+_IN_SPIN, _OUT_SPIN, _IN_BODY, _OUT_BODY, _NIP = range(5)
+
+
+@dataclass(frozen=True)
+class LumpedModel:
+    """Everything the compiled kernel needs, as plain arrays (built by :func:`build_lumped_model`)."""
+
+    system: LumpedSystem
+    fp: np.ndarray
+    ip: np.ndarray
+    free: np.ndarray  # indices of free coordinates
+    presc: np.ndarray  # indices of prescribed spins
+    presc_coef: np.ndarray  # q[presc] = coef * input angle(t)
+    harmonics: np.ndarray  # (meshes, H) stiffness harmonic coefficients c_n
+    phase_centre: np.ndarray  # (meshes,) (eps_alpha + eps_beta)/2
+    phase_index: np.ndarray  # (meshes,) coordinate that drives the mesh phase
+    phase_coef: np.ndarray
+    phase_offset: np.ndarray
+    backlash: np.ndarray  # (meshes,) normal backlash [m]
+    tables: np.ndarray  # (2, points, 3) friction force, arm1, arm2 of sun and ring meshes
+    mesh_type: np.ndarray  # (meshes,) 0 sun mesh, 1 ring mesh
+    tau: np.ndarray  # (meshes, 2) friction direction J n
+    g1: np.ndarray  # (meshes,) d delta_t / d theta_1 (sign gives forward running of gear 1)
+    friction_scale: np.ndarray  # (meshes,) p_bt / (|g1| v_reg)
+    ground_damping: np.ndarray  # (3,) bearing damping of the central members [N s/m]
+    spin_support: np.ndarray  # (n,) torsional support stiffness on spins (absolute angle)
+
+
+def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
+    """Assemble the time-domain model of the spec (one source of truth: involute, theory, geometry)."""
+    params = LumpedParameters.from_spec(spec, hold_input=True)
+    sysm = assemble(params)
+    geo = gear_set_geometry(spec)
+    th = theory(spec)
+    g, lc = spec.gears, spec.load_case
+    star = g.arrangement == "star"
+    r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)  # Omega_c / omega_in
+    nplan = params.planet_count
+    out_spin = 5 if star else 8
+    fp = np.zeros(_NFP)
+    fp[_MU] = spec.contact.friction_coefficient
+    fp[_W_IN] = lc.input_speed_rad_s
+    fp[_T_RAMP] = lc.ramp_time_s
+    fp[_R_C] = r_c
+    fp[_T_LOAD] = lc.load_torque_nm
+    fp[_LOAD_SIGN] = -math.copysign(1.0, th.ratio)
+    ip = np.array([2, out_spin, 0, 1 if star else 2], dtype=np.int64)
+
+    presc = np.flatnonzero(sysm.held_spin)
+    coef = np.array([(1.0 - r_c) if i == 2 else -r_c for i in presc])
+    psi = params.angles
+    meshes = [geo.sun_planet, geo.planet_ring]
+    nh = spec.contact_assumed.stiffness_harmonics
+    eps_b = geo.sun_planet.overlap_ratio(geo.helix_face_width)
+    harm, centre = [], []
+    for mesh in meshes:
+        ea = mesh.transverse_contact_ratio
+        c = mesh_stiffness_harmonics(ea, eps_b, nh) if spec.contact_assumed.stiffness_variation != "constant" \
+            else np.zeros(nh)
+        harm.append(np.broadcast_to(c, (nplan, nh)))
+        centre.append(np.full(nplan, 0.5 * (ea + eps_b)))
+    zs, zr = g.sun_teeth, g.ring_teeth
+    phase_index = np.r_[np.full(nplan, 2), np.full(nplan, 5)].astype(np.int64)
+    phase_coef = np.r_[np.full(nplan, zs / (2 * math.pi)), np.full(nplan, -zr / (2 * math.pi))]
+    phase_offset = np.r_[-zs * psi / (2 * math.pi),
+                         zr * psi / (2 * math.pi) + spec.gears_assumed.outer_inner_mesh_phase]
+    t_sun, t_ring = mesh_friction_tables(geo, spec.lumped_assumed.friction_table_points)
+    tables = np.stack([np.stack([t.force, t.arm1, t.arm2], axis=1) for t in (t_sun, t_ring)])
+    jn = np.stack([-sysm.mesh_direction[:, 1], sysm.mesh_direction[:, 0]], axis=1)
+    g1 = np.r_[np.full(nplan, geo.sun.base_radius), np.full(nplan, -geo.planet.base_radius)]
+    v_reg = spec.contact_assumed.friction_regularisation_m_per_s
+    fscale = geo.sun.base_pitch / (np.abs(g1) * v_reg)
+    spin_support = sysm.ground_spin_stiffness
+    ground = np.array([sysm.support_damping[0, 0], sysm.support_damping[3, 3], sysm.support_damping[6, 6]])
+    return LumpedModel(
+        sysm, fp, ip, np.flatnonzero(sysm.free), presc, coef, np.ascontiguousarray(np.vstack(harm)),
+        np.concatenate(centre), phase_index, phase_coef, phase_offset,
+        np.full(2 * nplan, geo.sun_planet.normal_backlash), np.ascontiguousarray(tables),
+        np.r_[np.zeros(nplan), np.ones(nplan)].astype(np.int64), np.ascontiguousarray(jn), g1, fscale, ground,
+        spin_support,
+    )
+
+
+# --------------------------------------------------------------------------- compiled kernel
+@numba.njit(cache=True)
+def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef, harm, pcentre,
+              pidx, pcoefm, poff,
+              backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal, movable, q, qd, acc, f, forces,
+              out):
+    """Accelerations ``acc`` (all coordinates, rotating frame), forces and the recorded signals ``out``."""
+    n = mass.size
+    nf = free.size
+    th_in, s, sd, sdd = ramp_state(t, fp[_T_RAMP])
+    w = fp[_W_IN]
+    r_c = fp[_R_C]
+    om, omd = r_c * w * s, r_c * w * sd  # frame speed and acceleration
+    th_c = r_c * w * th_in
+    q[:] = 0.0
+    qd[:] = 0.0
+    for k in range(nf):
+        q[free[k]] = y[k]
+        qd[free[k]] = y[nf + k]
+    for k in range(presc.size):
+        q[presc[k]] = pcoef[k] * w * th_in
+        qd[presc[k]] = pcoef[k] * w * s
+    for i in range(n):  # supports: sparse rows (CSR)
+        acc_i = -spin_support[i] * th_c
+        for k in range(sp_ptr[i], sp_ptr[i + 1]):
+            j = sp_idx[k]
+            acc_i -= sp_k[k] * q[j] + sp_c[k] * qd[j]
+        f[i] = acc_i
+    for b in range(3):  # ground bearings damp the absolute velocity x' + Omega J x
+        f[3 * b] += ground[b] * om * q[3 * b + 1]
+        f[3 * b + 1] -= ground[b] * om * q[3 * b]
+    f[ip[_OUT_SPIN]] += fp[_LOAD_SIGN] * fp[_T_LOAD] * s
+    mu = fp[_MU]
+    npts = tables.shape[1]
+    for m in range(km.size):
+        d = 0.0
+        dd = 0.0
+        for k in range(gidx.shape[1]):  # the (at most 6) coordinates of the mesh's two gears
+            d += gval[m, k] * q[gidx[m, k]]
+            dd += gval[m, k] * qd[gidx[m, k]]
+        phase = pcoefm[m] * q[pidx[m]] + poff[m]
+        kf = 1.0
+        for h in range(harm.shape[1]):
+            kf += harm[m, h] * math.cos(2.0 * math.pi * (h + 1) * (phase - pcentre[m]))
+        F = backlash_linear_force(d, dd, km[m] * kf, cm[m], backlash[m])
+        forces[m] = F
+        for k in range(gidx.shape[1]):
+            f[gidx[m, k]] -= F * gval[m, k]
+        if mu > 0.0 and F > 0.0:
+            ph = (phase - math.floor(phase)) * npts
+            i0 = int(ph) % npts
+            i1 = (i0 + 1) % npts
+            wt = ph - math.floor(ph)
+            ty = mtype[m]
+            fa = tables[ty, i0, 0] * (1.0 - wt) + tables[ty, i1, 0] * wt
+            a1 = tables[ty, i0, 1] * (1.0 - wt) + tables[ty, i1, 1] * wt
+            a2 = tables[ty, i0, 2] * (1.0 - wt) + tables[ty, i1, 2] * wt
+            b1 = 0 if ty == 0 else 3 + m - km.size // 2
+            b2 = 3 + m if ty == 0 else 1
+            ff = mu * F * math.tanh(g1[m] * qd[3 * b1 + 2] * fscale[m])
+            f[3 * b2] += ff * fa * tau[m, 0]
+            f[3 * b2 + 1] += ff * fa * tau[m, 1]
+            f[3 * b1] -= ff * fa * tau[m, 0]
+            f[3 * b1 + 1] -= ff * fa * tau[m, 1]
+            f[3 * b1 + 2] -= ff * a1
+            f[3 * b2 + 2] += ff * a2
+    acc[:] = 0.0
+    for k in range(presc.size):
+        acc[presc[k]] = pcoef[k] * w * sd
+    nb = n // 3
+    for b in range(nb):
+        ix, iy, it = 3 * b, 3 * b + 1, 3 * b + 2
+        if movable[ix]:
+            rx, ry = nominal[b, 0] + q[ix], nominal[b, 1] + q[iy]
+            acc[ix] = f[ix] / mass[ix] + 2.0 * om * qd[iy] + omd * ry + om * om * rx
+            acc[iy] = f[iy] / mass[iy] - 2.0 * om * qd[ix] - omd * rx + om * om * ry
+        if movable[it]:
+            acc[it] = f[it] / mass[it] - omd
+    for k in range(presc.size):  # held spins keep their prescribed motion
+        acc[presc[k]] = pcoef[k] * w * sd
+    # recorded signals: input/output absolute speed, drive torque, accelerations of the bearing nodes
+    out[0] = qd[ip[_IN_SPIN]] + om
+    out[1] = qd[ip[_OUT_SPIN]] + om
+    out[2] = mass[ip[_IN_SPIN]] * w * sd - f[ip[_IN_SPIN]]
+    cth, sth = math.cos(th_c), math.sin(th_c)
+    for k in range(2):
+        b = ip[_IN_BODY + k]
+        ax = acc[3 * b] + 2.0 * om * (-qd[3 * b + 1]) - omd * q[3 * b + 1] - om * om * q[3 * b]
+        ay = acc[3 * b + 1] + 2.0 * om * qd[3 * b] + omd * q[3 * b] - om * om * q[3 * b + 1]
+        out[3 + 2 * k] = cth * ax - sth * ay
+        out[4 + 2 * k] = sth * ax + cth * ay
+
+
+@numba.njit(cache=True)
+def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free,
+               presc, pcoef, harm,
+               pcentre, pidx, pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
+               movable):
+    """RK4 from t0 over n_out recorded steps; rec[k] = signals at t0 + k h_out. Returns the final state."""
+    n = mass.size
+    nf = free.size
+    nm = km.size
+    q, qd, acc, f = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
+    forces = np.zeros(nm)
+    out = np.zeros(7)
+    kk = np.zeros((4, 2 * nf))
+    ytmp = np.zeros(2 * nf)
+    h = h_out / substeps
+    for step in range(n_out):
+        for sub in range(substeps):
+            t = t0 + (step * substeps + sub) * h
+            for stage in range(4):
+                if stage == 0:
+                    ts = t
+                    ytmp[:] = y
+                else:
+                    ts = t + (h if stage == 3 else 0.5 * h)
+                    fac = h if stage == 3 else 0.5 * h
+                    for i in range(2 * nf):
+                        ytmp[i] = y[i] + fac * kk[stage - 1][i]
+                _evaluate(ts, ytmp, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef,
+                          harm, pcentre, pidx,
+                          pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
+                          movable, q, qd, acc, f, forces, out)
+                if stage == 0 and sub == 0:
+                    rec[step, 0:3] = out[0:3]
+                    rec[step, 3:3 + nm] = forces
+                    rec[step, 3 + nm:7 + nm] = out[3:7]
+                for i in range(nf):
+                    kk[stage][i] = ytmp[nf + i]
+                    kk[stage][nf + i] = acc[free[i]]
+            for i in range(2 * nf):
+                y[i] += h / 6.0 * (kk[0][i] + 2.0 * kk[1][i] + 2.0 * kk[2][i] + kk[3][i])
+    return y
+
+
+def _sparse_rows(*mats: np.ndarray) -> tuple[np.ndarray, ...]:
+    """CSR pattern (union of the non-zeros) of same-shaped matrices: indptr, indices, one data array each."""
+    pattern = np.any([m != 0.0 for m in mats], axis=0)
+    rows, cols = np.nonzero(pattern)
+    ptr = np.searchsorted(rows, np.arange(pattern.shape[0] + 1)).astype(np.int64)
+    return (ptr, cols.astype(np.int64), *[np.ascontiguousarray(m[rows, cols]) for m in mats])
+
+
+def _sparse_mesh_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Non-zero columns of each mesh row, padded (index 0, value 0) to equal length."""
+    width = max(1, int((G != 0.0).sum(1).max()))
+    idx = np.zeros((G.shape[0], width), dtype=np.int64)
+    val = np.zeros((G.shape[0], width))
+    for m, row in enumerate(G):
+        nz = np.flatnonzero(row)
+        idx[m, :nz.size], val[m, :nz.size] = nz, row[nz]
+    return idx, val
+
+
+def _kernel_args(model: LumpedModel) -> tuple:
+    s = model.system
+    return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
+            *_sparse_mesh_rows(s.mesh_G), s.mesh_stiffness,
+            s.mesh_damping, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
+            model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
+            model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
+            s.nominal_position, s.free & (s.mass > 0.0))
+
+
+def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, progress: bool) -> np.ndarray:
+    """Recorded signals at 0, h_out, ..., t_end: (steps + 1, 7 + meshes)."""
+    n_steps = int(round(t_end / h_out))
+    nm = model.system.mesh_stiffness.size
+    rec = np.zeros((n_steps + 1, 7 + nm))
+    y = np.zeros(2 * model.free.size)
+    args = _kernel_args(model)
+    chunk = max(1, n_steps // 20)
+    done = 0
+    while done < n_steps:
+        k = min(chunk, n_steps - done)
+        y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], *args)
+        done += k
+        if progress:
+            print(f"\rlumped: t = {done * h_out:.4f} / {t_end:.4f} s", end="", file=sys.stderr, flush=True)
+    if progress:
+        print(file=sys.stderr)
+    _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], *args)  # record the final state
+    return rec
+
+
+def run_lumped(spec: GearboxSpec, t_end_s: float | None = None, progress: bool = False) -> RunResult:
+    """Run the lumped model for the spec's load case; signals as the multibody runs (flexgear.results)."""
+    lc = spec.load_case
+    t_end = lc.end_time_s if t_end_s is None else float(t_end_s)
+    if t_end <= 0.0:
+        raise ValueError(f"t_end_s: expected > 0, got {t_end}")
+    wall0, cpu0 = time.perf_counter(), time.process_time()
+    model = build_lumped_model(spec)
+    rec = _simulate(model, t_end, lc.step_size_s, spec.lumped_assumed.integration_substeps, progress)
+    wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
+    n = model.system.params.planet_count
+    nm = 2 * n
+    t = np.arange(rec.shape[0]) * lc.step_size_s
+    w_in, w_out = np.degrees(rec[:, 0]), np.degrees(rec[:, 1])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(w_in != 0.0, w_out / w_in, np.nan)
+    data = np.column_stack([t, w_in, w_out, ratio, rec[:, 2], rec[:, 3:3 + nm], rec[:, 3 + nm:7 + nm]])
+    signals = pd.DataFrame(data, columns=signal_columns(n))
+    meta = run_metadata("lumped", "lumped", spec_hash(spec, "lumped", t_end), t_end, lc, n, {}, theory(spec),
+                        status="ok", reason="", wall_time_s=wall, cpu_time_s=cpu,
+                        integration={"method": "rk4", "substeps": spec.lumped_assumed.integration_substeps})
+    return RunResult(meta, signals)
+
+
+def static_mesh_forces(spec: GearboxSpec) -> tuple[np.ndarray, np.ndarray]:
+    """Normal mesh forces [N] (sun meshes, ring meshes) of the linear static problem at full load.
+
+    Mean mesh stiffness, input spin held, load torque on the output member, no friction:
+    K_ff q_f = F_f, F_m = k_m G_m . q.
+    """
+    model = build_lumped_model(spec)
+    s = model.system
+    K = s.stiffness()
+    free = model.free
+    load = np.zeros(s.n)
+    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    q = np.zeros(s.n)
+    q[free] = np.linalg.solve(K[np.ix_(free, free)], load[free])
+    forces = s.mesh_stiffness * (s.mesh_G @ q)
+    n = s.params.planet_count
+    return forces[:n], forces[n:]

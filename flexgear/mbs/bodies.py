@@ -1,0 +1,53 @@
+"""Bodies: mass-property algebra and rigid bodies on ``NodeRigidBodyRxyz`` nodes.
+
+Every body, rigid or flexible, has its reference frame on one ``NodeRigidBodyRxyz`` node placed
+at the gear centre with the z axis along the rotation axis. Coordinates of that node are
+(u_x, u_y, u_z, phi_x, phi_y, phi_z); phi_z is the unwrapped spin angle and, for small tilts,
+phi_x and phi_y are the tilt angles in the ground frame (R = R_x(phi_x) R_y(phi_y) R_z(phi_z)).
+Bushings, drives and gear contacts act on these frame coordinates, whatever the body's form.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.geometry.massprops import MassProperties, inertia_about_point
+
+__all__ = ["Body", "add_rigid_body"]
+
+
+@dataclass(frozen=True)
+class Body:
+    """Handles of one body in an Exudyn system (rigid or flexible)."""
+
+    name: str
+    node: int  # NodeRigidBodyRxyz of the body frame
+    obj: int  # the body object
+    marker_rigid: int  # MarkerNodeRigid on the frame node
+    marker_coordinates: int  # MarkerNodeCoordinates on the frame node
+    position: np.ndarray  # reference position of the frame [m]
+    props: MassProperties
+    flexible: bool = False
+
+
+def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) -> Body:
+    """Add a rigid body whose frame sits at ``position`` (ground frame axes) [m].
+
+    ``props`` is given in the body frame; Exudyn's ``ObjectRigidBody`` takes the inertia about
+    the frame origin and the centre-of-mass offset, so no approximation is involved.
+    """
+    import exudyn as exu  # noqa: F401  (imported for side effects of the item interface)
+    from exudyn.itemInterface import MarkerNodeCoordinates, MarkerNodeRigid, NodeRigidBodyRxyz, ObjectRigidBody
+    from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
+
+    node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{name}_node", referenceCoordinates=[*position, 0.0, 0.0, 0.0]))
+    j_ref = inertia_about_point(props)
+    obj = mbs.AddObject(ObjectRigidBody(
+        name=name, mass=props.mass, inertia=InertiaTensor2Inertia6D(j_ref),
+        centerOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
+    ))
+    m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
+    m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
+    return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)

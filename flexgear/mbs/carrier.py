@@ -1,0 +1,144 @@
+"""A rotating carrier: planet bearings on the carrier and the contacts' geometry turning with it.
+
+Planet bearing: an ``ObjectConnectorCartesianSpringDamper`` from a ``MarkerBodyPosition`` at the pin
+on the carrier to the planet's frame node (radial stiffness in x, y, axial in z: the bearing is
+isotropic about the axis, so the carrier's spin does not matter), plus tilt springs between the
+planet's and the carrier's tilt coordinates (both ground-frame tilts for small tilts); the planet's
+spin relative to the carrier stays free.
+
+Contacts (flexgear.mbs.contacts.GearContact) are linearised at the reference configuration, carrier
+angle 0. With the carrier at angle theta every contact's pitch point, normal and planet centre are
+turned about the carrier axis by R(theta); the deflection of contact i is
+
+    delta_i = G_i(theta) . (q - q_ref(theta)) + sum_k S_ik phi_k - S_i theta,    S_i = sum_k S_ik
+
+with G_i(theta) the gradient rows with every body's translation and rotation 3-blocks turned by
+R(theta), q_ref(theta) the reference frame positions with the orbiting bodies (planets) moved round
+the axis, S_ik the spin coefficients (turning-invariant) and the last term the carrier's rotation
+taken out of the absolute spins (the mesh sees spins relative to the carrier). Planets' translations
+are absolute coordinates, so the carrier's actual angle enters through the planets' positions, not
+as a column of its own: a column -S_i on the carrier's spin would count the carrier's rotation twice
+(a rigid rotation of the whole stage would then load the mesh). ``theta`` is the nominal carrier
+angle (spin ratio x prescribed drive angle), set once per step by a pre-step function: delta is
+stationary in theta at the nominal state (d delta / d theta = (c x n)_z - S_i = 0), so an error of
+theta (one step, elastic wind-up) enters only at second order, a eps^2 / 2.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.laws.ramps import drive_angle
+from flexgear.mbs.bodies import Body
+from flexgear.spec import Bearing
+
+__all__ = ["Carrier", "CarrierKinematics", "add_planet_bearing"]
+
+
+@dataclass(frozen=True)
+class Carrier:
+    """The carrier: its body name and nominal spin per prescribed drive angle (e.g. z_s / (z_s + z_r))."""
+
+    body: str
+    spin_per_drive_angle: float
+
+
+def _rotation(theta: float) -> np.ndarray:
+    c, s = math.cos(theta), math.sin(theta)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+class CarrierKinematics:
+    """Pre-step update of the contact constraint's gradient rows and offset for a rotating carrier.
+
+    ``rows`` (n_contacts, 6 n_bodies): the contacts' gradient rows at carrier angle 0 (one kinematic
+    row of every contact, over the frame coordinates in the order of ``bodies``). Bodies off the
+    carrier axis (other than the carrier) orbit with it. ``extra_rows`` are further row sets to turn
+    in place (the friction's sliding rows), given as arrays to overwrite.
+    """
+
+    def __init__(self, constraint, rows: np.ndarray, bodies: list[Body], carrier: Carrier, ramp_time: float,
+                 drive_speed: float, extra_rows: list[np.ndarray] | None = None):
+        self.constraint, self.carrier = constraint, carrier
+        self.ramp_time, self.drive_speed = ramp_time, drive_speed
+        self.rows0 = np.asarray(rows, float).copy()
+        names = [b.name for b in bodies]
+        if carrier.body not in names:
+            raise KeyError(f"carrier body {carrier.body!r} is not among the bodies {names}")
+        axis = next(b.position for b in bodies if b.name == carrier.body)
+        self.axis = np.asarray(axis, float)
+        self.positions = np.array([b.position for b in bodies], float)
+        radial = np.hypot(*(self.positions[:, :2] - self.axis[:2]).T)
+        self.orbiting = (radial > 1e-12) & (np.array(names) != carrier.body)
+        spin_cols = 6 * np.arange(len(bodies)) + 5
+        self.spin_sum = self.rows0[:, spin_cols].sum(axis=1)
+        self.extra = [(r, np.asarray(r, float).copy()) for r in (extra_rows or [])]
+
+    def theta(self, t: float) -> float:
+        """Nominal carrier angle [rad] at time t."""
+        return self.carrier.spin_per_drive_angle * float(drive_angle(t, self.ramp_time, self.drive_speed))
+
+    @staticmethod
+    def turned(rows: np.ndarray, theta: float) -> np.ndarray:
+        """Rows with every body's translation and rotation 3-blocks turned about z: g -> R(theta) g."""
+        n, m = rows.shape
+        blocks = rows.reshape(n, m // 3, 3)
+        return (blocks @ _rotation(theta).T).reshape(n, m)
+
+    def reference(self, theta: float) -> np.ndarray:
+        """Frame coordinates of the reference configuration with the carrier at ``theta`` (all rotations 0)."""
+        pos = self.positions.copy()
+        pos[self.orbiting] = self.axis + (pos[self.orbiting] - self.axis) @ _rotation(theta).T
+        return np.hstack([pos, np.zeros_like(pos)]).ravel()
+
+    def matrix_and_offset(self, t: float) -> tuple[np.ndarray, np.ndarray]:
+        """Constraint scaling matrix and offset at time t (aux = G q - offset)."""
+        theta = self.theta(t)
+        g = self.turned(self.rows0, theta)
+        return g, g @ self.reference(theta) + self.spin_sum * theta
+
+    def __call__(self, mbs, t: float) -> bool:
+        g, offset = self.matrix_and_offset(t)
+        self.constraint.set(mbs, g, offset)
+        theta = self.theta(t)
+        for target, rows0 in self.extra:
+            target[:] = self.turned(rows0, theta)
+        return True
+
+
+def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: Bearing, name: str | None = None) -> list[int]:
+    """Bearing of ``planet`` on its pin of ``carrier`` (Table 2 style stiffnesses, spin free).
+
+    Translation: ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) between the pin
+    (the planet's reference centre, fixed in the carrier) and the planet's frame node; tilt: a
+    coordinate spring k_t between the planet's and the carrier's tilt coordinates about x and y.
+    Damping c = k * damping_per_stiffness. Returns the connectors.
+    """
+    from exudyn.itemInterface import (
+        MarkerBodyPosition,
+        MarkerNodeCoordinate,
+        MarkerNodePosition,
+        ObjectConnectorCartesianSpringDamper,
+        ObjectConnectorCoordinateSpringDamper,
+    )
+
+    label = name or f"bearing_{planet.name}"
+    k = np.array([bearing.radial_stiffness_n_per_m, bearing.radial_stiffness_n_per_m, bearing.axial_stiffness_n_per_m])
+    c = bearing.damping_per_stiffness_s
+    pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
+                                           localPosition=list(planet.position - carrier.position)))
+    out = [mbs.AddObject(ObjectConnectorCartesianSpringDamper(
+        name=label, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=planet.node))],
+        stiffness=list(k), damping=list(c * k)))]
+    kt = bearing.tilt_stiffness_nm_per_rad
+    for axis in (3, 4):
+        out.append(mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
+            name=f"{label}_tilt{axis - 2}",
+            markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=carrier.node, coordinate=axis)),
+                           mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=planet.node, coordinate=axis))],
+            stiffness=kt, damping=c * kt)))
+    return out
+

@@ -1,0 +1,140 @@
+"""Gear contact on flexible gears: the elastic deflection at a contact point fixed in space.
+
+The mesh point stays where it is while a gear spins under it, so the material point in contact
+changes with the spin angle theta. A gear's elastic displacement there, projected on the tooth
+normal, is a linear function of its modal coordinates q with coefficients that depend on the
+material angle alpha = psi - theta (psi: angle of the contact point about the gear centre):
+
+    delta_el = c(alpha) . q,    c_j(alpha) = (R(alpha - psi) n) . Phi_j(r, alpha, z)
+
+(n: tooth normal in the ground frame, Phi_j: mode j in the body frame, (r, z): radius and axial
+position of the contact). c(alpha) is fitted, mode by mode, as a Fourier series in alpha to the
+mode shapes at the mesh nodes near the contact circle: global modes are smooth around the
+circumference, and the tooth-level compliance already lives in the contact law, so a smooth fit
+(rather than node-wise interpolation, which made the force noisy in the prototype) is the model.
+
+The coefficients enter the contact's linear kinematic constraint (flexgear.mbs.contacts) as extra
+columns, updated once per time step for the step's end time from the nominal spin angle of each
+gear (theta = spin ratio x prescribed drive angle; the elastic vibration's own phase effect is
+neglected). The deflection carried by the auxiliary coordinate is then the total one, and its
+rate includes the transport of material under the contact point.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.laws.ramps import drive_angle
+
+__all__ = ["ModalColumn", "modal_contact_coefficients", "ContactKinematics", "PreStepChain"]
+
+
+@dataclass(frozen=True)
+class ModalColumn:
+    """Coefficients of one flexible gear's modal coordinates in one contact's deflection row."""
+
+    contact: int  # row of the contact in the kinematic constraint
+    body: str
+    sign: float  # +1 for gear 1 of the contact, -1 for gear 2
+    contact_angle: float  # psi [rad]
+    spin_per_drive_angle: float  # nominal gear spin per prescribed drive angle
+    values: np.ndarray  # (n_grid, n_modes) coefficients at alpha_k = 2 pi k / n_grid [m per modal unit]
+
+
+def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.ndarray, normal: np.ndarray,
+                               half_width: float, radial_band: float, order: int, n_grid: int = 720
+                               ) -> np.ndarray:
+    """c_j(alpha) on a grid of n_grid material angles, shape (n_grid, n_modes).
+
+    ``nodes`` (n, 3) and ``modes`` (3n, m) in the body frame (gear centre at the origin, z the axis);
+    ``point`` the contact point relative to the gear centre at zero spin; ``normal`` the tooth normal;
+    nodes within ``radial_band`` of the contact radius and ``half_width`` of its axial position are
+    fitted by a least-squares Fourier series of ``order`` harmonics in alpha.
+    """
+    r, z, psi = math.hypot(point[0], point[1]), point[2], math.atan2(point[1], point[0])
+    rho, ang = np.hypot(nodes[:, 0], nodes[:, 1]), np.arctan2(nodes[:, 1], nodes[:, 0])
+    n_terms = 2 * order + 1
+    band = radial_band
+    for _ in range(8):
+        sel = np.flatnonzero((np.abs(rho - r) <= band) & (np.abs(nodes[:, 2] - z) <= half_width))
+        if len(sel) >= 4 * n_terms:
+            break
+        band *= 1.5
+    else:
+        raise ValueError(f"only {len(sel)} mesh nodes near the contact circle r = {r:.4f} m, z = {z:.4f} m: "
+                         f"too few for a Fourier fit of order {order}")
+    alpha = ang[sel]
+    # tooth normal carried with the material point: R(alpha - psi) n
+    ca, sa = np.cos(alpha - psi), np.sin(alpha - psi)
+    n_b = np.stack([ca * normal[0] - sa * normal[1], sa * normal[0] + ca * normal[1],
+                    np.full_like(alpha, normal[2])], axis=1)
+    phi = modes.reshape(len(nodes), 3, -1)[sel]  # (k, 3, m)
+    samples = np.einsum("kd,kdm->km", n_b, phi)
+
+    def basis(a: np.ndarray) -> np.ndarray:
+        cols = [np.ones_like(a)]
+        for h in range(1, order + 1):
+            cols += [np.cos(h * a), np.sin(h * a)]
+        return np.stack(cols, axis=1)
+
+    coef, *_ = np.linalg.lstsq(basis(alpha), samples, rcond=None)
+    return basis(2 * np.pi * np.arange(n_grid) / n_grid) @ coef
+
+
+class ContactKinematics:
+    """Pre-step update of the modal columns of the contact constraint's ``scalingMarker1``.
+
+    ``base`` is the constant part (frame coordinates); ``columns`` say where each flexible gear's
+    modal coefficients go (``column_offsets[body]``: first column of that body's modal coordinates).
+    """
+
+    def __init__(self, constraint, base: np.ndarray, columns: list[ModalColumn],
+                 column_offsets: dict[str, int], ramp_time: float, drive_speed: float):
+        self.constraint, self.base = constraint, base
+        self.ramp_time, self.drive_speed = ramp_time, drive_speed
+        width = max(c.values.shape[1] for c in columns)
+        self.n_grid = columns[0].values.shape[0]
+        self.tables = np.stack([np.pad(c.values, ((0, 0), (0, width - c.values.shape[1]))) for c in columns])
+        self.rows = np.array([c.contact for c in columns])
+        self.signs = np.array([c.sign for c in columns])
+        self.psi = np.array([c.contact_angle for c in columns])
+        self.spin = np.array([c.spin_per_drive_angle for c in columns])
+        self.n_modes = np.array([c.values.shape[1] for c in columns])
+        self.first = np.array([column_offsets[c.body] for c in columns])
+        self.matrix = base.copy()
+
+    def matrix_at(self, t: float) -> np.ndarray:
+        """The constraint's scaling matrix (frame + modal columns) at time t."""
+        theta = float(drive_angle(t, self.ramp_time, self.drive_speed))
+        alpha = np.mod(self.psi - self.spin * theta, 2 * np.pi) * (self.n_grid / (2 * np.pi))
+        i0 = np.floor(alpha).astype(int) % self.n_grid
+        w = (alpha - np.floor(alpha))[:, None]
+        i1 = (i0 + 1) % self.n_grid
+        k = np.arange(len(alpha))
+        values = (1 - w) * self.tables[k, i0] + w * self.tables[k, i1]
+        out = self.matrix
+        for j in range(len(alpha)):
+            out[self.rows[j], self.first[j]:self.first[j] + self.n_modes[j]] = (
+                self.signs[j] * values[j, :self.n_modes[j]])
+        return out
+
+    def __call__(self, mbs, t: float) -> bool:
+        self.constraint.set(mbs, self.matrix_at(t))
+        return True
+
+
+class PreStepChain:
+    """Several pre-step functions as one (Exudyn takes a single pre-step user function)."""
+
+    def __init__(self, functions: list[Callable]):
+        self.functions = [f for f in functions if f is not None]
+
+    def __call__(self, mbs, t: float) -> bool:
+        ok = True
+        for f in self.functions:
+            ok = f(mbs, t) and ok
+        return ok

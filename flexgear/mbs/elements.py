@@ -1,0 +1,176 @@
+"""Linear elements and supports on body frame coordinates: bushings, fixed joints, speed drive, load torque.
+
+Element contract (as ROSS's): every linear element gives a 6x6 stiffness and damping matrix on the
+frame coordinates (u_x, u_y, u_z, phi_x, phi_y, phi_z) of one body; all of them are summed into one
+``ObjectGenericODE2`` over the frame nodes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.laws.ramps import drive_angle, ramp_fraction
+from flexgear.mbs.bodies import Body
+from flexgear.spec import Bearing
+
+
+@dataclass(frozen=True)
+class Bushing:
+    """A bearing as a 6-DOF linear spring-damper from a body frame to ground (spin left free).
+
+    Stiffness diag(k_r, k_r, k_a, k_t, k_t, 0) on (u_x, u_y, u_z, phi_x, phi_y, phi_z) [N/m, N·m/rad];
+    damping c = k * damping_per_stiffness [s] (stiffness-proportional).
+    """
+
+    body: str
+    radial_stiffness: float
+    axial_stiffness: float
+    tilt_stiffness: float
+    damping_per_stiffness: float
+
+    @classmethod
+    def from_bearing(cls, body: str, bearing: Bearing) -> Bushing:
+        """Bushing of a Table 2 bearing."""
+        return cls(body, bearing.radial_stiffness_n_per_m, bearing.axial_stiffness_n_per_m,
+                   bearing.tilt_stiffness_nm_per_rad, bearing.damping_per_stiffness_s)
+
+    def stiffness_matrix(self) -> np.ndarray:
+        k = [self.radial_stiffness, self.radial_stiffness, self.axial_stiffness,
+             self.tilt_stiffness, self.tilt_stiffness, 0.0]
+        return np.diag(k)
+
+    def damping_matrix(self) -> np.ndarray:
+        return self.damping_per_stiffness * self.stiffness_matrix()
+
+
+def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_nodes: list[int] | None = None,
+                        extra_size: int = 0) -> tuple[int, int]:
+    """Sum the elements' matrices into one ``ObjectGenericODE2`` over the bodies' frame nodes.
+
+    ``extra_nodes`` (e.g. the modal nodes of flexible bodies, ``extra_size`` coordinates in all) are
+    appended to the object with zero matrices so that its marker spans them too.
+    Returns ``(object, marker)``: the marker (``MarkerObjectODE2Coordinates``) spans all frame
+    coordinates in the order of ``bodies``, then the extra ones, and is reused by the gear contacts.
+    """
+    from exudyn.itemInterface import MarkerObjectODE2Coordinates, ObjectGenericODE2
+
+    index = {b.name: i for i, b in enumerate(bodies)}
+    n = 6 * len(bodies) + extra_size
+    stiffness, damping = np.zeros((n, n)), np.zeros((n, n))
+    for e in elements:
+        if e.body not in index:
+            raise KeyError(f"bushing on unknown body {e.body!r}; bodies: {sorted(index)}")
+        s = slice(6 * index[e.body], 6 * index[e.body] + 6)
+        stiffness[s, s] += e.stiffness_matrix()
+        damping[s, s] += e.damping_matrix()
+    obj = mbs.AddObject(ObjectGenericODE2(
+        name="frame_elements", nodeNumbers=[b.node for b in bodies] + list(extra_nodes or []),
+        massMatrix=np.zeros((n, n)), stiffnessMatrix=stiffness, dampingMatrix=damping, forceVector=np.zeros(n),
+    ))
+    marker = mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=obj))
+    return obj, marker
+
+
+def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float) -> int:
+    """Prescribe the spin angle of ``body`` to the STEP speed ramp's integral (position level).
+
+    Returns the constraint; its ``Force`` output is the drive torque [N·m].
+    """
+    from exudyn import symbolic as esym
+    from exudyn.itemInterface import MarkerNodeCoordinate, NodePointGround, ObjectConnectorCoordinate
+    from exudyn.utilities import CreateSymbolicUserFunction
+
+    ground = mbs.AddNode(NodePointGround())
+    m0 = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
+    m1 = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
+    drive = mbs.AddObject(ObjectConnectorCoordinate(name="drive", markerNumbers=[m0, m1]))
+
+    def offset(mbs, t, itemNumber, lOffset):  # noqa: N803
+        return drive_angle(t, ramp_time, speed, esym)
+
+    fn = CreateSymbolicUserFunction(mbs, offset, "offsetUserFunction", drive)
+    mbs.SetObjectParameter(drive, "offsetUserFunction", fn)
+    _keep_alive(mbs, [fn])
+    return drive
+
+
+def add_load_torque(mbs, body: Body, torque: float, ramp_time: float) -> int:
+    """Torque ``torque`` [N·m] about the body's spin axis, ramped by STEP(t, 0, 0, T, 1)."""
+    from exudyn import symbolic as esym
+    from exudyn.itemInterface import LoadCoordinate, MarkerNodeCoordinate
+    from exudyn.utilities import CreateSymbolicUserFunction
+
+    marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
+    load = mbs.AddLoad(LoadCoordinate(name="load_torque", markerNumber=marker, load=torque))
+
+    def ramped(mbs, t, load):
+        return load * ramp_fraction(t, ramp_time, esym)
+
+    fn = CreateSymbolicUserFunction(mbs, ramped, "loadUserFunction", load)
+    mbs.SetLoadParameter(load, "loadUserFunction", fn)
+    _keep_alive(mbs, [fn])
+    return load
+
+
+def add_fixed_joint(mbs, body: Body, other: Body | None = None, coordinates: tuple[int, ...] = (0, 1, 2, 3, 4, 5),
+                    name: str | None = None) -> list[int]:
+    """Fixed joint on frame coordinates (linear, exact): ``body`` to ``other``, or to ground if ``other`` is None.
+
+    Joins the selected frame coordinates (0-2 translation, 3-5 rotation, 5 = spin) of two bodies whose
+    frames coincide in the reference configuration: q_body = q_other (one constraint). For a flexible
+    body the frame is its mean-axis frame (Tisserand), so the joint acts on the body's mean motion, not
+    on its interface nodes. To ground: each selected displacement coordinate is held at zero (one
+    constraint each; e.g. ``coordinates=(5,)`` holds a ring's spin and leaves its bearing compliance to
+    a bushing). Returns the constraints.
+    """
+    from exudyn.itemInterface import (
+        MarkerNodeCoordinate,
+        NodePointGround,
+        ObjectConnectorCoordinate,
+        ObjectConnectorCoordinateVector,
+    )
+
+    label = name or f"fixed_{body.name}_{other.name if other is not None else 'ground'}"
+    if other is not None:
+        rows = np.eye(6)[list(coordinates)]
+        return [mbs.AddObject(ObjectConnectorCoordinateVector(
+            name=label, markerNumbers=[body.marker_coordinates, other.marker_coordinates],
+            scalingMarker0=rows, scalingMarker1=rows, offset=np.zeros(len(rows))))]
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    return [mbs.AddObject(ObjectConnectorCoordinate(
+        name=f"{label}_{k}", markerNumbers=[ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node,
+                                                                                       coordinate=k))]))
+        for k in coordinates]
+
+
+def add_interface_joint(mbs, body: Body, other: Body, interfaces: tuple[str, str], point, name: str = "") -> int:
+    """Fixed joint of two bodies at their interfaces, at ``point`` [m, ground frame, reference configuration].
+
+    A flexible body joins through the ``MarkerSuperElementRigid`` of its interface (the RBE3 motion
+    of the interface node set, see flexgear.mbs.flexible.add_flexible_body, which must have placed that
+    marker at ``point``); a rigid body through a body-fixed marker at ``point``. All six relative
+    motions are constrained (``ObjectJointGeneric``); its ``Force``/``Torque`` outputs are the
+    forces [N] and moments [N·m] the joint transmits. Returns the joint.
+    """
+    from exudyn.itemInterface import MarkerBodyRigid, ObjectJointGeneric, VObjectJointGeneric
+
+    markers = []
+    for b, itf in zip((body, other), interfaces, strict=True):
+        if b.flexible:
+            if itf not in b.interface_markers:
+                raise KeyError(f"flexible body {b.name!r} has no marker on interface {itf!r}; "
+                               f"have {sorted(b.interface_markers)}")
+            markers.append(b.interface_markers[itf])
+        else:
+            local = np.asarray(point, float) - b.position
+            markers.append(mbs.AddMarker(MarkerBodyRigid(bodyNumber=b.obj, localPosition=list(map(float, local)))))
+    return mbs.AddObject(ObjectJointGeneric(name=name or f"joint_{body.name}_{other.name}", markerNumbers=markers,
+                                            constrainedAxes=[1] * 6, visualization=VObjectJointGeneric(show=False)))
+
+
+def _keep_alive(mbs, functions: list) -> None:
+    """Symbolic user functions must outlive the simulation: keep them with the system."""
+    store = mbs.variables.setdefault("flexgear_symbolic_functions", [])
+    store.extend(functions)

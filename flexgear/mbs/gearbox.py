@@ -1,0 +1,204 @@
+"""Model: a single-stage star gearbox (carrier fixed) assembled from bodies and connectors.
+
+The assembly follows section 2.1 of the study: input shaft fixed to the sun, ring fixed to the
+output shaft (for rigid parts the fixed joint merges the two into one body, which is exact),
+bushings at the input-shaft, output-shaft and planet bearings (Table 2), a gear contact for every
+sun-planet and planet-ring mesh and helix half, the input speed prescribed as a STEP ramp and
+the load torque on the output as a STEP ramp (Table 5).
+
+Frames: ground z along the gearbox axis, sun and ring centred at the origin, planet i at
+a_w (cos psi_i, sin psi_i, 0) with psi_i = 2 pi i / N. Mesh normals follow from the operating
+pressure angles, the base helix angle and the hand of each helix half (see :func:`mesh_contacts`).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.geometry.massprops import MassProperties, combine_mass_properties
+from flexgear.geometry.pair import helix_halves as pair_helix_halves
+from flexgear.mbs.bodies import Body, add_rigid_body
+from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
+from flexgear.mbs.elements import Bushing, add_interface_joint, add_load_torque, add_speed_drive
+from flexgear.mbs.train import add_gear_train
+from flexgear.spec import GearboxSpec, Variant
+from flexgear.theory import Theory, theory
+
+__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"]
+
+
+@dataclass
+class GearboxModel:
+    """Handles of an assembled gearbox in an Exudyn system."""
+
+    spec: GearboxSpec
+    theory: Theory
+    bodies: dict[str, Body]
+    outer_contacts: list[list[int]]  # [planet][half] spring-damper objects, sun-planet
+    inner_contacts: list[list[int]]  # [planet][half] spring-damper objects, planet-ring
+    drive: int
+    load: int
+    contacts: list[GearContact] = field(default_factory=list)
+    friction: MeshFriction | None = None
+    kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics for flexible gears
+    aux_node: int = -1  # node of the contacts' deflection coordinates
+    input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
+    output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
+    joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
+
+
+def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
+    """(axial position z_h [m], planet hand H, face-width share) of each helix half."""
+    return [(h.z, h.hand, h.share) for h in pair_helix_halves(geo.helix_layout, geo.helix_face_width, geo.half_gap)]
+
+
+def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContact]:
+    """Gear contacts of every planet, mesh and helix half, in the order (planet, outer/inner, half).
+
+    Built with the generic :func:`flexgear.geometry.layout.pair.pair_contacts`. Sun-planet: gear 1 = sun, pushing
+    in the drive sense; planet-ring: gear 1 = planet, pushing against the drive sense. The halves'
+    hands (flexgear.geometry.layout.pair convention, gear 1 in the +z half): sun +1, planet -1, so that the
+    planet's axial forces from sun and ring cancel. Mesh phase of planet i:
+    phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing), plus the configured
+    outer-inner phase on the planet-ring mesh.
+    """
+    geo = gear_set_geometry(spec)
+    g = spec.gears
+    zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
+    sigma = 1.0 if drive_sign >= 0 else -1.0
+    spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
+    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
+                  half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
+    contacts = []
+    for i, psi in enumerate(geo.planet_angles):
+        c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
+        phase = zs * psi / (2 * math.pi)
+        contacts += pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", geo.sun_planet, np.zeros(3),
+                                  c_planet, hand=1, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
+                                  phase_offset=phase, **common)
+        contacts += pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", geo.planet_ring, c_planet,
+                                  np.zeros(3), hand=-1, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
+                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
+    return contacts
+
+
+MassSource = Callable[[GearboxSpec, str], MassProperties]
+ReducedSource = Callable[[GearboxSpec, str, str], object]
+
+
+def _exact_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
+    from flexgear.geometry.layout import component_mass_properties
+
+    return component_mass_properties(spec, component)
+
+
+def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
+    from flexgear.fe.reduced import component_reduced_body
+
+    return component_reduced_body(spec, component, level, progress=True)
+
+
+def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
+    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's."""
+    if variant.rigid_mass_properties == "exact":
+        return _exact_mass_source
+    return lambda spec, component: reduced(spec, component, variant.mesh_level).props
+
+
+def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
+                   level: str, props: MassSource, reduced: ReducedSource,
+                   joint: tuple[str, np.ndarray] | None = None) -> Body:
+    """One component as a rigid body or a reduced flexible body of the same geometry.
+
+    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point.
+    """
+    if form == "rigid":
+        return add_rigid_body(mbs, name, props(spec, geometry), position)
+    from flexgear.mbs.flexible import add_flexible_body
+
+    return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
+                             stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
+                             interface_markers={joint[0]: joint[1]} if joint else [], show=False)
+
+
+def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
+                       reduced_source: ReducedSource | None = None) -> GearboxModel:
+    """Assemble the star gearbox of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards).
+
+    Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
+    ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
+    exact); otherwise they are two bodies joined by a fixed joint at their interfaces
+    (flexgear.fe.reduced.JOINT_INTERFACES, at flexgear.fe.reduced.joint_point): a flexible body
+    through its interface node set's RBE3 motion, a rigid one at the point. The input bearing and the
+    drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
+    body when shaft and gear are one), on the frame coordinates at the frame origin (gear mid-plane).
+    Rigid components carry the mass properties of the variant's ``rigid_mass_properties``: "mesh",
+    those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
+    "exact", the exact geometry's; ``mass_source`` overrides both.
+    """
+    from flexgear.fe.reduced import JOINT_INTERFACES, joint_point
+
+    spec = variant.gearbox
+    if spec.gears.arrangement != "star":
+        raise ValueError(f"{spec.source}: field 'gears.arrangement': build_star_gearbox needs 'star'")
+    source = reduced_source or _default_reduced_source
+    loaded: dict[tuple[str, str], object] = {}
+
+    def reduced(spec: GearboxSpec, component: str, level: str):  # each component loaded once per build
+        if (component, level) not in loaded:
+            loaded[component, level] = source(spec, component, level)
+        return loaded[component, level]
+
+    props = mass_source or _mass_source(variant, reduced)
+    form = variant.components
+    th = theory(spec)
+    geo = gear_set_geometry(spec)
+    level = variant.mesh_level
+    bodies: list[Body] = []
+    pairs = []
+    ends = {}
+    for gear, shaft in (("sun", "input_shaft"), ("ring", "output_shaft")):
+        if form[gear] == "rigid" and form[shaft] == "rigid":
+            merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
+            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
+            ends[gear] = gear
+        else:
+            point = joint_point(spec, gear)
+            lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
+                                  (JOINT_INTERFACES[gear], point))
+            other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
+                                   (JOINT_INTERFACES[shaft], point))
+            bodies += [lead, other]
+            pairs.append((lead, other, (JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft]), point))
+            ends[gear] = shaft
+    for i, psi in enumerate(geo.planet_angles):
+        pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
+        bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
+                                     props, reduced))
+    by_body = {bd.name: bd for bd in bodies}
+    joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
+    b = spec.bearings
+    bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
+    bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
+    lc = spec.load_case
+    contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
+    # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
+    train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s,
+                           friction=spec.contact.friction_coefficient > 0.0,
+                           contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
+                           radial_band=spec.gears.normal_module_m)
+    springs = train.springs
+    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s)
+    load = add_load_torque(mbs, by_body[ends["ring"]], -math.copysign(lc.load_torque_nm, th.output_speed),
+                           lc.ramp_time_s)
+    halves = len(helix_halves(geo))
+    per_planet = 2 * halves
+    outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
+    inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
+    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
+                        train.aux_node, ends["sun"], ends["ring"], joints)

@@ -1,0 +1,129 @@
+"""A gear train in an Exudyn system: linear elements, gear contacts, and their per-step updates.
+
+:func:`add_gear_train` is the one assembly step every gearbox shares (the GTF star gearbox of
+flexgear.mbs.gearbox and the examples alike). Given the bodies (rigid or flexible, each on its frame
+node), the linear frame elements (bushings) and the gear contacts, it adds
+
+- one ``ObjectGenericODE2`` with all bushing matrices over the frame coordinates,
+- the contacts (flexgear.mbs.contacts.add_gear_contacts): one auxiliary deflection coordinate each,
+  their linear kinematics (one constraint per gear pair), one compiled impact law each,
+- for flexible gears, the per-step modal columns of the constraint (flexgear.mbs.contact_kinematics),
+- for a rotating carrier, the per-step turning of the contact geometry (flexgear.mbs.carrier),
+- tooth friction as a per-step generalized load (flexgear.mbs.contacts.MeshFriction), if mu > 0,
+
+and chains the pre-step functions. The nominal drive (ramp time, final speed) fixes the mesh phase
+and the nominal angles the updates use.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.mbs.bodies import Body
+from flexgear.mbs.carrier import Carrier, CarrierKinematics
+from flexgear.mbs.contacts import GearContact, MeshConstraint, MeshFriction, add_gear_contacts
+from flexgear.mbs.elements import add_linear_elements
+
+__all__ = ["GearTrain", "add_gear_train", "modal_columns"]
+
+
+@dataclass
+class GearTrain:
+    """Handles of an assembled gear train."""
+
+    bodies: dict[str, Body]
+    contacts: list[GearContact]
+    springs: list[int]  # per contact: spring-damper whose Force output is the normal force [N]
+    aux_node: int  # node of the contacts' deflection coordinates
+    constraint: MeshConstraint  # the linear mesh kinematics (one Exudyn constraint per gear pair)
+    frame_elements: int  # ObjectGenericODE2 of the bushings
+    coordinates_marker: int
+    kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics (flexible gears)
+    carrier: CarrierKinematics | None = None
+    friction: MeshFriction | None = None
+
+    def springs_named(self, prefix: str) -> list[int]:
+        """Spring-dampers of the contacts whose name starts with ``prefix`` (e.g. all helix halves of a mesh)."""
+        out = [s for s, c in zip(self.springs, self.contacts, strict=True) if c.name.startswith(prefix)]
+        if not out:
+            raise KeyError(f"no contact named {prefix!r}...; contacts: {[c.name for c in self.contacts]}")
+        return out
+
+
+def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: int, radial_band: float) -> list:
+    """Contact-deflection coefficients of the flexible gears' modal coordinates (contact_kinematics)."""
+    from flexgear.mbs.contact_kinematics import ModalColumn, modal_contact_coefficients
+
+    columns = []
+    for row, c in enumerate(contacts):
+        for name, sign, spin in ((c.body1, 1.0, c.spin_per_drive_angle[0]), (c.body2, -1.0, c.spin_per_drive_angle[1])):
+            body = bodies[name]
+            if not body.flexible:
+                continue
+            rel = np.asarray(c.point) - body.position
+            values = modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel, c.normal,
+                                                0.5 * c.half_width, radial_band, order)
+            columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
+    return columns
+
+
+def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearContact], ramp_time: float,
+                   drive_speed: float, *, friction: bool = True,
+                   carrier: Carrier | None = None, contact_fourier_order: int = 8,
+                   radial_band: float | None = None) -> GearTrain:
+    """Add the bushings ``elements``, the gear ``contacts`` and their per-step updates for ``bodies``.
+
+    ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
+    (flexgear.mbs.contacts.drive_angle) drives the mesh phase. ``friction``: add tooth friction for
+    contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; rigid gears only).
+    Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
+    from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
+    tooth height). Sets the system's pre-step user function if
+    any update is needed.
+    """
+    by_name = {b.name: b for b in bodies}
+    if len(by_name) != len(bodies):
+        raise ValueError(f"body names must be unique: {[b.name for b in bodies]}")
+    for c in contacts:
+        for name in (c.body1, c.body2):
+            if name not in by_name:
+                raise KeyError(f"contact {c.name!r} names unknown body {name!r}; bodies: {sorted(by_name)}")
+    flexible = [b for b in bodies if b.flexible]
+    if carrier is not None and flexible:
+        raise NotImplementedError("a rotating carrier with flexible bodies is not supported yet: the modal "
+                                  "columns assume contact points fixed in space")
+    offsets, n_total = {}, 6 * len(bodies)
+    for b in flexible:
+        offsets[b.name] = n_total
+        n_total += b.reduced.n_modes
+    frame_elements, coords = add_linear_elements(mbs, bodies, elements)
+    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
+                                                                 offsets, n_total)
+    train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords)
+    pre_steps = [schedule] if schedule is not None else []
+    if flexible and radial_band is None:
+        raise ValueError(f"flexible bodies {[b.name for b in flexible]} need radial_band [m] (about one normal module)")
+    columns = modal_columns(contacts, by_name, contact_fourier_order, radial_band) if flexible else []
+    if columns:
+        from flexgear.mbs.contact_kinematics import ContactKinematics
+
+        train.kinematics = ContactKinematics(constraint, base, columns, offsets, ramp_time, drive_speed)
+        constraint.set(mbs, train.kinematics.matrix_at(0.0))
+        pre_steps.append(train.kinematics)
+    if friction and any(c.friction_coefficient > 0.0 for c in contacts):
+        train.friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, ramp_time, drive_speed)
+    if carrier is not None:
+        extra = [train.friction.sliding_rows] if train.friction is not None else []
+        train.carrier = CarrierKinematics(constraint, base, bodies, carrier, ramp_time, drive_speed, extra)
+        g, offset = train.carrier.matrix_and_offset(0.0)
+        constraint.set(mbs, g, offset)
+        pre_steps.append(train.carrier)  # before friction: friction uses the turned sliding rows
+    if train.friction is not None:
+        pre_steps.append(train.friction)
+    if pre_steps:
+        from flexgear.mbs.contact_kinematics import PreStepChain
+
+        mbs.SetPreStepUserFunction(PreStepChain(pre_steps) if len(pre_steps) > 1 else pre_steps[0])
+    return train

@@ -1,0 +1,1 @@
+"""The PDF screening report: figures and pages."""
