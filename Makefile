@@ -1,10 +1,22 @@
 # flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s), make report
-PY ?= python3
+#
+# Environment: inside an active virtual environment ($VIRTUAL_ENV) make uses it; otherwise it creates
+# .venv with the first Python 3.11-3.13 it finds (PYTHON=/path/to/python3.x chooses one) and installs
+# the project there (pip install -e ".[test]", again only when pyproject.toml changes). Nothing is
+# installed system-wide, so a Python that refuses system-wide installs (Debian's) works too.
+ifdef VIRTUAL_ENV
+VENV ?= $(VIRTUAL_ENV)
+else
+VENV ?= .venv
+endif
+PY := $(VENV)/bin/python
+STAMP := $(VENV)/.flexgear-installed
+PYTHON_CANDIDATES := $(PYTHON) python3 python3.13 python3.12 python3.11 /usr/bin/python3
 VARIANTS := $(sort $(wildcard model_variants/model*.toml))
 QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 RESULTS ?= results
 
-.PHONY: quick install test lint meshes matrix report lpm bench clean
+.PHONY: quick install venv test lint meshes matrix report lpm bench clean distclean
 
 quick: install
 	$(PY) -m flexgear.cli meshes --level coarse
@@ -12,32 +24,42 @@ quick: install
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf
 
-install:
-	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+install: $(STAMP)
 
-lint:
+$(STAMP): pyproject.toml
+	@if [ ! -x "$(PY)" ]; then .ci/make-venv "$(VENV)" $(PYTHON_CANDIDATES); fi
+	@echo "installing flexgear and its dependencies into $(VENV) (pip install -e .[test])"
+	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	@touch $(STAMP)
+
+venv: install
+
+lint: install
 	$(PY) -m ruff check flexgear tests benchmarks examples
 	$(PY) -c "from importlinter.cli import lint_imports; raise SystemExit(lint_imports(no_cache=True, no_logo=True))"
 
 test: lint
 	$(PY) -m pytest -q
 
-meshes:
+meshes: install
 	$(PY) -m flexgear.cli meshes --level coarse
 	$(PY) -m flexgear.cli meshes --level default --no-reduce
 
-matrix:
+matrix: install
 	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
 
-report:
+report: install
 	$(PY) -m flexgear.cli report $(RESULTS)/full --output reports/screening_report.pdf
 
-lpm:
+lpm: install
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
 
-bench:
+bench: install
 	$(PY) benchmarks/bench_rigid.py --repeat 3
 
 clean:
 	rm -rf $(RESULTS) reports/*.pdf
+
+distclean: clean
+	rm -rf .venv

@@ -12,6 +12,7 @@ first use, so ``import flexgear`` stays light.
 
 from importlib import import_module
 
+from flexgear.geometry import feasibility as _feasibility  # noqa: F401  (registers the load-time feasibility checks)
 from flexgear.geometry.involute import Gear, GearMesh, GearSetGeometry, Mesh, gear_set_geometry, solve_profile_shifts
 from flexgear.laws.ramps import step, step_integral
 from flexgear.spec import GearboxSpec, SpecError, Variant, load_gearbox, load_variant, spec_hash

@@ -1,26 +1,49 @@
-"""Command line: ``flexgear run | matrix | lpm | compare | report | meshes``.
+"""Command line: flexgear run | matrix | lpm | compare | report | meshes.
 
-Each subcommand is a thin wrapper over one library function; the heavy modules are imported
-only by the subcommand that needs them.
+Each subcommand is a pair of functions, ``_args_<name>(parser)`` (its arguments, each with help text) and
+``cmd_<name>(args) -> exit code`` (a thin wrapper over one library function), listed in ``SUBCOMMANDS``;
+adding a subcommand is adding one pair and one line there. Heavy modules are imported only by the
+subcommand that needs them. Errors in input files end in one line on stderr and exit code 2.
 """
 
 from __future__ import annotations
 
 import argparse
 import sys
+from collections.abc import Callable
 from pathlib import Path
 
-__all__ = ["main"]
+from flexgear.progress import Progress, say
+
+__all__ = ["main", "SUBCOMMANDS"]
+
+OUT_HELP = "results folder; each run goes to OUT/<variant name>/ (default: %(default)s)"
+T_END_HELP = "simulated time in s (default: end_time_s of the load case)"
 
 
-def _cmd_run(a: argparse.Namespace) -> int:
-    from flexgear.mbs.run import run_variant
-    from flexgear.results import save_result
+# --------------------------------------------------------------------------- run
+def _args_run(p: argparse.ArgumentParser) -> None:
+    p.add_argument("variant", help="variant file (model_variants/model1.toml ...)")
+    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP)
+    p.add_argument("--time-budget", type=float, default=None, metavar="S",
+                   help="wall-time budget in s (default: [solver_assumed] wall_time_budget_s)")
+
+
+def cmd_run(a: argparse.Namespace) -> int:
+    from flexgear.mbs.run import ramp_warning, run_variant
     from flexgear.spec import load_variant
+    from flexgear.study.matrix import make_task, save_task_result
 
     variant = load_variant(a.variant)
-    result = run_variant(variant, t_end_s=a.t_end, progress=True)
-    out = save_result(result, Path(a.out) / variant.name)
+    task = make_task(variant, a.t_end, a.time_budget)
+    warning = ramp_warning(variant, variant.gearbox.load_case.end_time_s if a.t_end is None else a.t_end)
+    if warning:
+        say(f"warning: {variant.name}: {warning}")
+    result = run_variant(variant, t_end_s=a.t_end, progress=True, time_budget_s=a.time_budget)
+    result.meta.update(input_hash=task.input_hash, variant_file=task.variant_file)
+    out = Path(a.out) / variant.name
+    save_task_result(task, result, out)
     print(f"{variant.name}: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.1f} s -> {out}")
     if not result.ok:
         print(f"reason: {result.meta.get('reason')}", file=sys.stderr)
@@ -28,105 +51,185 @@ def _cmd_run(a: argparse.Namespace) -> int:
     return 0
 
 
-def _cmd_matrix(a: argparse.Namespace) -> int:
+# --------------------------------------------------------------------------- matrix
+def _args_matrix(p: argparse.ArgumentParser) -> None:
+    p.add_argument("variants", nargs="+", metavar="VARIANT", help="variant files, one run each")
+    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP + "; finished runs are kept (resume)")
+    p.add_argument("--workers", type=int, default=2, metavar="N",
+                   help="local worker processes (default: %(default)s; ignored with --scheduler)")
+    p.add_argument("--scheduler", default=None, metavar="ADDR",
+                   help="Dask scheduler address, e.g. tcp://host:8786 (default: local processes); workers get the "
+                        "files' content and send the results back")
+    p.add_argument("--time-budget", type=float, default=None, metavar="S",
+                   help="wall-time budget per run in s (default: [solver_assumed] wall_time_budget_s)")
+
+
+def cmd_matrix(a: argparse.Namespace) -> int:
     from flexgear.study.matrix import run_matrix
 
-    table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end,
-                       workers=a.workers, scheduler=a.scheduler, progress=True)
+    table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end, workers=a.workers,
+                       scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget)
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
     return 0
 
 
-def _cmd_lpm(a: argparse.Namespace) -> int:
+# --------------------------------------------------------------------------- lpm
+def _args_lpm(p: argparse.ArgumentParser) -> None:
+    p.add_argument("gearbox", help="gearbox file, or a variant file (its gearbox with its overrides)")
+    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--out", default="results", metavar="DIR",
+                   help="results folder; the run goes to OUT/lumped/ (default: %(default)s)")
+
+
+def cmd_lpm(a: argparse.Namespace) -> int:
     import tomllib
 
     from flexgear.lumped.run import run_lumped
     from flexgear.results import save_result
-    from flexgear.spec import load_gearbox, load_variant
+    from flexgear.spec import SpecError, load_gearbox, load_variant
 
-    with open(a.gearbox, "rb") as fh:  # a gearbox file, or a variant file (its gearbox with its overrides)
-        is_variant = "components" in tomllib.load(fh)
+    try:
+        with open(a.gearbox, "rb") as fh:  # a gearbox file, or a variant file (its gearbox with its overrides)
+            is_variant = "components" in tomllib.load(fh)
+    except (OSError, tomllib.TOMLDecodeError) as exc:
+        raise SpecError(a.gearbox, "<file>", f"cannot be read as TOML ({exc.__class__.__name__})") from None
     spec = load_variant(a.gearbox).gearbox if is_variant else load_gearbox(a.gearbox)
     result = run_lumped(spec, t_end_s=a.t_end, progress=True)
-    out = save_result(result, Path(a.out) / "lumped")
+    out = save_result(result, Path(a.out) / "lumped", inputs={Path(spec.source).name: Path(spec.source).read_bytes()})
     print(f"lumped: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.2f} s -> {out}")
     return 0 if result.ok else 1
 
 
-def _cmd_compare(a: argparse.Namespace) -> int:
-    from flexgear.results import load_result
-    from flexgear.study.compare import compare_results
+# --------------------------------------------------------------------------- compare
+def _args_compare(p: argparse.ArgumentParser) -> None:
+    p.add_argument("a", metavar="A", help="a run folder (holds run.json) or a results folder (holds NAME/run.json)")
+    p.add_argument("b", metavar="B", help="the same kind as A; two results folders compare their common runs")
+    p.add_argument("--out", default=None, metavar="DIR",
+                   help="write table6 and table7 as CSV to DIR (default: print only)")
+    p.add_argument("--allow-unequal", action="store_true",
+                   help="compare runs with different load cases (end time, step, ramps) with a warning, "
+                        "instead of refusing")
 
-    table6, table7 = compare_results(load_result(a.result_a), load_result(a.result_b))
-    print(table6.to_string())
-    print()
-    print(table7.to_string())
+
+def cmd_compare(a: argparse.Namespace) -> int:
+    from flexgear.results import load_result
+    from flexgear.study.compare import compare_results, load_case_differences
+    from flexgear.study.matrix import write_table
+
+    pairs = _run_pairs(Path(a.a), Path(a.b))
+    for label, run_a, run_b in pairs:
+        ra, rb = load_result(run_a), load_result(run_b)
+        diffs = load_case_differences(ra, rb)
+        if diffs and not a.allow_unequal:
+            raise ValueError(f"{run_a} and {run_b} have different load cases ({'; '.join(diffs)}); "
+                             "expected equal ones (or --allow-unequal)")
+        if diffs:
+            say(f"warning: {label}: different load cases ({'; '.join(diffs)})")
+        table6, table7 = compare_results(ra, rb)
+        print(f"{label}\n{table6.to_string()}\n\n{table7.to_string()}\n")
+        if a.out:
+            out = Path(a.out)
+            write_table(table6.reset_index(), out / f"{label}_table6")
+            t7 = table7.copy()
+            t7.columns = [" ".join(map(str, c)) if isinstance(c, tuple) else str(c) for c in t7.columns]
+            write_table(t7.reset_index(), out / f"{label}_table7")
+            print(f"tables -> {out}/{label}_table6.csv, {label}_table7.csv")
     return 0
 
 
-def _cmd_report(a: argparse.Namespace) -> int:
+def _run_pairs(a: Path, b: Path) -> list[tuple[str, Path, Path]]:
+    """(label, run A, run B) from two run folders or two results folders (their common run names)."""
+    def kind(p: Path) -> str:
+        if (p / "run.json").is_file():
+            return "run"
+        if p.is_dir() and any((c / "run.json").is_file() for c in p.iterdir()):
+            return "results"
+        raise FileNotFoundError(f"{p}: expected a run folder (with run.json) or a results folder "
+                                "(with <name>/run.json inside)")
+
+    ka, kb = kind(a), kind(b)
+    if ka != kb:
+        raise ValueError(f"{a} is a {ka} folder, {b} a {kb} folder: expected two of the same kind")
+    if ka == "run":
+        return [(f"{a.name}_vs_{b.name}", a, b)]
+    names = sorted(c.name for c in a.iterdir() if (c / "run.json").is_file() and (b / c.name / "run.json").is_file())
+    if not names:
+        raise ValueError(f"{a} and {b} have no run name in common")
+    return [(n, a / n, b / n) for n in names]
+
+
+# --------------------------------------------------------------------------- report
+def _args_report(p: argparse.ArgumentParser) -> None:
+    p.add_argument("results", help="results folder of a matrix (matrix_results.csv, screening.csv, runs)")
+    p.add_argument("--output", default="reports/screening_report.pdf", metavar="FILE",
+                   help="PDF to write (default: %(default)s)")
+
+
+def cmd_report(a: argparse.Namespace) -> int:
     from flexgear.report.pages import build_report
 
+    if not Path(a.results).is_dir():
+        raise FileNotFoundError(f"{a.results}: expected the results folder of a matrix")
     path = build_report(Path(a.results), Path(a.output))
     print(f"report -> {path}")
     return 0
 
 
-def _cmd_meshes(a: argparse.Namespace) -> int:
-    from flexgear.fe.mesh import build_meshes
+# --------------------------------------------------------------------------- meshes
+def _args_meshes(p: argparse.ArgumentParser) -> None:
+    p.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml",
+                   help="gearbox file (default: %(default)s)")
+    p.add_argument("--level", default="coarse", help="mesh level of gearbox.toml [meshing_assumed] (default: coarse)")
+    p.add_argument("--no-reduce", action="store_true", help="meshes only, no reduced flexible bodies")
+
+
+def cmd_meshes(a: argparse.Namespace) -> int:
+    from flexgear.fe.mesh import component_mesh
     from flexgear.fe.reduced import component_reduced_body
-    from flexgear.spec import GEOMETRY_COMPONENTS, load_gearbox
+    from flexgear.spec import GEOMETRY_COMPONENTS, SpecError, load_gearbox
 
     spec = load_gearbox(a.gearbox)
-    build_meshes(spec, a.level, progress=True)
+    if a.level not in spec.meshing_assumed:
+        raise SpecError(a.gearbox, "meshing_assumed", f"has no level {a.level!r}; levels: "
+                        f"{', '.join(sorted(spec.meshing_assumed))}")
+    with Progress(len(GEOMETRY_COMPONENTS), f"meshes ({a.level})", "parts", fmt="{:.0f}",
+                  plain_step=1 / len(GEOMETRY_COMPONENTS)) as bar:
+        for i, name in enumerate(GEOMETRY_COMPONENTS, 1):
+            mesh = component_mesh(spec, name, a.level)
+            bar.update_to(i, postfix=f"{name}: {mesh.n_elements} tetrahedra, order {mesh.order}")
     if a.no_reduce:
         return 0
-    for component in GEOMETRY_COMPONENTS:
-        body = component_reduced_body(spec, component, a.level, progress=True)
-        print(f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
+    components = GEOMETRY_COMPONENTS
+    with Progress(len(components), f"reduced bodies ({a.level})", "parts", fmt="{:.0f}",
+                  plain_step=1 / len(components)) as bar:
+        for i, component in enumerate(components, 1):
+            body = component_reduced_body(spec, component, a.level)
+            bar.update_to(i, postfix=f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
     return 0
 
 
+# --------------------------------------------------------------------------- parser
+SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = [
+    ("run", "run one variant file with the Exudyn backend", _args_run, cmd_run),
+    ("matrix", "run a matrix of variant files (resumable) and screen them", _args_matrix, cmd_matrix),
+    ("lpm", "run the lumped-parameter model of a gearbox (or variant) file", _args_lpm, cmd_lpm),
+    ("compare", "Tables 6 and 7 of two runs, or of the common runs of two results folders", _args_compare,
+     cmd_compare),
+    ("report", "PDF screening report from saved results", _args_report, cmd_report),
+    ("meshes", "build (or load from the cache) the component meshes and reduced bodies", _args_meshes, cmd_meshes),
+]
+
+
 def _parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="flexgear", description=__doc__.splitlines()[0])
-    sub = p.add_subparsers(dest="command", required=True)
-
-    r = sub.add_parser("run", help="run one variant file with the Exudyn backend")
-    r.add_argument("variant")
-    r.add_argument("--t-end", type=float, default=None, help="simulated time [s] (default: the load case's)")
-    r.add_argument("--out", default="results", help="results folder (default: results)")
-    r.set_defaults(func=_cmd_run)
-
-    m = sub.add_parser("matrix", help="run a matrix of variant files and screen them")
-    m.add_argument("variants", nargs="+")
-    m.add_argument("--t-end", type=float, default=None)
-    m.add_argument("--out", default="results")
-    m.add_argument("--workers", type=int, default=2)
-    m.add_argument("--scheduler", default=None, help="Dask scheduler address (default: local processes)")
-    m.set_defaults(func=_cmd_matrix)
-
-    lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox (or variant) file")
-    lp.add_argument("gearbox")
-    lp.add_argument("--t-end", type=float, default=None)
-    lp.add_argument("--out", default="results")
-    lp.set_defaults(func=_cmd_lpm)
-
-    c = sub.add_parser("compare", help="Tables 6 and 7 from two saved runs")
-    c.add_argument("result_a")
-    c.add_argument("result_b")
-    c.set_defaults(func=_cmd_compare)
-
-    rp = sub.add_parser("report", help="PDF screening report from saved results")
-    rp.add_argument("results")
-    rp.add_argument("--output", default="reports/screening_report.pdf")
-    rp.set_defaults(func=_cmd_report)
-
-    me = sub.add_parser("meshes", help="build (or load from cache) the component meshes and reduced bodies")
-    me.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml")
-    me.add_argument("--level", default="coarse", help="mesh level of gearbox.toml [meshing_assumed] (default: coarse)")
-    me.add_argument("--no-reduce", action="store_true", help="meshes only, no reduced flexible bodies")
-    me.set_defaults(func=_cmd_meshes)
+    p = argparse.ArgumentParser(prog="flexgear", description="Dynamics of geared transmissions on Exudyn: "
+                                "rigid or flexible components, variant matrix, screening report.")
+    sub = p.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    for name, help_text, add_args, func in SUBCOMMANDS:
+        sp = sub.add_parser(name, help=help_text, description=help_text)
+        add_args(sp)
+        sp.set_defaults(func=func)
     return p
 
 
@@ -134,8 +237,9 @@ def main(argv: list[str] | None = None) -> int:
     args = _parser().parse_args(argv)
     try:
         return args.func(args)
-    except (ValueError, FileNotFoundError) as exc:  # SpecError is a ValueError
-        print(f"error: {exc}", file=sys.stderr)
+    except (ValueError, OSError) as exc:  # SpecError is a ValueError; missing/unreadable paths are OSErrors
+        text = " ".join(str(exc).split())
+        print(f"error: {text}", file=sys.stderr)
         return 2
 
 

@@ -3,8 +3,11 @@
 A run directory holds ``run.json`` (metadata: variant, backend, status, configuration and its
 hash, wall and CPU time, theory values, versions) and, for a finished run, ``signals.parquet``:
 one row per recorded step, a ``time_s`` column and one column per signal, each named with its
-unit (see :func:`signal_columns`). Files are written atomically (temporary file + rename), so a
-reader never sees a half-written result.
+unit (see :func:`signal_columns`); ``inputs/`` holds copies of the input files the run was made from.
+Files are written atomically (:func:`flexgear.cache.atomic_write_bytes`: a hidden temporary file in the
+same folder, then a rename), so a reader never sees a half-written result, even when the writer is killed;
+:func:`flexgear.cache.remove_stale_temporaries` deletes what a killed writer left behind. Files are
+readable by others (0644 under the usual umask 022; folders 0755).
 """
 
 from __future__ import annotations
@@ -58,10 +61,15 @@ class RunResult:
 
 
 
-def save_result(result: RunResult, run_dir: str | Path) -> Path:
-    """Write ``signals.parquet`` (if any), extra tables and then ``run.json`` into ``run_dir``."""
+def save_result(result: RunResult, run_dir: str | Path, inputs: dict[str, bytes] | None = None) -> Path:
+    """Write ``inputs/<file>`` (copies of the input files), ``signals.parquet`` (if any), extra tables and
+    then ``run.json`` into ``run_dir``: a run folder with a ``run.json`` is complete."""
     run_dir = Path(run_dir)
     run_dir.mkdir(parents=True, exist_ok=True)
+    if inputs:
+        for name, data in inputs.items():
+            atomic_write_bytes(run_dir / "inputs" / name, data)
+        result.meta["inputs"] = {k: f"inputs/{k}" for k in inputs}
     if result.signals is not None:
         atomic_write_bytes(run_dir / "signals.parquet", result.signals.to_parquet(index=False))
     for name, table in result.extra.items():

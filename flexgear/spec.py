@@ -17,9 +17,35 @@ import hashlib
 import json
 import math
 import tomllib
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any, get_type_hints
+
+from flexgear.schema import (
+    COMPONENT_GEOMETRY,
+    COMPONENTS,
+    GEAR_COMPONENTS,
+    GEOMETRY_COMPONENTS,
+    SHAFT_COMPONENTS,
+    Bearing,
+    Bearings,
+    ComponentsAssumed,
+    Contact,
+    ContactAssumed,
+    GearboxSpec,
+    GearSet,
+    GearSetAssumed,
+    IndicatorWeights,
+    LoadCase,
+    LumpedAssumed,
+    Material,
+    MeshingSettings,
+    ReductionSettings,
+    ScreeningSettings,
+    SolverSettings,
+    SpecError,
+    Variant,
+)
 
 __all__ = [
     "SpecError",
@@ -49,332 +75,33 @@ __all__ = [
     "load_variant",
     "spec_hash",
     "as_dict",
+    "register_feasibility_check",
 ]
-
-COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
-"""Component names of Table 3, in its column order (a variant sets each rigid or flexible)."""
-
-GEAR_COMPONENTS = ("sun", "planet", "ring")
-SHAFT_COMPONENTS = ("input_shaft", "output_shaft")
-GEOMETRY_COMPONENTS = GEAR_COMPONENTS + SHAFT_COMPONENTS
-"""Distinct component geometries (one planet geometry serves every planet)."""
-
-COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"}
-"""Table 3 component (or geometry) name -> its geometry name."""
-
-
-class SpecError(ValueError):
-    """A specification file is wrong: the message names the file, the field and what is allowed."""
-
-    def __init__(self, path: str | Path, fieldname: str, allowed: str, got: Any = None):
-        self.path, self.field, self.allowed = str(path), fieldname, allowed
-        got_text = "" if got is None else f", got {got!r}"
-        super().__init__(f"{path}: field '{fieldname}': {allowed}{got_text}")
-
-
-def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
-         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
-    """Field with a numeric range check (validated on load); optional when ``default`` is given."""
-    return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
-
-
-def _choice(*choices: str, doc: str = "") -> Any:
-    return field(metadata={"choices": choices, "doc": doc})
-
-
-def _text(doc: str = "", default: str | None = None) -> Any:
-    if default is None:
-        return field(metadata={"doc": doc})
-    return field(default=default, metadata={"doc": doc})
-
-
-# --------------------------------------------------------------------------- gearbox tables
-@dataclass(frozen=True)
-class GearSet:
-    """Table 1 of the study (and the planet count and arrangement of section 2.1)."""
-
-    sun_teeth: int = _num(3, integer=True)
-    planet_teeth: int = _num(3, integer=True)
-    ring_teeth: int = _num(3, integer=True)
-    planet_count: int = _num(1, 12, integer=True)
-    normal_module_mm: float = _num(0.0, lo_open=True)
-    helix_angle_deg: float = _num(0.0, 45.0)
-    normal_pressure_angle_deg: float = _num(10.0, 30.0)
-    arrangement: str = _choice("star", "planetary")
-
-    @property
-    def normal_module_m(self) -> float:
-        return self.normal_module_mm * 1e-3
-
-    @property
-    def helix_angle_rad(self) -> float:
-        return math.radians(self.helix_angle_deg)
-
-    @property
-    def normal_pressure_angle_rad(self) -> float:
-        return math.radians(self.normal_pressure_angle_deg)
-
-
-@dataclass(frozen=True)
-class GearSetAssumed:
-    """Gear data the study does not give (documented in gearbox.toml)."""
-
-    face_width_mm: float = _num(0.0, lo_open=True)
-    helix_layout: str = _choice("double", "single")
-    half_gap_mm: float = _num(0.0)
-    operating_centre_distance_mm: float = _num(0.0)
-    planet_shift_coefficient: float = _num(-1.0, 1.5)
-    addendum_coefficient: float = _num(0.5, 1.5)
-    dedendum_coefficient: float = _num(0.8, 2.0)
-    root_fillet_coefficient: float = _num(0.0, 0.6)
-    normal_backlash_mm: float = _num(0.0)
-    outer_inner_mesh_phase: float = _num(0.0, 1.0)
-
-    @property
-    def face_width_m(self) -> float:
-        return self.face_width_mm * 1e-3
-
-    @property
-    def half_gap_m(self) -> float:
-        return self.half_gap_mm * 1e-3
-
-    @property
-    def operating_centre_distance_m(self) -> float:
-        return self.operating_centre_distance_mm * 1e-3
-
-    @property
-    def normal_backlash_m(self) -> float:
-        return self.normal_backlash_mm * 1e-3
-
-
-@dataclass(frozen=True)
-class Material:
-    """Gear and shaft material (assumed: through-hardened gear steel)."""
-
-    density_kg_m3: float = _num(0.0, lo_open=True)
-    youngs_modulus_pa: float = _num(0.0, lo_open=True)
-    poisson_ratio: float = _num(0.0, 0.5)
-
-
-@dataclass(frozen=True)
-class ComponentsAssumed:
-    """Bores, rim and shaft dimensions (assumed: the study gives no drawing)."""
-
-    sun_bore_diameter_mm: float = _num(0.0, lo_open=True)
-    planet_bore_diameter_mm: float = _num(0.0, lo_open=True)
-    ring_rim_thickness_mm: float = _num(0.0, lo_open=True)
-    ring_flange_outer_diameter_mm: float = _num(0.0, lo_open=True)
-    ring_flange_thickness_mm: float = _num(0.0, lo_open=True)
-    ring_bolt_count: int = _num(1, integer=True)
-    ring_bolt_hole_diameter_mm: float = _num(0.0, lo_open=True)
-    input_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
-    input_shaft_inner_diameter_mm: float = _num(0.0)
-    input_shaft_length_mm: float = _num(0.0, lo_open=True)
-    output_shaft_outer_diameter_mm: float = _num(0.0, lo_open=True)
-    output_shaft_inner_diameter_mm: float = _num(0.0)
-    output_shaft_length_mm: float = _num(0.0, lo_open=True)
-    # geometry details (flexgear.geometry.layout); defaults keep older gearbox files valid
-    relief_groove_depth_mm: float = field(default=1.0, metadata={"lo": 0.0, "doc": "mm beyond the root circle"})
-    bearing_seat_width_mm: float = field(default=20.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
-
-
-@dataclass(frozen=True)
-class Bearing:
-    """One bearing (bushing) of Table 2.
-
-    The study's "torsional stiffness" is read as the tilting stiffness about the two axes
-    normal to the shaft (N·m/rad): a bearing leaves the spin free. Damping is assumed
-    stiffness-proportional, c = k · damping_per_stiffness_s.
-    """
-
-    radial_stiffness_n_per_m: float = _num(0.0)
-    axial_stiffness_n_per_m: float = _num(0.0)
-    tilt_stiffness_nm_per_rad: float = _num(0.0)
-    damping_per_stiffness_s: float = _num(0.0)
-
-
-@dataclass(frozen=True)
-class Bearings:
-    """Table 2: input-shaft, output-shaft and planet bearings."""
-
-    input_shaft: Bearing
-    output_shaft: Bearing
-    planet: Bearing
-
-
-@dataclass(frozen=True)
-class Contact:
-    """Gear contact of section 2.1 (ADAMS impact function), one value for both mesh types."""
-
-    stiffness: float = _num(0.0, lo_open=True, doc="N/m^exponent")
-    exponent: float = _num(1.0, 3.0)
-    damping_fraction_of_stiffness: float = _num(0.0)
-    penetration_depth_m: float = _num(0.0, lo_open=True)
-    friction_coefficient: float = _num(0.0, 1.0)
-
-
-@dataclass(frozen=True)
-class ContactAssumed:
-    """Contact modelling choices the study does not give."""
-
-    stiffness_harmonics: int = _num(0, 10, integer=True)
-    stiffness_variation: str = _choice("contact_lines", "constant")
-    friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
-
-
-@dataclass(frozen=True)
-class LoadCase:
-    """Table 5: input speed and load torque as STEP ramps."""
-
-    input_speed_rpm: float = _num()
-    load_torque_nm: float = _num()
-    ramp_time_s: float = _num(0.0, lo_open=True)
-    end_time_s: float = _num(0.0, lo_open=True)
-    step_size_s: float = _num(0.0, lo_open=True)
-
-    @property
-    def input_speed_rad_s(self) -> float:
-        return self.input_speed_rpm * 2.0 * math.pi / 60.0
-
-
-@dataclass(frozen=True)
-class SolverSettings:
-    """Time-integration settings (assumed; the study used ADAMS GSTIFF)."""
-
-    spectral_radius: float = _num(0.0, 1.0)
-    newton_max_modified_iterations: int = _num(1, 50, integer=True)
-    newton_relative_tolerance: float = _num(0.0, 1e-2, lo_open=True)
-    linear_solver: str = _choice("sparse", "dense")
-    record_every_steps: int = _num(1, integer=True)
-
-
-@dataclass(frozen=True)
-class MeshingSettings:
-    """Mesh sizes per level (assumed)."""
-
-    tooth_size_mm: float = _num(0.0, lo_open=True)
-    body_size_mm: float = _num(0.0, lo_open=True)
-    element_order: int = _num(1, 2, integer=True)
-    # Netgen curvaturesafety: element size <= curvature radius / this on curved faces and edges.
-    elements_per_curvature_radius: float = _num(0.0, lo_open=True, default=0.3)
-    # Netgen optsteps2d and optsteps3d: smoothing/swapping passes after surface and volume meshing.
-    optimisation_steps: int = _num(0, 10, integer=True, default=3)
-
-
-@dataclass(frozen=True)
-class ReductionSettings:
-    """Component-mode synthesis settings for flexible bodies (assumed)."""
-
-    fixed_interface_modes: int = _num(0, 200, integer=True)
-    interface: str = _choice("rbe3", "rbe2")
-    simulation_modes: int = _num(1, 200, integer=True)
-    modal_stiffness_damping_s: float = _num(0.0)
-    contact_fourier_order: int = _num(1, 60, integer=True)
-
-
-@dataclass(frozen=True)
-class IndicatorWeights:
-    """Weights of the study's five screening indicators in the composite point (sum 1).
-
-    Section 2.2: "taking 20 % of each of the five simulation indicators".
-    """
-
-    input_speed: float = _num(0.0, 1.0)
-    output_speed: float = _num(0.0, 1.0)
-    transmission_ratio: float = _num(0.0, 1.0)
-    outer_mesh_force: float = _num(0.0, 1.0)
-    inner_mesh_force: float = _num(0.0, 1.0)
-
-
-@dataclass(frozen=True)
-class ScreeningSettings:
-    """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
-
-    See ``[screening]`` in gearbox.toml and :mod:`flexgear.study.screening` for each value's meaning.
-    """
-
-    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
-    lines: str = _choice("westgard", "six_sigma")
-    window: str = _choice("after_ramps", "fixed")
-    after_ramp_delay_s: float = _num(0.0)
-    window_start_s: float = _num(0.0)
-    window_end_s: float = _num(0.0, lo_open=True)
-    short_run_fraction: float = _num(0.0, 1.0, lo_open=True)
-    sample_count: int = _num(2, 10000, integer=True)
-    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
-    weights: IndicatorWeights
-
-
-@dataclass(frozen=True)
-class LumpedAssumed:
-    """Lumped-parameter model only (flexgear.lumped.run, section 2.3): values the study does not give.
-
-    See ``[lumped_assumed]`` in gearbox.toml for each value's source.
-    """
-
-    mesh_stiffness_per_width_n_per_mm_um: float = _num(0.0, lo_open=True, doc="C_gamma of eq. 10")
-    mesh_damping_ratio: float = _num(0.0, 1.0, doc="xi of eq. 13")
-    integration_substeps: int = _num(1, 64, integer=True)
-    friction_table_points: int = _num(16, 65536, integer=True)
-    carrier_mass_kg: float = _num(0.0, lo_open=True)
-    carrier_inertia_kg_m2: float = _num(0.0, lo_open=True)
-
-    @property
-    def mesh_stiffness_per_width_n_per_m2(self) -> float:
-        """C_gamma in SI: 1 N/(mm um) = 1e9 N/m^2."""
-        return self.mesh_stiffness_per_width_n_per_mm_um * 1e9
-
-
-@dataclass(frozen=True)
-class GearboxSpec:
-    """The whole gearbox: the study's tables plus documented assumptions."""
-
-    source: Path
-    title: str
-    gears: GearSet
-    gears_assumed: GearSetAssumed
-    material_assumed: Material
-    components_assumed: ComponentsAssumed
-    bearings: Bearings
-    contact: Contact
-    contact_assumed: ContactAssumed
-    load_case: LoadCase
-    solver_assumed: SolverSettings
-    meshing_assumed: dict[str, MeshingSettings]
-    reduction_assumed: ReductionSettings
-    screening: ScreeningSettings
-    lumped_assumed: LumpedAssumed
-
-    def with_changes(self, **tables: Any) -> GearboxSpec:
-        """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
-        return dataclasses.replace(self, **tables)
-
-
-@dataclass(frozen=True)
-class Variant:
-    """One row of Table 3: the gearbox plus rigid/flexible per component."""
-
-    source: Path
-    name: str
-    gearbox: GearboxSpec
-    components: dict[str, str]
-    mesh_level: str = "default"
-    # Mass properties of the rigid components: "mesh" = those of the reduced flexible body built from
-    # the same mesh at mesh_level (rigid and flexible twins identical, the variant matrix compares like
-    # with like); "exact" = the exact geometry's volume integrals (no mesh needed).
-    rigid_mass_properties: str = "mesh"
-
-    def is_rigid(self) -> bool:
-        return all(v == "rigid" for v in self.components.values())
 
 
 # --------------------------------------------------------------------------- loading
-def _read_toml(path: Path) -> dict[str, Any]:
+_FEASIBILITY: list[Callable[[GearboxSpec], None]] = []
+
+
+def register_feasibility_check(check: Callable[[GearboxSpec], None]) -> None:
+    """Run ``check(spec)`` on every loaded gearbox (it raises SpecError); see :mod:`flexgear.geometry.feasibility`."""
+    if check not in _FEASIBILITY:
+        _FEASIBILITY.append(check)
+
+
+def _read_toml(path: Path, text: str | None = None) -> dict[str, Any]:
+    """The TOML table of ``path``, or of ``text`` when given (``path`` then only names it in errors)."""
     try:
+        if text is not None:
+            return tomllib.loads(text)
         with open(path, "rb") as fh:
             return tomllib.load(fh)
     except FileNotFoundError:
         raise SpecError(path, "<file>", "file does not exist") from None
+    except IsADirectoryError:
+        raise SpecError(path, "<file>", "is a folder; expected a TOML file") from None
+    except (PermissionError, UnicodeDecodeError) as exc:
+        raise SpecError(path, "<file>", f"cannot be read ({exc.__class__.__name__})") from None
     except tomllib.TOMLDecodeError as exc:
         raise SpecError(path, "<file>", f"is not valid TOML ({exc})") from None
 
@@ -426,10 +153,14 @@ def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
     return cls(**values)
 
 
-def load_gearbox(path: str | Path) -> GearboxSpec:
-    """Load and validate a gearbox TOML file (see ``model_variants/gearbox.toml``)."""
+def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
+    """Load and validate a gearbox TOML file (see ``model_variants/gearbox.toml``).
+
+    ``text``: the file's content, already read (``path`` then only names it in messages). Every field
+    is checked, then the consistency of the tables and the geometric feasibility (:mod:`flexgear.geometry.feasibility`).
+    """
     path = Path(path)
-    raw = _read_toml(path)
+    raw = _read_toml(path, text)
     tables = {f.name for f in dataclasses.fields(GearboxSpec)} - {"source"}
     unknown = sorted(set(raw) - set(tables))
     if unknown:
@@ -452,6 +183,8 @@ def load_gearbox(path: str | Path) -> GearboxSpec:
     }
     spec = GearboxSpec(**kwargs)
     _check_consistency(spec)
+    for check in _FEASIBILITY:
+        check(spec)
     return spec
 
 
@@ -471,6 +204,9 @@ def _check_consistency(spec: GearboxSpec) -> None:
     if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
         raise SpecError(p, "screening.window_end_s", "expected a value > window_start_s",
                         spec.screening.window_end_s)
+    lc = spec.load_case
+    if lc.step_size_s >= min(lc.end_time_s, lc.ramp_time_s):
+        raise SpecError(p, "load_case.step_size_s", "expected < ramp_time_s and < end_time_s", lc.step_size_s)
     for level, m in spec.meshing_assumed.items():
         if m.body_size_mm < m.tooth_size_mm:
             raise SpecError(p, f"meshing_assumed.{level}.body_size_mm", "expected >= tooth_size_mm",
@@ -495,14 +231,41 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
     return gearbox.with_changes(**changes)
 
 
-def load_variant(path: str | Path) -> Variant:
+def _variant_gearbox(path: Path, raw: dict[str, Any], gearbox_text: str | None) -> GearboxSpec:
+    """The variant's gearbox with its overrides, validated; an infeasible override names the variant file."""
+    if not isinstance(raw["gearbox"], str) or not raw["gearbox"]:
+        raise SpecError(path, "gearbox", "expected a path (string) relative to this file", raw["gearbox"])
+    gearbox_path = path.parent / raw["gearbox"]
+    if gearbox_text is None and gearbox_path.is_dir():
+        raise SpecError(path, "gearbox", f"is a folder ({gearbox_path}); expected a TOML file", raw["gearbox"])
+    if gearbox_text is None and not gearbox_path.exists():
+        raise SpecError(path, "gearbox", f"file does not exist ({gearbox_path})", raw["gearbox"])
+    gearbox = load_gearbox(gearbox_path, gearbox_text)
+    if "overrides" not in raw:
+        return gearbox
+    gearbox = _apply_overrides(gearbox, raw["overrides"], path)
+    try:
+        _check_consistency(gearbox)
+        for check in _FEASIBILITY:
+            check(gearbox)
+    except SpecError as exc:
+        table, _, name = exc.field.partition(".")
+        if name.split(".")[0] in raw["overrides"].get(table, {}):
+            raise SpecError(path, f"overrides.{exc.field}", str(exc).split(f"'{exc.field}': ", 1)[1]) from None
+        raise SpecError(path, "overrides", f"make the gearbox infeasible: {exc}") from None
+    return gearbox
+
+
+def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | None = None) -> Variant:
     """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible.
 
     Optional ``[overrides.<table>]`` replace single fields of the gearbox's tables for this variant
-    (e.g. a shortened ``load_case`` for a quick run), validated like the gearbox file.
+    (e.g. a shortened ``load_case`` for a quick run), validated like the gearbox file. ``text`` and
+    ``gearbox_text``: the two files' contents, already read (e.g. shipped to a worker without the files);
+    the paths then only name them in messages.
     """
     path = Path(path)
-    raw = _read_toml(path)
+    raw = _read_toml(path, text)
     allowed = {"name", "gearbox", "components", "mesh_level", "rigid_mass_properties", "description", "overrides"}
     unknown = sorted(set(raw) - allowed)
     if unknown:
@@ -510,11 +273,7 @@ def load_variant(path: str | Path) -> Variant:
     for key in ("name", "gearbox", "components"):
         if key not in raw:
             raise SpecError(path, key, "missing (required)")
-    if not isinstance(raw["gearbox"], str):
-        raise SpecError(path, "gearbox", "expected a path (string) relative to this file", raw["gearbox"])
-    gearbox = load_gearbox(path.parent / raw["gearbox"])
-    if "overrides" in raw:
-        gearbox = _apply_overrides(gearbox, raw["overrides"], path)
+    gearbox = _variant_gearbox(path, raw, gearbox_text)
     comps = raw["components"]
     if not isinstance(comps, dict):
         raise SpecError(path, "components", "expected a table")

@@ -14,6 +14,8 @@ mesh cycles per block (zero mean in each block). So the Bias % is 100 |bias| and
 from __future__ import annotations
 
 import os
+import time
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -22,7 +24,7 @@ from flexgear.results import RunResult, signal_columns
 from flexgear.spec import load_gearbox
 from flexgear.theory import theory
 
-GEARBOX = "model_variants/gearbox.toml"
+GEARBOX = str(Path(__file__).resolve().parents[1] / "model_variants" / "gearbox.toml")
 DT = 2.0**-17
 RAMP = 0.5
 SEGMENTS = 10
@@ -97,8 +99,16 @@ def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -
 
     More flexible components give a smaller bias and a longer time, as in the study. A variant
     named "boom" raises like a failing solver, "crash" kills its worker process, and "diverge"
-    returns a failed result.
+    returns a failed result. One whose name starts with "slow" writes its process id to
+    ``$FLEXGEAR_TEST_PID_DIR/<name>.pid`` and sleeps ``$FLEXGEAR_TEST_SLOW_S`` seconds (for kill tests).
+    Every result records the worker's working directory and cache folder.
     """
+    if variant.name.startswith("slow"):
+        pid_dir = os.environ.get("FLEXGEAR_TEST_PID_DIR")
+        if pid_dir:
+            with open(os.path.join(pid_dir, f"{variant.name}.pid"), "a") as fh:
+                fh.write(f"{os.getpid()}\n")
+        time.sleep(float(os.environ.get("FLEXGEAR_TEST_SLOW_S", "0")))
     if variant.name == "boom":
         raise RuntimeError("solver blew up")
     if variant.name == "crash":
@@ -109,5 +119,6 @@ def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -
     keys = ("output_speed", "outer_mesh_force", "inner_mesh_force")
     res = synthetic_result(variant.name, dict.fromkeys(keys, 0.01 / (1 + flex)), dict.fromkeys(keys, 0.002),
                            wall_time_s=1.0 + flex)
-    res.meta.update(components=dict(variant.components), t_end_s=t_end_s)
+    res.meta.update(components=dict(variant.components), t_end_s=t_end_s, worker_cwd=os.getcwd(),
+                    worker_cache=os.environ.get("FLEXGEAR_CACHE_DIR", ""))
     return res

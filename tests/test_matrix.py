@@ -93,15 +93,54 @@ def test_resume_skips_unchanged_runs(variants, tmp_path):
     assert not changed["resumed"].any()
 
 
-def test_dask_local_cluster(variants, tmp_path):
+def _confine(workdir: str, forbidden: list[str]) -> str:
+    """On a Dask worker: run in ``workdir`` and refuse any file access under ``forbidden`` (the caller's
+    variant files and output folder), as on a cluster node that does not share the caller's disk."""
+    import os
+    import sys
+
+    roots = [os.path.realpath(f) for f in forbidden]
+
+    def hook(event: str, args: tuple) -> None:
+        if event in ("open", "os.rename", "os.replace", "os.mkdir", "os.remove", "os.listdir", "os.scandir"):
+            for arg in args[:2]:
+                if isinstance(arg, (str, bytes, os.PathLike)):
+                    path = os.path.realpath(os.fsdecode(arg))
+                    if any(path == r or path.startswith(r + os.sep) for r in roots):
+                        raise PermissionError(f"worker may not touch {path}")
+
+    os.chdir(workdir)
+    sys.addaudithook(hook)
+    return os.getcwd()
+
+
+def test_dask_workers_get_content_not_paths_and_the_caller_writes(variants, tmp_path, tmp_path_factory):
+    """Workers in another working directory and cache folder, unable to read the variant files or to write
+    the output folder: the runs still succeed and every result lands in the caller's folder."""
     distributed = pytest.importorskip("distributed")
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                                  dashboard_address=None) as cluster:
-        table = run_matrix([variants["rigid"], variants["flex"], variants["boom"]], tmp_path / "d", t_end_s=0.6,
+    remote = tmp_path_factory.mktemp("worker_node")
+    cache = remote / "cache"
+    out = tmp_path / "d"
+    forbidden = [str(variants["rigid"]), str(variants["flex"]), str(variants["boom"]), str(tmp_path / "gearbox.toml"),
+                 str(out)]
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None,
+                                  local_directory=str(remote), env={"FLEXGEAR_CACHE_DIR": str(cache)}) as cluster:
+        with distributed.Client(cluster) as client:
+            cwds = client.run(_confine, str(remote), forbidden)
+            assert set(cwds.values()) == {str(remote)}
+            blocked = client.submit(lambda p: open(p).read(), str(variants["rigid"]), pure=False)
+            with pytest.raises(PermissionError):
+                blocked.result()
+        table = run_matrix([variants["rigid"], variants["flex"], variants["boom"]], out, t_end_s=0.6,
                            scheduler=cluster.scheduler_address, progress=False, runner=fake_runner)
     status = dict(zip(table["variant"], table["status"], strict=True))
     assert status == {"rigid": "ok", "flex": "ok", "boom": "failed"}
     assert table.loc[table["variant"] == "flex", "selected"].item()
+    for name in ("rigid", "flex"):
+        saved = load_result(out / name)
+        assert saved.ok and len(saved.signals) > 1000
+        assert saved.meta["worker_cwd"] == str(remote) and saved.meta["worker_cache"] == str(cache)
+        assert (out / name / "inputs" / "gearbox.toml").read_text() == (tmp_path / "gearbox.toml").read_text()
 
 
 def test_quick_matrix_end_to_end_with_the_exudyn_backend(tmp_path):

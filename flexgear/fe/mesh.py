@@ -23,8 +23,9 @@ from __future__ import annotations
 
 import io
 import json
-import sys
+import os
 import time
+import uuid
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -34,6 +35,7 @@ import trimesh
 from flexgear.cache import atomic_write_bytes, cache_dir
 from flexgear.geometry.layout import component_layout, exact_mass_properties, geometry_hash
 from flexgear.geometry.massprops import MassProperties
+from flexgear.progress import say
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = [
@@ -97,6 +99,12 @@ class ComponentMesh:
         return mesh
 
 
+def _private_temporary(path: Path, suffix: str) -> Path:
+    """A temporary name next to ``path``, unique to this process and call (two workers building the same
+    cache entry must not write into one file), ending in ``suffix`` (the writers choose the format by it)."""
+    return path.with_name(f".{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{suffix}")
+
+
 def component_brep(spec: GearboxSpec, component: str, progress: bool = False) -> Path:
     """Path of the cached OCC solid (``.brep``) of ``component``; built on a cache miss."""
     path = cache_dir() / f"solid-{component}-{geometry_hash(spec, component)}.brep"
@@ -105,7 +113,7 @@ def component_brep(spec: GearboxSpec, component: str, progress: bool = False) ->
 
         t0 = time.perf_counter()
         shape = component_solid(spec, component)
-        tmp = path.with_suffix(".tmp.brep")
+        tmp = _private_temporary(path, ".brep")
         shape.WriteBrep(str(tmp))
         tmp.replace(path)
         _say(progress, f"  {component}: solid built in {time.perf_counter() - t0:.1f} s")
@@ -114,7 +122,7 @@ def component_brep(spec: GearboxSpec, component: str, progress: bool = False) ->
 
 def _say(progress: bool, text: str) -> None:
     if progress:
-        print(text, file=sys.stderr, flush=True)
+        say(text)
 
 
 def _refine_teeth(geo, spec: GearboxSpec, component: str, size: float, mp) -> None:
@@ -249,7 +257,7 @@ def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", ord
     surface = _orient_outward(nodes, surface)
     regions = region_nodes(spec, component, nodes, np.unique(surface))
     mesh = ComponentMesh(component, level, order, nodes, elements, surface, regions, build, paths["vol"], brep)
-    tmp_vol = paths["vol"].with_name(paths["vol"].name + ".tmp.vol.gz")
+    tmp_vol = _private_temporary(paths["vol"], ".vol.gz")
     ngmesh.Save(str(tmp_vol))
     tmp_vol.replace(paths["vol"])
     buf = io.BytesIO()
@@ -260,8 +268,9 @@ def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", ord
             "elements": mesh.n_elements, "build_time_s": build,
             "regions": {k: len(v) for k, v in regions.items()}}
     atomic_write_bytes(paths["json"], json.dumps(info, indent=1).encode())
-    _say(progress, f"  {component}: {mesh.n_elements} tetrahedra, {mesh.n_nodes} nodes, order {order}, "
-                   f"meshed in {build:.1f} s")
+    role = "" if order == spec.meshing_assumed[level].element_order else " (topology for the reduction)"
+    _say(progress, f"  {component} ({level}): {mesh.n_elements} tetrahedra, {mesh.n_nodes} nodes, "
+                   f"order {order}{role}, meshed in {build:.1f} s")
     return mesh
 
 

@@ -21,6 +21,7 @@ import numpy as np
 from flexgear.cache import atomic_write_bytes, cache_dir
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.geometry.layout import component_layout, geometry_hash
+from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_reduced_body", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
@@ -104,7 +105,8 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
         from flexgear.fe.mesh import component_mesh
 
         if progress:
-            print(f"[flexgear] building reduced body of {name} ({level} mesh) ...", flush=True)
+            say(f"  {name} ({level}): building the reduced body (order-{mesh_settings.element_order} FE model "
+                "on the first-order mesh topology)")
         # first-order mesh topology; fe_model raises the order itself (a second-order Netgen mesh loaded
         # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
         mesh = component_mesh(spec, name, level, order=1, progress=progress)

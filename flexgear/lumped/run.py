@@ -29,7 +29,6 @@ study's set (~8 kHz) gives omega h << 2.8, well inside RK4's stability region.
 from __future__ import annotations
 
 import math
-import sys
 import time
 from dataclasses import dataclass
 
@@ -40,6 +39,7 @@ import pandas as pd
 from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
 from flexgear.laws.compiled import backlash_linear_force, ramp_state
 from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
+from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import GearboxSpec, spec_hash
 from flexgear.theory import theory
@@ -306,14 +306,12 @@ def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, pro
     args = _kernel_args(model)
     chunk = max(1, n_steps // 20)
     done = 0
-    while done < n_steps:
-        k = min(chunk, n_steps - done)
-        y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], *args)
-        done += k
-        if progress:
-            print(f"\rlumped: t = {done * h_out:.4f} / {t_end:.4f} s", end="", file=sys.stderr, flush=True)
-    if progress:
-        print(file=sys.stderr)
+    with Progress(t_end, "lumped", "s", enabled=progress, fmt="{:.4g}") as bar:
+        while done < n_steps:
+            k = min(chunk, n_steps - done)
+            y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], *args)
+            done += k
+            bar.update_to(done * h_out)
     _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], *args)  # record the final state
     return rec
 

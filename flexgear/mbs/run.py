@@ -3,6 +3,13 @@
 Solver: generalized-alpha (spectral radius from ``[solver_assumed]``), modified Newton with a
 Jacobian update after at most ``newton_max_modified_iterations`` iterations, dense linear solver,
 one thread, no solution file; sensors store every ``record_every_steps``-th step in memory.
+
+Divergence guard (:class:`RunGuard`, a post-step user function): the run stops and is recorded as
+failed, with its reason, when the state is not finite (NaN), when a shaft spins faster than
+``runaway_speed_factor`` times its nominal speed (a runaway), when the wall time exceeds
+``wall_time_budget_s`` (all three in ``[solver_assumed]``), or when Newton's method fails (Exudyn's
+own error). Exudyn's console output (its per-run banner and step lines) is switched off; the guard
+drives a :class:`flexgear.progress.Progress` display instead.
 """
 
 from __future__ import annotations
@@ -16,10 +23,14 @@ import pandas as pd
 
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
+from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import Variant, as_dict, spec_hash
 
-__all__ = ["run_variant"]
+__all__ = ["GUARD_EVERY_STEPS", "RunGuard", "ramp_warning", "run_variant"]
+
+GUARD_EVERY_STEPS = 50
+"""Steps between two checks of the divergence guard (each reads two node velocities and the clock)."""
 
 
 def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
@@ -76,15 +87,109 @@ def _meta(variant: Variant, t_end: float) -> dict:
                         source=str(variant.source), spec=as_dict(gb))
 
 
+class RunGuard:
+    """Post-step user function of one run: divergence guard, wall-time budget and progress display.
+
+    Every ``GUARD_EVERY_STEPS`` steps it reads the spin speed of the input and output body; it stops
+    the solver (returns False) with :attr:`reason` set when a speed is not finite, when
+    |omega| > runaway_speed_factor * |omega_nominal| (omega_nominal: the load case's speed and its theory
+    ratio), or when the wall time since construction exceeds ``budget_s``.
+    """
+
+    def __init__(self, model: GearboxModel, variant: Variant, t_end: float, budget_s: float,
+                 progress: bool = False) -> None:
+        from flexgear.theory import theory
+
+        th = theory(variant.gearbox)
+        factor = variant.gearbox.solver_assumed.runaway_speed_factor
+        self.nodes = {"input": model.bodies[model.input_body].node, "output": model.bodies[model.output_body].node}
+        self.limits = {"input": factor * abs(math.radians(th.input_speed_deg_per_s)),
+                       "output": factor * abs(math.radians(th.output_speed_deg_per_s))}
+        self.budget_s, self.t_end = budget_s, t_end
+        self.reason = ""
+        self.steps = 0
+        self.t0 = time.perf_counter()
+        self.bar = Progress(t_end, f"run {variant.name}", "s", enabled=progress, fmt="{:.4g}")
+
+    def __call__(self, mbs, t: float) -> bool:
+        self.steps += 1
+        if self.steps % GUARD_EVERY_STEPS:
+            return True
+        import exudyn as exu
+
+        for side, node in self.nodes.items():
+            w = float(mbs.GetNodeOutput(node, exu.OutputVariableType.AngularVelocity)[2])
+            if not math.isfinite(w):
+                self.reason = f"diverged: non-finite {side} speed at t = {t:.6g} s"
+            elif abs(w) > self.limits[side]:
+                self.reason = (f"diverged: {side} speed {abs(w):.4g} rad/s above the runaway limit "
+                               f"{self.limits[side]:.4g} rad/s (runaway_speed_factor) at t = {t:.6g} s")
+            if self.reason:
+                return False
+        elapsed = time.perf_counter() - self.t0
+        if elapsed > self.budget_s:
+            self.reason = (f"wall-time budget of {self.budget_s:g} s exceeded at t = {t:.6g} s "
+                           f"of {self.t_end:g} s (wall_time_budget_s)")
+            return False
+        self.bar.update_to(t)
+        return True
+
+
+def ramp_warning(variant: Variant, t_end: float) -> str:
+    """A warning when the run ends before the STEP ramps of speed and load do (no steady part), else ''."""
+    ramp = variant.gearbox.load_case.ramp_time_s
+    if t_end <= ramp:
+        return (f"the run ends at t = {t_end:g} s, inside the load ramps (ramp_time_s = {ramp:g} s): "
+                "no steady part; screening and Tables 6/7 use its last part only")
+    return ""
+
+
+def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
+    """SolveDynamic with Exudyn's console output off; raises with the guard's or the solver's reason."""
+    import exudyn as exu
+    import exudyn.solver as exu_solver
+
+    # Exudyn warns when a run allocates memory in every step. Ours do by design: the sensors store
+    # every recorded step in memory (storeInternal) and the contact user functions return new
+    # vectors. The warning says nothing about a particular run, so it is switched off.
+    exu_solver.solverCheckMemoryAllocationsThreshold = math.inf
+    # a post-step function: the pre-step one belongs to the model (contact kinematics, friction, drive schedule)
+    if mbs.GetPostStepUserFunction() not in (0, None):
+        raise RuntimeError("the model has a post-step user function already; the divergence guard needs it")
+    mbs.SetPostStepUserFunction(guard)
+    was_printing = exu.config.printToConsole
+    exu.config.printToConsole = False
+    try:
+        mbs.SolveDynamic(simulation_settings(variant, t_end, False), solverType=exu.DynamicSolverType.GeneralizedAlpha,
+                         storeSolver=True, showHints=False)
+    except Exception as exc:
+        guard.bar.close()
+        if guard.reason:
+            raise FloatingPointError(guard.reason) from None
+        _ok, message = exu.SolverSuccess(mbs.sys["dynamicSolver"]) if "dynamicSolver" in mbs.sys else (False, "")
+        first = " ".join(message.split())[:600] if message else str(exc)
+        raise RuntimeError(f"solver failed: {first}") from None
+    finally:
+        exu.config.printToConsole = was_printing
+    if guard.reason:
+        guard.bar.close()
+        raise FloatingPointError(guard.reason)
+    guard.bar.update_to(t_end)
+    guard.bar.close()
+
+
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
-                mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None) -> RunResult:
+                mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
+                time_budget_s: float | None = None) -> RunResult:
     """Run ``variant`` for ``t_end_s`` (default: the load case's end time).
 
-    Never raises for a model or solver failure: the result then has status "failed" and the reason.
+    ``time_budget_s`` overrides ``[solver_assumed] wall_time_budget_s``. Never raises for a model or
+    solver failure: the result then has status "failed" and the reason (see :class:`RunGuard`).
     """
     import exudyn as exu
 
     t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
+    budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
     meta = _meta(variant, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
@@ -96,8 +201,8 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         sensors = add_gearbox_sensors(mbs, model)
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
-        mbs.SolveDynamic(simulation_settings(variant, t_end, progress),
-                         solverType=exu.DynamicSolverType.GeneralizedAlpha)
+        guard = RunGuard(model, variant, t_end, budget - build_s, progress)
+        _solve(mbs, variant, t_end, guard)
         signals = _signals(mbs, model, sensors)
         window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:
@@ -106,8 +211,8 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
             torque = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}"]))
             meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
-            raise FloatingPointError("the solution diverged (non-finite signals)")
-        meta.update(status="ok", reason="", build_time_s=build_s)
+            raise FloatingPointError("diverged: non-finite signals")
+        meta.update(status="ok", reason="", build_time_s=build_s, warning=ramp_warning(variant, t_end))
     except Exception as exc:  # recorded, not raised: a failed variant must not stop a matrix
         signals = None
         meta.update(status="failed", reason=f"{type(exc).__name__}: {exc}",

@@ -29,6 +29,7 @@ __all__ = [
     "harmonic_amplitudes",
     "steady_window",
     "compare_results",
+    "load_case_differences",
 ]
 
 TABLE7_HARMONICS = (1, 2, 4, 6, 9)
@@ -165,3 +166,24 @@ def compare_results(a: RunResult, b: RunResult, window: tuple[float, float] | No
     table7.attrs["mesh_frequency_hz"] = f_mesh
     table7.attrs["axis"] = axis
     return table6, table7
+
+
+_LOAD_CASE_KEYS = (("t_end_s", "end time [s]"), ("step_size_s", "step [s]"), ("ramp_time_s", "ramp time [s]"),
+                   ("theory.input_speed_deg_per_s", "input speed [deg/s]"), ("theory.input_torque_nm",
+                                                                             "input torque [N m]"))
+
+
+def load_case_differences(a: RunResult, b: RunResult, rel: float = 1e-9) -> list[str]:
+    """The load-case values in which two runs differ (end time, step, ramps, theory speed and torque):
+    compared runs must share their load case, or Tables 6 and 7 compare different things."""
+    def value(meta: dict, dotted: str) -> float | None:
+        for key in dotted.split("."):
+            meta = meta.get(key) if isinstance(meta, dict) else None
+        return None if meta is None else float(meta)
+
+    out = []
+    for key, label in _LOAD_CASE_KEYS:
+        va, vb = value(a.meta, key), value(b.meta, key)
+        if va is not None and vb is not None and not math.isclose(va, vb, rel_tol=rel):
+            out.append(f"{label} {va:g} vs {vb:g}")
+    return out

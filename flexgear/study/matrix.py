@@ -1,31 +1,36 @@
 """Variant matrix runner: run variants in parallel, time them, resume, then screen (section 2.2).
 
-``run_matrix`` runs every variant file in a worker process (a local process pool, or a Dask
-distributed cluster given by its scheduler address), writes each run with
-:func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with copies of
-its input files (``inputs/``), and then writes
+``run_matrix`` ships every run to a worker (a local process pool, or a Dask distributed cluster given by
+its scheduler address) as a :class:`RunTask` that carries the *content* of the variant file and of its
+gearbox file, not their paths: a worker needs no access to the caller's files. The worker loads the
+variant from that content, builds (or finds in its own cache, ``FLEXGEAR_CACHE_DIR``, keyed by hash) the
+meshes and reduced bodies, runs it and sends the :class:`~flexgear.results.RunResult` back; the caller
+writes it with :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with
+copies of its input files (``inputs/``), as each run finishes. Then it writes
 
 - ``matrix_results.csv`` / ``.parquet``: one row per variant: status and reason, components,
   simulated time, the runner's wall and CPU time of the run (model build + simulation), the
-  worker's total wall and CPU time (file loading, build, simulation, saving), input and
-  configuration hashes, whether the run was resumed;
+  worker's total wall and CPU time (loading, build, simulation), input and configuration hashes,
+  whether the run was resumed;
 - ``screening.csv`` / ``.parquet``: per variant Bias %, CV %, distance, zone, sigma, time,
   selected (:func:`flexgear.study.screening.screening_tables`); ``screening_indicators.*`` per
   indicator; ``selection.txt``: the selected variant and why.
 
-Resume: a run is skipped when its directory holds an ``ok`` result whose ``input_hash`` equals
-the hash of the variant (the gearbox without its ``[screening]`` table, which is
-post-processing only) and the simulated end time. A variant whose file is bad (SpecError), whose
-runner returns a failed result, raises, or kills its worker process is recorded as failed with
-its reason while the others go on. CPU time is the worker process's ``time.process_time``
-(all its threads). With a remote Dask cluster, ``out_dir`` must be on a file system the workers
-share with the caller.
+Nothing lost: every file is written atomically and a run folder is complete once its ``run.json`` is
+there (written last). A matrix killed at any moment (SIGKILL included) resumes when started again: a
+run is skipped when its folder holds an ``ok`` result whose ``input_hash`` equals the hash of the
+variant (the gearbox without its ``[screening]`` table, which is post-processing only) and the simulated
+end time; the temporary files of interrupted writes are deleted. A variant whose file is bad (SpecError),
+whose runner returns a failed result (divergence, wall-time budget), raises, or kills its worker process
+is recorded as failed with its reason while the others go on. CPU time is the worker process's
+``time.process_time`` (all its threads).
 """
 
 from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import socket
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -36,16 +41,18 @@ from typing import Any
 
 import pandas as pd
 
-from flexgear.cache import atomic_write_bytes
+from flexgear.cache import atomic_write_bytes, remove_stale_temporaries
+from flexgear.progress import Progress, say
 from flexgear.results import RunResult, load_result, save_result
 from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant, spec_hash
 from flexgear.study.screening import screening_tables
 
-__all__ = ["run_matrix", "run_input_hash", "run_one", "write_table", "screen_directory"]
+__all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
+           "screen_directory"]
 
 Runner = Callable[..., RunResult]
 
-_HEARTBEAT_S = 30.0
+_HEARTBEAT_S = 60.0
 _POLL_S = 0.2
 
 
@@ -66,35 +73,51 @@ def _failed(name: str, reason: str, **meta: Any) -> RunResult:
                       "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), **meta})
 
 
-def _copy_inputs(variant: Variant, run_dir: Path) -> dict[str, str]:
-    inputs = run_dir / "inputs"
-    inputs.mkdir(parents=True, exist_ok=True)
-    copied = {}
-    for key, src in (("variant", variant.source), ("gearbox", variant.gearbox.source)):
-        dst = inputs / Path(src).name
-        atomic_write_bytes(dst, Path(src).read_bytes())
-        copied[key] = str(dst.relative_to(run_dir))
-    return copied
+@dataclasses.dataclass(frozen=True)
+class RunTask:
+    """One run as shipped to a worker: the input files' names and contents (no paths to open)."""
+
+    name: str
+    variant_file: str  # the caller's path: names the file in messages only
+    variant_text: str
+    gearbox_file: str
+    gearbox_text: str
+    t_end_s: float | None
+    input_hash: str
+    time_budget_s: float | None = None
+
+    def inputs(self) -> dict[str, bytes]:
+        """The input files for ``inputs/`` of the run folder."""
+        return {Path(self.variant_file).name: self.variant_text.encode(),
+                Path(self.gearbox_file).name: self.gearbox_text.encode()}
 
 
-def run_one(variant_path: str, run_dir: str, t_end_s: float | None, input_hash: str,
-            runner: Runner | None = None) -> dict[str, Any]:
-    """Worker task: load, run and save one variant; never raises for a model failure.
+def make_task(variant: Variant, t_end_s: float | None, time_budget_s: float | None = None) -> RunTask:
+    """The task of a loaded variant: reads its two files once, on the caller's side."""
+    t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
+    return RunTask(variant.name, str(variant.source), Path(variant.source).read_text(),
+                   str(variant.gearbox.source), Path(variant.gearbox.source).read_text(), t_end_s,
+                   run_input_hash(variant, t_end), time_budget_s)
 
-    Returns the saved metadata (small, cheap to send back from a worker process).
-    """
+
+def run_task(task: RunTask, runner: Runner | None = None) -> RunResult:
+    """Worker side: load the variant from the shipped content, run it, return the result (writes nothing
+    but cache entries). Never raises for a model failure."""
     wall0, cpu0 = time.perf_counter(), time.process_time()
-    name = Path(variant_path).stem
     try:
-        variant = load_variant(variant_path)
-        name = variant.name
-        result = (runner or _default_runner())(variant, t_end_s=t_end_s, progress=False)
-        inputs = _copy_inputs(variant, Path(run_dir))
+        variant = load_variant(task.variant_file, task.variant_text, task.gearbox_text)
+        extra = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
+        result = (runner or _default_runner())(variant, t_end_s=task.t_end_s, progress=False, **extra)
     except Exception as exc:  # recorded, not raised: the other variants go on
-        result, inputs = _failed(name, f"{type(exc).__name__}: {exc}"), {}
-    result.meta.update(input_hash=input_hash, variant_file=str(variant_path), inputs=inputs,
+        result = _failed(task.name, f"{type(exc).__name__}: {exc}")
+    result.meta.update(input_hash=task.input_hash, variant_file=task.variant_file, worker_host=socket.gethostname(),
                        total_wall_time_s=time.perf_counter() - wall0, total_cpu_time_s=time.process_time() - cpu0)
-    save_result(result, run_dir)
+    return result
+
+
+def save_task_result(task: RunTask, result: RunResult, run_dir: Path) -> dict[str, Any]:
+    """Caller side: write the result and copies of its input files; return its metadata."""
+    save_result(result, run_dir, inputs=task.inputs())
     return dict(result.meta)
 
 
@@ -105,41 +128,31 @@ def write_table(table: pd.DataFrame, stem: Path) -> None:
 
 
 # --------------------------------------------------------------------------- execution
-@dataclasses.dataclass(frozen=True)
-class _Task:
-    name: str
-    path: str
-    run_dir: str
-    input_hash: str
-
-
 def _say(progress: bool, text: str) -> None:
     if progress:
-        print(f"[matrix {time.strftime('%H:%M:%S')}] {text}", file=sys.stderr, flush=True)
+        say(f"[matrix {time.strftime('%H:%M:%S')}] {text}")
 
 
-def _run_pool(tasks: list[_Task], submit: Callable, t_end_s: float | None, runner: Runner | None,
-              progress: bool, done_count: list[int], total: int) -> tuple[dict[str, dict], list[_Task]]:
-    """Submit tasks, poll until all finish; return metas and the tasks whose worker died."""
-    futures = {submit(run_one, t.path, t.run_dir, t_end_s, t.input_hash, runner): t for t in tasks}
-    started = time.perf_counter()
-    last_beat = started
+def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, out_dir: Path,
+              progress: bool, bar: Progress) -> tuple[dict[str, dict], list[RunTask]]:
+    """Submit tasks, save each result as it arrives; return the metas and the tasks whose worker died."""
+    futures = {submit(run_task, t, runner): t for t in tasks}
+    started = last_beat = time.perf_counter()
     metas: dict[str, dict] = {}
-    died: list[_Task] = []
+    died: list[RunTask] = []
     while futures:
         finished = [f for f in futures if f.done()]
         for fut in finished:
             task = futures.pop(fut)
             try:
-                meta = fut.result()
+                result = fut.result()
             except Exception as exc:  # the worker process died (segfault, out of memory) or was killed
                 died.append(task)
                 _say(progress, f"{task.name}: worker lost ({type(exc).__name__}: {exc})")
                 continue
-            metas[task.name] = meta
-            done_count[0] += 1
-            _say(progress, f"{done_count[0]}/{total} {task.name}: {meta['status']}, "
-                           f"{meta.get('wall_time_s', float('nan')):.1f} s wall, "
+            meta = metas[task.name] = save_task_result(task, result, out_dir / task.name)
+            bar.update_to(bar.value + 1, postfix=f"{task.name} {meta['status']}")
+            _say(progress, f"{task.name}: {meta['status']}, {meta.get('wall_time_s', float('nan')):.1f} s wall, "
                            f"{meta.get('cpu_time_s', float('nan')):.1f} s CPU"
                            + (f" ({meta.get('reason')})" if meta["status"] != "ok" else ""))
         now = time.perf_counter()
@@ -152,38 +165,40 @@ def _run_pool(tasks: list[_Task], submit: Callable, t_end_s: float | None, runne
     return metas, died
 
 
-def _execute(tasks: list[_Task], t_end_s: float | None, workers: int, scheduler: str | None,
-             runner: Runner | None, progress: bool) -> dict[str, dict]:
-    done_count = [0]
+def _execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: Runner | None,
+             out_dir: Path, progress: bool) -> dict[str, dict]:
     if not tasks:
         return {}
+    # on a terminal a bar; in a log the per-run lines of _say are the progress
+    bar = Progress(len(tasks), "matrix", "runs", enabled=progress and sys.stderr.isatty(), fmt="{:.0f}")
     if scheduler is not None:
         from distributed import Client
 
         with Client(scheduler) as client:
             _say(progress, f"{len(tasks)} runs on Dask cluster {scheduler}")
 
-            def submit(fn: Callable, *args: Any) -> Any:
-                return client.submit(fn, *args, pure=False, key=f"flexgear-run-{args[0]}-{args[3]}")
+            def submit(fn: Callable, task: RunTask, run: Runner | None) -> Any:
+                return client.submit(fn, task, run, pure=False, key=f"flexgear-run-{task.name}-{task.input_hash}")
 
-            metas, died = _run_pool(tasks, submit, t_end_s, runner, progress, done_count, len(tasks))
+            metas, died = _run_pool(tasks, submit, runner, out_dir, progress, bar)
     else:
         _say(progress, f"{len(tasks)} runs on {workers} local worker process(es)")
         ctx = get_context("spawn")
         with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
-            metas, died = _run_pool(tasks, pool.submit, t_end_s, runner, progress, done_count, len(tasks))
+            metas, died = _run_pool(tasks, pool.submit, runner, out_dir, progress, bar)
         # A dead worker breaks the whole pool: rerun each affected task alone to find the culprit.
         retry, died = died, []
         for task in retry:
             with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as solo:
-                again, lost = _run_pool([task], solo.submit, t_end_s, runner, progress, done_count, len(tasks))
+                again, lost = _run_pool([task], solo.submit, runner, out_dir, progress, bar)
             metas.update(again)
             died += lost
     for task in died:  # died again alone (or on the cluster): record it
         result = _failed(task.name, "worker process died (crash or out of memory in the solver)",
-                         input_hash=task.input_hash, variant_file=task.path)
-        save_result(result, task.run_dir)
-        metas[task.name] = dict(result.meta)
+                         input_hash=task.input_hash, variant_file=task.variant_file)
+        metas[task.name] = save_task_result(task, result, out_dir / task.name)
+        bar.update_to(bar.value + 1, postfix=f"{task.name} failed")
+    bar.close()
     return metas
 
 
@@ -216,20 +231,23 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
 
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
-               runner: Runner | None = None) -> pd.DataFrame:
+               runner: Runner | None = None, time_budget_s: float | None = None) -> pd.DataFrame:
     """Run the variant files, save each run, screen them; return the results + screening table.
 
     ``runner(variant, t_end_s=..., progress=...) -> RunResult`` defaults to
     :func:`flexgear.mbs.run.run_variant`; it must be importable by the worker processes.
     ``scheduler`` is a Dask scheduler address (``tcp://host:8786``); None uses ``workers`` local
-    processes. See the module docstring for the files written and the resume rule.
+    processes. ``time_budget_s`` overrides each variant's ``[solver_assumed] wall_time_budget_s``.
+    See the module docstring for the files written and the resume rule.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
+    for stale in remove_stale_temporaries(out_dir):
+        _say(progress, f"removed {stale.relative_to(out_dir)} (an interrupted write)")
     names: list[str] = []
     metas: dict[str, dict] = {}
     resumed: set[str] = set()
-    tasks: list[_Task] = []
+    tasks: list[RunTask] = []
     settings: ScreeningSettings | None = None
     for path in map(Path, variant_paths):
         try:
@@ -248,18 +266,17 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
             raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
         names.append(name)
         settings = settings or variant.gearbox.screening
-        t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
-        h = run_input_hash(variant, t_end)
+        task = make_task(variant, t_end_s, time_budget_s)
         run_dir = out_dir / name
         if (run_dir / "run.json").exists():
             old = load_result(run_dir).meta
-            if old.get("status") == "ok" and old.get("input_hash") == h:
+            if old.get("status") == "ok" and old.get("input_hash") == task.input_hash:
                 metas[name] = old
                 resumed.add(name)
-                _say(progress, f"{name}: unchanged (hash {h}), skipped")
+                _say(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
                 continue
-        tasks.append(_Task(name, str(path), str(run_dir), h))
-    metas.update(_execute(tasks, t_end_s, workers, scheduler, runner, progress))
+        tasks.append(task)
+    metas.update(_execute(tasks, workers, scheduler, runner, out_dir, progress))
     table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])
     write_table(table, out_dir / "matrix_results")
     if settings is None:

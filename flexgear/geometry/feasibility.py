@@ -1,0 +1,164 @@
+"""Geometric and physical feasibility of a gearbox, checked when the file is loaded (before any meshing).
+
+:func:`check_feasibility` raises a one-line :class:`flexgear.spec.SpecError` that names the file, the
+field that causes the problem and what is allowed:
+
+- gear set: neighbouring planets' tip circles must not overlap, 2 a_w sin(pi/N) > d_a,planet
+  (the equal-spacing assembly condition is checked in :mod:`flexgear.spec`);
+- centre distance: reachable by profile shifts, cos(alpha_wt) = a_0 cos(alpha_t) / a_w < 1 for both meshes
+  (ISO 21771 centre-distance equation);
+- tooth thickness at the tip > 0 for sun, planet and ring (no pointed tooth), psi(r_a) of
+  :meth:`flexgear.geometry.involute.Gear.tooth_half_angle`; the field named is the one that makes it pointed
+  (backlash, addendum or the profile shift, which the centre distance sets for sun and ring);
+- a ring whose tip circle lies inside its base circle has no involute at the tip;
+- backlash below the normal module (a larger one is a unit slip);
+- bores inside the root circle less the relief groove, shaft inner < outer diameter, the input shaft
+  inside the sun's bore, the output shaft inside the ring flange, the flange beyond the rim with room for
+  the bolt holes, the bolts side by side on their circle, bearing seats shorter than the shafts.
+
+The checks register themselves with :func:`flexgear.spec.register_feasibility_check` when
+:mod:`flexgear` is imported, so every :func:`flexgear.spec.load_gearbox` and
+:func:`flexgear.spec.load_variant` runs them.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+from flexgear.geometry.involute import Gear, gear_set_geometry, transverse_pressure_angle
+from flexgear.spec import GearboxSpec, SpecError, register_feasibility_check
+
+__all__ = ["check_feasibility"]
+
+_MM = 1e-3
+
+
+def _reachable_centre_distance(spec: GearboxSpec) -> None:
+    g, a = spec.gears, spec.gears_assumed
+    if a.operating_centre_distance_mm == 0.0:  # 0: the mean of the two standard centre distances
+        return
+    alpha_t = transverse_pressure_angle(g.normal_pressure_angle_rad, g.helix_angle_rad)
+    mt_mm = g.normal_module_mm / math.cos(g.helix_angle_rad)
+    lower = max(abs(mt_mm * (g.planet_teeth + z) / 2) * math.cos(alpha_t) for z in (g.sun_teeth, -g.ring_teeth))
+    if a.operating_centre_distance_mm <= lower:
+        raise SpecError(spec.source, "gears_assumed.operating_centre_distance_mm",
+                        f"cannot be reached by profile shifts: expected > {lower:.3f} mm (base-circle limit "
+                        "a_0 cos(alpha_t) of the larger mesh) or 0 (the mean standard centre distance)",
+                        a.operating_centre_distance_mm)
+
+
+def _backlash(spec: GearboxSpec) -> None:
+    a, g = spec.gears_assumed, spec.gears
+    if a.normal_backlash_mm >= g.normal_module_mm:
+        raise SpecError(spec.source, "gears_assumed.normal_backlash_mm",
+                        f"expected < the normal module ({g.normal_module_mm} mm): millimetres, not micrometres?",
+                        a.normal_backlash_mm)
+
+
+def _tip_thickness(gear: Gear) -> float:
+    """Transverse tooth thickness (arc) at the tip circle, 2 r_a psi(r_a) [m]."""
+    return 2 * gear.tip_radius * gear.tooth_half_angle(gear.tip_radius)
+
+
+def _pointed_field(spec: GearboxSpec, name: str, gear: Gear) -> str:
+    """The field that takes most tip thickness away: backlash (thinning), an addendum above the standard 1,
+    or a positive profile shift (the planet's own; sun's and ring's follow from the centre distance)."""
+    s = _tip_thickness(gear)
+    losses = {"gears_assumed.normal_backlash_mm": _tip_thickness(dataclasses.replace(gear, thinning=0.0)) - s,
+              "gears_assumed.addendum_coefficient": _tip_thickness(dataclasses.replace(
+                  gear, addendum_coefficient=min(gear.addendum_coefficient, 1.0))) - s}
+    shift_field = ("gears_assumed.planet_shift_coefficient" if name == "planet"
+                   else "gears_assumed.operating_centre_distance_mm")
+    losses[shift_field] = _tip_thickness(dataclasses.replace(gear, shift=min(gear.shift, 0.0))) - s
+    return max(losses, key=losses.__getitem__)
+
+
+def _teeth(spec: GearboxSpec) -> None:
+    gs = gear_set_geometry(spec)
+    g = spec.gears
+    for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
+        if gear.internal and gear.tip_radius <= gear.base_radius:
+            raise SpecError(spec.source, "gears_assumed.addendum_coefficient",
+                            f"the ring's tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
+                            f"(d = {2e3 * gear.base_radius:.2f} mm): no involute at the tip; expected a smaller value",
+                            spec.gears_assumed.addendum_coefficient)
+        if _tip_thickness(gear) <= 0:
+            field = _pointed_field(spec, name, gear)
+            raise SpecError(spec.source, field,
+                            f"makes the {name} tooth pointed (no tooth thickness left at the tip circle, profile "
+                            f"shift x = {gear.shift:.3f}); expected a value that leaves a tip thickness > 0",
+                            _value(spec, field))
+    tip_d = 2 * gs.planet.tip_radius
+    spacing = 2 * gs.centre_distance * math.sin(math.pi / g.planet_count) if g.planet_count > 1 else math.inf
+    if spacing <= tip_d:
+        fit = max(n for n in range(1, g.planet_count)
+                  if n == 1 or 2 * gs.centre_distance * math.sin(math.pi / n) > tip_d)
+        raise SpecError(spec.source, "gears.planet_count",
+                        f"neighbouring planets' tip circles overlap (centre spacing {spacing / _MM:.2f} mm <= "
+                        f"tip diameter {tip_d / _MM:.2f} mm); expected at most {fit} planets", g.planet_count)
+
+
+def _value(spec: GearboxSpec, dotted: str) -> object:
+    table, name = dotted.split(".")
+    return getattr(getattr(spec, table), name)
+
+
+def _components(spec: GearboxSpec) -> None:
+    gs, c, p = gear_set_geometry(spec), spec.components_assumed, spec.source
+    groove = c.relief_groove_depth_mm if spec.gears_assumed.helix_layout == "double" else 0.0
+    for name in ("sun", "planet"):
+        limit = 2 * getattr(gs, name).root_radius / _MM - 2 * groove
+        bore = getattr(c, f"{name}_bore_diameter_mm")
+        if bore >= limit:
+            raise SpecError(p, f"components_assumed.{name}_bore_diameter_mm",
+                            f"expected < {limit:.2f} mm (the {name}'s root diameter less twice the relief groove "
+                            "depth)", bore)
+    if c.input_shaft_outer_diameter_mm > c.sun_bore_diameter_mm:
+        raise SpecError(p, "components_assumed.input_shaft_outer_diameter_mm",
+                        f"expected <= sun_bore_diameter_mm ({c.sun_bore_diameter_mm} mm): the shaft sits in the "
+                        "sun's bore", c.input_shaft_outer_diameter_mm)
+    if c.output_shaft_length_mm <= c.ring_flange_thickness_mm:
+        raise SpecError(p, "components_assumed.output_shaft_length_mm",
+                        f"expected > ring_flange_thickness_mm ({c.ring_flange_thickness_mm} mm)",
+                        c.output_shaft_length_mm)
+    for shaft in ("input_shaft", "output_shaft"):
+        inner, outer = (getattr(c, f"{shaft}_{k}_diameter_mm") for k in ("inner", "outer"))
+        if inner >= outer:
+            raise SpecError(p, f"components_assumed.{shaft}_inner_diameter_mm",
+                            f"expected < {shaft}_outer_diameter_mm ({outer} mm)", inner)
+        if c.bearing_seat_width_mm >= getattr(c, f"{shaft}_length_mm"):
+            raise SpecError(p, "components_assumed.bearing_seat_width_mm",
+                            f"expected < {shaft}_length_mm ({getattr(c, f'{shaft}_length_mm')} mm)",
+                            c.bearing_seat_width_mm)
+    if groove >= c.ring_rim_thickness_mm:
+        raise SpecError(p, "components_assumed.relief_groove_depth_mm",
+                        f"expected < ring_rim_thickness_mm ({c.ring_rim_thickness_mm} mm): the groove is cut into "
+                        "the ring's rim", c.relief_groove_depth_mm)
+    rim_d = 2 * gs.ring.root_radius / _MM + 2 * c.ring_rim_thickness_mm
+    need = rim_d + 2 * c.ring_bolt_hole_diameter_mm
+    if c.ring_flange_outer_diameter_mm <= need:
+        raise SpecError(p, "components_assumed.ring_flange_outer_diameter_mm",
+                        f"expected > {need:.2f} mm (the ring's rim diameter {rim_d:.2f} mm plus room for the bolt "
+                        "holes)", c.ring_flange_outer_diameter_mm)
+    if c.output_shaft_outer_diameter_mm >= c.ring_flange_outer_diameter_mm:
+        raise SpecError(p, "components_assumed.output_shaft_outer_diameter_mm",
+                        f"expected < ring_flange_outer_diameter_mm ({c.ring_flange_outer_diameter_mm} mm)",
+                        c.output_shaft_outer_diameter_mm)
+    bolt_circle = math.pi * (rim_d + c.ring_flange_outer_diameter_mm) / 2
+    if c.ring_bolt_count * c.ring_bolt_hole_diameter_mm >= bolt_circle:
+        raise SpecError(p, "components_assumed.ring_bolt_count",
+                        f"expected < {bolt_circle / c.ring_bolt_hole_diameter_mm:.0f} bolt holes of "
+                        f"{c.ring_bolt_hole_diameter_mm} mm side by side on the {bolt_circle:.1f} mm bolt circle",
+                        c.ring_bolt_count)
+
+
+def check_feasibility(spec: GearboxSpec) -> None:
+    """Raise a :class:`SpecError` for the first infeasible value of ``spec`` (see the module docstring)."""
+    _backlash(spec)
+    _reachable_centre_distance(spec)
+    _teeth(spec)
+    _components(spec)
+
+
+register_feasibility_check(check_feasibility)
