@@ -45,6 +45,7 @@ class Progress:
         self.stream = sys.stderr if stream is None else stream
         self.plain_step, self.fmt = plain_step, fmt
         self.value = 0.0
+        self._postfix = ""
         self._next_plain = plain_step
         self._t0 = time.perf_counter()
         self._bar: Any = None
@@ -60,6 +61,7 @@ class Progress:
         if not self.enabled:
             return
         value = min(float(value), self.total)
+        self._postfix = postfix or self._postfix
         if self._bar is not None:
             self._bar.update(value - self._bar.n)
             if postfix:
@@ -86,7 +88,7 @@ class Progress:
             self._bar.close()
             self._bar = None
         elif self._next_plain <= 1.0 + 1e-12:
-            self._plain(self.value, postfix)
+            self._plain(self.value, postfix or self._postfix)
             self._next_plain = 2.0
 
     def __enter__(self) -> Progress:
