@@ -158,7 +158,7 @@ def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, out
         now = time.perf_counter()
         if futures and now - last_beat >= _HEARTBEAT_S:
             last_beat = now
-            _say(progress, f"running {len(futures)}: {', '.join(t.name for t in futures.values())} "
+            _say(progress, f"running or queued {len(futures)}: {', '.join(t.name for t in futures.values())} "
                            f"({now - started:.0f} s elapsed)")
         if futures and not finished:
             time.sleep(_POLL_S)
