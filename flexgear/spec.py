@@ -211,6 +211,9 @@ class Contact:
     damping_fraction_of_stiffness: float = _num(0.0)
     penetration_depth_m: float = _num(0.0, lo_open=True)
     friction_coefficient: float = _num(0.0, 1.0)
+    # "impact": the study's ADAMS law (section 2.1, the fields above); "iso6336": linear mesh stiffness of
+    # ISO 6336-1 (flexgear.laws.iso6336) with eq. 13 damping ([contact_assumed] mesh_damping_ratio)
+    law: str = field(default="impact", metadata={"choices": ("impact", "iso6336"), "doc": "contact law"})
 
 
 @dataclass(frozen=True)
@@ -220,6 +223,8 @@ class ContactAssumed:
     stiffness_harmonics: int = _num(0, 10, integer=True)
     stiffness_variation: str = _choice("contact_lines", "constant")
     friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
+    mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0, "doc": "xi of eq. 13 (iso6336 law)"})
+    application_factor: float = field(default=1.0, metadata={"lo": 1.0, "doc": "K_A of ISO 6336-1 (iso6336 law)"})
 
 
 @dataclass(frozen=True)

@@ -34,6 +34,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = [
@@ -137,6 +138,7 @@ class LumpedParameters:
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width
         - mesh damping: eq. 13, c = 2 xi sqrt(k_m m_1 m_2 / (m_1 + m_2)) with the gear masses
           (the study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m)
+        - with ``[contact] law = "iso6336"`` both from flexgear.laws.contact.mesh_laws, the multibody model's law
         - pressure angles: operating transverse pressure angles of the two meshes (flexgear.geometry.involute)
         """
         from flexgear.geometry.layout import component_mass_properties
@@ -171,24 +173,25 @@ class LumpedParameters:
             fixed = ("ring",)
         if hold_input:
             fixed = (*fixed, "sun")
-        k_m = la.mesh_stiffness_per_width_n_per_m2 * spec.gears_assumed.face_width_m
         m_s, m_p, m_r = props["sun"].mass, props["planet"].mass, props["ring"].mass
+        if spec.contact.law == "iso6336":  # the multibody model's law and damping (flexgear.laws.contact.mesh_laws)
+            laws = mesh_laws(spec)
+            k_s, k_r = laws["outer"].stiffness, laws["inner"].stiffness
+            c_s, c_r = laws["outer"].damping_max, laws["inner"].damping_max
+        else:  # the study's lumped model: eq. 10 with an assumed C_gamma, eq. 13
+            k_s = k_r = la.mesh_stiffness_per_width_n_per_m2 * spec.gears_assumed.face_width_m
+            c_s = mesh_damping(k_s, m_s, m_p, la.mesh_damping_ratio)
+            c_r = mesh_damping(k_r, m_p, m_r, la.mesh_damping_ratio)
         return cls(
             sun=sun, ring=ring, carrier=carrier, planet=planet, planet_count=geo.planet_count,
-            sun_mesh_stiffness_n_per_m=k_m, ring_mesh_stiffness_n_per_m=k_m,
+            sun_mesh_stiffness_n_per_m=k_s, ring_mesh_stiffness_n_per_m=k_r,
             sun_pressure_angle_rad=geo.sun_planet.operating_pressure_angle,
             ring_pressure_angle_rad=geo.planet_ring.operating_pressure_angle,
             fixed=fixed, base_helix_angle_rad=geo.sun.base_helix_angle,
             planet_angles_rad=tuple(float(a) for a in geo.planet_angles),
-            sun_mesh_damping_n_s_per_m=mesh_damping(k_m, m_s, m_p, la.mesh_damping_ratio),
-            ring_mesh_damping_n_s_per_m=mesh_damping(k_m, m_p, m_r, la.mesh_damping_ratio),
+            sun_mesh_damping_n_s_per_m=c_s, ring_mesh_damping_n_s_per_m=c_r,
             source=str(spec.source),
         )
-
-
-def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, damping_ratio: float) -> float:
-    """Eq. 13: c = 2 xi sqrt(k m1 m2 / (m1 + m2)) [N s/m] (mesh damping from the damping ratio xi)."""
-    return 2.0 * damping_ratio * math.sqrt(stiffness_n_per_m * mass1_kg * mass2_kg / (mass1_kg + mass2_kg))
 
 
 @dataclass(frozen=True)

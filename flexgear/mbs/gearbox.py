@@ -22,6 +22,7 @@ import numpy as np
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
+from flexgear.laws.contact import mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
 from flexgear.mbs.elements import Bushing, add_interface_joint, add_load_torque, add_speed_drive
@@ -74,16 +75,18 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
     spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
     common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
                   half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
+    laws = mesh_laws(spec)
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
         phase = zs * psi / (2 * math.pi)
         contacts += pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", geo.sun_planet, np.zeros(3),
                                   c_planet, hand=1, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
-                                  phase_offset=phase, **common)
+                                  phase_offset=phase, law=laws["outer"], **common)
         contacts += pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", geo.planet_ring, c_planet,
                                   np.zeros(3), hand=-1, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
-                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
+                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, law=laws["inner"],
+                                  **common)
     return contacts
 
 
