@@ -223,7 +223,8 @@ class ContactAssumed:
     stiffness_harmonics: int = _num(0, 10, integer=True)
     stiffness_variation: str = _choice("contact_lines", "constant")
     friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
-    mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0, "doc": "xi of eq. 13 (iso6336 law)"})
+    mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0,
+                                                              "doc": "xi of eq. 13 (iso6336 law)"})
     application_factor: float = field(default=1.0, metadata={"lo": 1.0, "doc": "K_A of ISO 6336-1 (iso6336 law)"})
 
 

@@ -11,7 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces", "periodic_values", "ramp_state"]
+__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force",
+           "mesh_friction_forces", "periodic_values", "ramp_state"]
 
 
 @njit(cache=True)

@@ -81,7 +81,8 @@ def mesh_laws(spec: GearboxSpec) -> dict[str, ContactLaw]:
     line_load = ca.application_factor * f_t / (b * 1e3)
     mass = {c: component_mass_properties(spec, c).mass for c in ("sun", "planet", "ring")}
     out = {}
-    for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"), ("inner", geo.planet_ring, "planet", "ring")):
+    for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"),
+                               ("inner", geo.planet_ring, "planet", "ring")):
         gear1, gear2 = mesh.gear1, mesh.gear2
         iso = tooth_stiffness(gear1.teeth, gear2.teeth, gear1.shift, gear2.shift, gear1.helix_angle,
                               gear1.base_helix_angle, gear1.normal_pressure_angle, ga.dedendum_coefficient,

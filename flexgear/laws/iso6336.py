@@ -46,7 +46,10 @@ class ToothStiffness:
     mesh: float  # c_gamma_alpha
 
     def normal_stiffness_n_per_m(self, face_width_m: float, base_helix_angle_rad: float) -> float:
-        """Mean mesh stiffness along the tooth normal [N/m]: c_gamma_alpha b / cos^2(beta_b) (1 N/(mm um) = 1e9 N/m^2)."""
+        """Mean mesh stiffness along the tooth normal [N/m]: c_gamma_alpha b / cos^2(beta_b).
+
+        1 N/(mm um) = 1e9 N/m^2.
+        """
         return self.mesh * 1e9 * face_width_m / math.cos(base_helix_angle_rad) ** 2
 
 
