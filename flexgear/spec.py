@@ -31,6 +31,7 @@ __all__ = [
     "Bearings",
     "Contact",
     "ContactAssumed",
+    "SupportsAssumed",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",
@@ -332,6 +333,19 @@ class LumpedAssumed:
 
 
 @dataclass(frozen=True)
+class SupportsAssumed:
+    """Where the bearings, the speed drive and the load torque act (flexgear.geometry.supports).
+
+    ``placement`` "bearing_seats": bushings at the shafts' bearing seats and the planets' bores, drive and load at
+    the input shaft's and output shaft's bearing-seat interfaces; "gear_centres": all on the body frames at the
+    gear mid-planes (the former model, kept for comparison).
+    """
+
+    placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
+                                                              "doc": "where supports act"})
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -350,6 +364,7 @@ class GearboxSpec:
     reduction_assumed: ReductionSettings
     screening: ScreeningSettings
     lumped_assumed: LumpedAssumed
+    supports_assumed: SupportsAssumed = field(default_factory=SupportsAssumed)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
@@ -440,7 +455,8 @@ def load_gearbox(path: str | Path) -> GearboxSpec:
     unknown = sorted(set(raw) - set(tables))
     if unknown:
         raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
-    for name in tables:
+    optional = {f.name for f in dataclasses.fields(GearboxSpec) if f.default_factory is not dataclasses.MISSING}
+    for name in tables - optional:
         if name not in raw:
             raise SpecError(path, name, "missing (required)")
     if not isinstance(raw["title"], str):
@@ -451,7 +467,8 @@ def load_gearbox(path: str | Path) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     kwargs: dict[str, Any] = {"source": path, "title": raw["title"]}
     for name in tables - {"title", "meshing_assumed"}:
-        kwargs[name] = _build(hints[name], raw[name], path, name)
+        if name in raw:
+            kwargs[name] = _build(hints[name], raw[name], path, name)
     kwargs["meshing_assumed"] = {
         level: _build(MeshingSettings, table, path, f"meshing_assumed.{level}")
         for level, table in meshing.items()
