@@ -34,6 +34,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.geometry.massprops import combine_mass_properties
+from flexgear.geometry.supports import condensed_radial_stiffness, gearbox_supports
 from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
@@ -132,9 +134,12 @@ class LumpedParameters:
         """Parameters of the spec's gearbox (``hold_input``: also hold the sun's spin, as the prescribed drive does).
 
         - masses and spin inertias: flexgear.geometry.layout.component_mass_properties (sun + input shaft,
+          the in-plane mass the apparent mass at the gear centre of the joined parts, see ``mi``;
           ring + output shaft for the star arrangement; for the planetary arrangement the output
           shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*)
-        - bearing stiffness: Table 2 radial ("leveling") stiffness; damping c = k * damping_per_stiffness_s
+        - bearing stiffness: the Table 2 bearing at its place (``[supports_assumed]``, flexgear.geometry.supports)
+          condensed to the gear centre, 1/k = 1/k_r + L^2/k_t (L: gear to bearing centre; the tilt statically
+          condensed); damping c = k * damping_per_stiffness_s
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width
         - mesh damping: eq. 13, c = 2 xi sqrt(k_m m_1 m_2 / (m_1 + m_2)) with the gear masses
           (the study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m)
@@ -144,32 +149,45 @@ class LumpedParameters:
         from flexgear.geometry.layout import component_mass_properties
 
         geo = gear_set_geometry(spec)
-        la, b = spec.lumped_assumed, spec.bearings
+        la = spec.lumped_assumed
         names = GEOMETRY_COMPONENTS
         props = {c: component_mass_properties(spec, c) for c in names}
         star = spec.gears.arrangement == "star"
 
+        supports = gearbox_supports(spec)
+
         def member(mass: float, inertia: float, radius: float, bearing, held: bool = False) -> MemberParameters:
             if held:
                 return MemberParameters.from_inertia(max(mass, 0.0), inertia, radius, math.inf)
-            k = bearing.radial_stiffness_n_per_m
+            # the bearing at its seat condensed to the gear centre (flexgear.geometry.supports)
+            k = condensed_radial_stiffness(supports[bearing])
             return MemberParameters.from_inertia(mass, inertia, radius, k,
-                                                 bearing_damping_n_s_per_m=k * bearing.damping_per_stiffness_s)
+                                                 bearing_damping_n_s_per_m=k * supports[bearing].damping_per_stiffness)
 
         def mi(*names: str) -> tuple[float, float]:
-            return sum(props[n].mass for n in names), sum(props[n].inertia[2, 2] for n in names)
+            """Apparent in-plane mass at the gear centre and spin inertia of the rigidly joined parts.
 
-        sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, b.input_shaft)
-        planet = member(*mi("planet"), geo.planet.base_radius, b.planet)
+            A rigid shaft and gear whose centre of mass lies d off the gear plane answer an in-plane force at
+            the gear centre with translation and tilt: m_app = 1 / (1/m + d^2/I_t) (I_t: tilt inertia about
+            the centre of mass), the mass the multibody model's gear centre shows (d = 0: m).
+            """
+            body = combine_mass_properties(*(props[n] for n in names))
+            d = float(body.com[2])
+            tilt = 0.5 * float(body.inertia[0, 0] + body.inertia[1, 1])
+            apparent = body.mass if d == 0.0 else 1.0 / (1.0 / body.mass + d**2 / tilt)
+            return apparent, sum(props[n].inertia[2, 2] for n in names)
+
+        sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, "input_shaft")
+        planet = member(*mi("planet"), geo.planet.base_radius, "planet")
         if star:
-            ring = member(*mi("ring", "output_shaft"), geo.ring.base_radius, b.output_shaft)
+            ring = member(*mi("ring", "output_shaft"), geo.ring.base_radius, "output_shaft")
             carrier = member(0.0, 0.0, geo.centre_distance, None, held=True)
             fixed: tuple[str, ...] = ("carrier",)
         else:
             ring = member(*mi("ring"), geo.ring.base_radius, None, held=True)
             m_out, i_out = mi("output_shaft")
             carrier = member(la.carrier_mass_kg + m_out, la.carrier_inertia_kg_m2 + i_out, geo.centre_distance,
-                             b.output_shaft)
+                             "output_shaft")
             fixed = ("ring",)
         if hold_input:
             fixed = (*fixed, "sun")
