@@ -120,13 +120,14 @@ def support_points(support: Support) -> list[np.ndarray]:
     return [np.array([0.0, 0.0, z]) for z, _ in support.spring_points()]
 
 
-def interface_spin_marker(mbs, body: Body, interface: str | None) -> int:
+def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, int, int]:
     """A coordinate marker on the spin angle of ``body`` at ``interface`` [rad]: drive and load act on it.
 
     Rigid body (or ``interface`` None): the frame's spin coordinate. Flexible body: an auxiliary coordinate s
     tied by one linear constraint to s = phi_z + r . q, r the interface's elastic rotation about the axis per
     modal coordinate (``ReducedBody.interface_motion`` row 5, the rotation its RBE3 virtual-node marker
     carries; first order in the elastic rotation and tilt). A torque on s reaches the body there.
+    Returns (marker, node, coordinate index in the node) of that spin angle.
     """
     from exudyn.itemInterface import (
         MarkerNodeCoordinate,
@@ -138,7 +139,7 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> int:
     )
 
     if interface is None or not body.flexible:
-        return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
+        return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5)), body.node, 5
     r = body.reduced.interface_motion(interface)[5]
     spin = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_{interface}_spin", numberOfODE2Coordinates=1,
                                        referenceCoordinates=[0.0], initialCoordinates=[0.0],
@@ -151,7 +152,7 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> int:
         markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=spin)),
                        mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
         scalingMarker0=np.ones((1, 1)), scalingMarker1=row, offset=np.zeros(1)))
-    return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=spin, coordinate=0))
+    return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=spin, coordinate=0)), spin, 0
 
 
 def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float, marker: int | None = None) -> int:

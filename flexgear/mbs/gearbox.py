@@ -60,6 +60,7 @@ class GearboxModel:
     input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
     joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
+    output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -220,13 +221,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                            radial_band=spec.gears.normal_module_m)
     springs = train.springs
     seat = "bearing_seat" if seats else None  # drive and load at the shafts' seats (spline, flange)
-    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s,
-                            interface_spin_marker(mbs, by_body[ends["sun"]], seat))
+    spin_in = interface_spin_marker(mbs, by_body[ends["sun"]], seat)
+    spin_out = interface_spin_marker(mbs, by_body[ends["ring"]], seat)
+    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
     load = add_load_torque(mbs, by_body[ends["ring"]], -math.copysign(lc.load_torque_nm, th.output_speed),
-                           lc.ramp_time_s, interface_spin_marker(mbs, by_body[ends["ring"]], seat))
+                           lc.ramp_time_s, spin_out[0])
     halves = len(helix_halves(geo))
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        train.aux_node, ends["sun"], ends["ring"], joints)
+                        train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:])
