@@ -30,7 +30,9 @@ def signal_columns(planet_count: int) -> list[str]:
     - ``input_torque_nm``: drive torque on the input shaft
     - ``outer_mesh_force_{i}_n``: normal force of the sun-planet mesh of planet i (1-based)
     - ``inner_mesh_force_{i}_n``: normal force of the planet-ring mesh of planet i
-    - ``{input,output}_bearing_accel_{x,y}_m_per_s2``: radial acceleration at the shaft bearings
+    - ``{input,output}_bearing_accel_{x,y}_m_per_s2``: radial acceleration of the member carrying the input/output
+      bearing, taken at its gear centre (the frame node of sun/ring or their shaft; the lumped model's node), not
+      at the bearing seat
 
     Optional columns a backend may add after these (flexgear.mbs.deflection):
 
