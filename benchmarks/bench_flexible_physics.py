@@ -83,7 +83,8 @@ def sharing(t_end: float) -> None:
                       flush=True)
             outer, inner = static_sharing_with_pin_error(v.gearbox)
             print(law, placement, "lumped static, 10 um pin error of planet 1: sun-mesh forces",
-                  np.round(outer, 1), f"K_gamma {outer.max() / outer.mean():.4f} (ring meshes {inner.max() / inner.mean():.4f})", flush=True)
+                  np.round(outer, 1), f"K_gamma {outer.max() / outer.mean():.4f}",
+                  f"(ring meshes {inner.max() / inner.mean():.4f})", flush=True)
 
 
 def ripple(t_end: float) -> None:
