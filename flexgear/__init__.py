@@ -27,6 +27,7 @@ _LAZY = {
     "Body": "bodies", "add_rigid_body": "bodies",
     "FlexibleBody": "flexible", "add_flexible_body": "flexible",
     "fe_model": "fem", "ReducedBody": "cms", "interface": "cms", "reduce": "cms",
+    "LoadCircle": "fe.attachment", "static_compliance": "fe.compliance",
     # connectors
     "Bushing": "connectors", "ContactLaw": "connectors", "GearContact": "connectors",
     "add_fixed_joint": "connectors", "add_interface_joint": "connectors", "add_speed_drive": "connectors",

@@ -24,18 +24,20 @@ opposite hand at z = +/-(b_h + gap)/2, each half the face width).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from flexgear.connectors import ContactLaw, GearContact, contact_gradients
 from flexgear.involute import (
     Gear,
+    HelixHalf,
     Mesh,
     PeriodicSeries,
     contact_line_series,
+    helix_halves,
     inv,
     inv_inverse,
+    tooth_normal_local,
     transverse_pressure_angle,
 )
 from flexgear.massprops import MassProperties
@@ -44,27 +46,6 @@ from flexgear.spec import Contact, ContactAssumed
 __all__ = ["HelixHalf", "helix_halves", "gear_pair_geometry", "pair_contacts", "annulus_mass_properties"]
 
 _EZ = np.array([0.0, 0.0, 1.0])
-
-
-@dataclass(frozen=True)
-class HelixHalf:
-    """One helix of a single- or double-helical gear: axial mid-plane z [m], hand of gear 1, face-width share."""
-
-    z: float
-    hand: int
-    share: float
-
-
-def helix_halves(layout: str, helix_face_width: float, half_gap: float, hand: int = 1) -> list[HelixHalf]:
-    """Helix halves of a ``"single"`` or ``"double"`` (herringbone) layout; ``hand``: gear 1 in the half at +z."""
-    if hand not in (1, -1):
-        raise ValueError(f"hand must be +1 (right) or -1 (left), got {hand!r}")
-    if layout == "single":
-        return [HelixHalf(0.0, hand, 1.0)]
-    if layout == "double":
-        z = 0.5 * (helix_face_width + half_gap)
-        return [HelixHalf(z, hand, 0.5), HelixHalf(-z, -hand, 0.5)]
-    raise ValueError(f"helix_layout must be 'single' or 'double', got {layout!r}")
 
 
 def gear_pair_geometry(z1: int, z2: int, normal_module: float, helix_angle: float, pressure_angle: float,
@@ -136,12 +117,12 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: Mesh, centre1, centre
                          f"{mesh.centre_distance} m")
     s = 1.0 if drive_sign >= 0 else -1.0
     if mesh.internal:
-        e, r_w1 = -d / a, a * g1.teeth / (g2.teeth - g1.teeth)
+        e = -d / a
     else:
-        e, r_w1 = d / a, a * g1.teeth / (g1.teeth + g2.teeth)
+        e = d / a
+    r_w1 = mesh.operating_pitch_radii[0]
     alpha = mesh.operating_pressure_angle
     t_dir = math.sin(alpha) * e + s * math.cos(alpha) * np.cross(_EZ, e)
-    beta_b = g1.base_helix_angle
     helix_width = g1.face_width / (2 if helix_layout == "double" else 1)
     n_harm = contact_assumed.stiffness_harmonics
     stiffness, sliding, lever = contact_line_series(mesh, helix_width, n_harm)
@@ -153,7 +134,8 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: Mesh, centre1, centre
         phase_per_drive_angle = g1.teeth * (spins[0] - carrier_spin) * s / (2 * math.pi)
     out = []
     for k, half in enumerate(helix_halves(helix_layout, helix_width, half_gap, hand), start=1):
-        normal = math.cos(beta_b) * t_dir - half.hand * s * math.sin(beta_b) * _EZ
+        n_r, n_t, n_z = tooth_normal_local(mesh, s, half.hand)
+        normal = n_r * e + n_t * np.cross(_EZ, e) + n_z * _EZ
         point = c1 + r_w1 * e + [0.0, 0.0, half.z]
         grad1, grad2 = contact_gradients(c1, c2, point, normal, t_dir)
         out.append(GearContact(
