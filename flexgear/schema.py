@@ -24,6 +24,7 @@ __all__ = [
     "Bearings",
     "Contact",
     "ContactAssumed",
+    "SupportsAssumed",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",
@@ -200,6 +201,9 @@ class Contact:
     damping_fraction_of_stiffness: float = _num(0.0)
     penetration_depth_m: float = _num(0.0, lo_open=True)
     friction_coefficient: float = _num(0.0, 1.0)
+    # "impact": the study's ADAMS law (section 2.1, the fields above); "iso6336": linear mesh stiffness of
+    # ISO 6336-1 (flexgear.laws.iso6336) with eq. 13 damping ([contact_assumed] mesh_damping_ratio)
+    law: str = field(default="impact", metadata={"choices": ("impact", "iso6336"), "doc": "contact law"})
 
 
 @dataclass(frozen=True)
@@ -209,6 +213,9 @@ class ContactAssumed:
     stiffness_harmonics: int = _num(0, 10, integer=True)
     stiffness_variation: str = _choice("contact_lines", "constant")
     friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
+    mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0,
+                                                              "doc": "xi of eq. 13 (iso6336 law)"})
+    application_factor: float = field(default=1.0, metadata={"lo": 1.0, "doc": "K_A of ISO 6336-1 (iso6336 law)"})
 
 
 @dataclass(frozen=True)
@@ -259,9 +266,13 @@ class ReductionSettings:
 
     fixed_interface_modes: int = _num(0, 200, integer=True)
     interface: str = _choice("rbe3", "rbe2")
-    simulation_modes: int = _num(1, 200, integer=True)
     modal_stiffness_damping_s: float = _num(0.0)
     contact_fourier_order: int = _num(1, 60, integer=True)
+    # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
+    attachment_order: int = _num(0, 60, integer=True)
+    # 0: keep every mode of the (attachment-corrected) basis; n > 0: only the n lowest (loses the
+    # static correction: for speed experiments only).
+    simulation_modes: int = _num(0, 400, integer=True, default=0)
 
 
 @dataclass(frozen=True)
@@ -318,6 +329,19 @@ class LumpedAssumed:
 
 
 @dataclass(frozen=True)
+class SupportsAssumed:
+    """Where the bearings, the speed drive and the load torque act (flexgear.geometry.supports).
+
+    ``placement`` "bearing_seats": bushings at the shafts' bearing seats and the planets' bores, drive and load at
+    the input shaft's and output shaft's bearing-seat interfaces; "gear_centres": all on the body frames at the
+    gear mid-planes (the former model, kept for comparison).
+    """
+
+    placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
+                                                              "doc": "where supports act"})
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -336,6 +360,7 @@ class GearboxSpec:
     reduction_assumed: ReductionSettings
     screening: ScreeningSettings
     lumped_assumed: LumpedAssumed
+    supports_assumed: SupportsAssumed = field(default_factory=SupportsAssumed)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""

@@ -44,6 +44,7 @@ from flexgear.schema import (
     ScreeningSettings,
     SolverSettings,
     SpecError,
+    SupportsAssumed,
     Variant,
 )
 
@@ -57,6 +58,7 @@ __all__ = [
     "Bearings",
     "Contact",
     "ContactAssumed",
+    "SupportsAssumed",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",
@@ -165,7 +167,8 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     unknown = sorted(set(raw) - set(tables))
     if unknown:
         raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
-    for name in tables:
+    optional = {f.name for f in dataclasses.fields(GearboxSpec) if f.default_factory is not dataclasses.MISSING}
+    for name in tables - optional:
         if name not in raw:
             raise SpecError(path, name, "missing (required)")
     if not isinstance(raw["title"], str):
@@ -176,7 +179,8 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     kwargs: dict[str, Any] = {"source": path, "title": raw["title"]}
     for name in tables - {"title", "meshing_assumed"}:
-        kwargs[name] = _build(hints[name], raw[name], path, name)
+        if name in raw:
+            kwargs[name] = _build(hints[name], raw[name], path, name)
     kwargs["meshing_assumed"] = {
         level: _build(MeshingSettings, table, path, f"meshing_assumed.{level}")
         for level, table in meshing.items()

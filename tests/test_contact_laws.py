@@ -75,16 +75,23 @@ def test_compiled_forms_match_numpy():
     assert f_sym.Evaluate() == pytest.approx(float(f_np), rel=1e-12)
 
 
-def test_compiled_friction_kernel_equals_reference(model1):
+@pytest.mark.parametrize("law", ["impact", "iso6336"])
+def test_compiled_friction_kernel_equals_reference(model1, law):
+    import dataclasses
+
     import exudyn as exu
 
     from flexgear.mbs.gearbox import build_star_gearbox
 
+    gb = model1.gearbox
+    variant = dataclasses.replace(model1, gearbox=gb.with_changes(contact=dataclasses.replace(gb.contact, law=law)))
     mbs = exu.SystemContainer().AddSystem()
-    friction = build_star_gearbox(mbs, model1).friction
+    friction = build_star_gearbox(mbs, variant).friction
+    assert friction.law.kind == law
     rng = np.random.default_rng(7)
+    scale = 1e-4 if law == "impact" else 1e-5  # deflections of the law's order
     for t in (0.01, 0.3, 0.55):
-        d, dt, qt = rng.uniform(-1e-4, 5e-4, 20), rng.normal(0, 1e-3, 20), rng.normal(0, 300, 42)
+        d, dt, qt = rng.uniform(-scale, 5 * scale, 20), rng.normal(0, 1e-3, 20), rng.normal(0, 300, 42)
         ref = friction.forces(t, d, dt, qt)
         assert np.max(np.abs(friction.fast_forces(t, d, dt, qt) - ref)) < 1e-9 * np.max(np.abs(ref))
 

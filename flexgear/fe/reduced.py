@@ -6,6 +6,11 @@ Interfaces (where a component is connected; RBE3, distributing, by default):
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
 - output shaft: "bolt_circle", the bolt-hole walls of its web, and "bearing_seat" (``bearing_seat_width_mm``
   at the far end of the tube).
+Load circles (attachment modes, flexgear.fe.attachment): each gear's contact bands, one per mesh and
+helix half, at the mesh's operating pitch radius (sun: the sun-planet mesh; planet: both meshes; ring:
+the planet-ring mesh), over the half's face width, loaded along the tooth normal in the gear's local
+frame, with the band the contact kernel reads (one normal module). The shafts carry their loads at
+their interfaces, whose static modes the basis holds anyway.
 The mesh is the component's cached mesh at the variant's level (flexgear.fe.mesh); the tooth
 compliance itself is in the contact law. Results are cached by a hash of the geometry, the
 mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body).
@@ -13,23 +18,27 @@ mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body
 
 from __future__ import annotations
 
+import dataclasses
+import math
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
+from flexgear.geometry.involute import gear_set_geometry, helix_halves, tooth_normal_local
 from flexgear.geometry.layout import component_layout, geometry_hash
 from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
-__all__ = ["component_interfaces", "component_reduced_body", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
-           "joint_point"]
+__all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
+           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point"]
 
 """Variant component name -> geometry component name."""
 
-_REDUCTION_VERSION = 3  # 3: shaft-sun seat, bolt circle and bearing seats as interfaces
+_REDUCTION_VERSION = 4  # 4: attachment modes on the contact bands, whole compressed basis kept
 _TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
 
 
@@ -71,6 +80,59 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
     return [joint, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
+def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
+    """(load circle of order 0, angles of the contacts on it [rad]) per contact band of a gear.
+
+    Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
+    pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it; planet 1
+    (at angle 0) meets the sun at angle pi and the ring at 0 about its own centre.
+    """
+    if component not in ("sun", "planet", "ring"):
+        return []
+    geo = gear_set_geometry(spec)
+    sigma = math.copysign(1.0, spec.load_case.input_speed_rad_s)
+    planets = np.asarray(geo.planet_angles, float)
+    # (mesh, hand of gear 1, drive sign, is this component gear 1, contact angles on this component)
+    meshes = {"sun": [(geo.sun_planet, 1, sigma, True, planets)],
+              "planet": [(geo.sun_planet, 1, sigma, False, np.array([math.pi])),
+                         (geo.planet_ring, -1, -sigma, True, np.array([0.0]))],
+              "ring": [(geo.planet_ring, -1, -sigma, False, planets)]}[component]
+    width = geo.helix_face_width
+    out = []
+    for mesh, hand, drive, first, angles in meshes:
+        radius = mesh.operating_pitch_radii[0 if first else 1]
+        for half in helix_halves(geo.helix_layout, width, geo.half_gap, hand):
+            n_r, n_t, n_z = tooth_normal_local(mesh, drive, half.hand)
+            direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
+            circle = LoadCircle(radius, half.z - width / 2, half.z + width / 2, 0, direction,
+                                spec.gears.normal_module_m)
+            out.append((circle, angles))
+    return out
+
+
+def component_load_circles(spec: GearboxSpec, component: str, order: int) -> list[LoadCircle]:
+    """Load circles of ``order`` on ``component``'s contact bands (module docstring); [] for shafts or order 0."""
+    if order == 0:
+        return []
+    return [dataclasses.replace(c, order=order) for c, _ in _contact_bands(spec, component)]
+
+
+def component_contacts(spec: GearboxSpec, component: str) -> tuple[np.ndarray, np.ndarray]:
+    """Contact points (p, 3) [m] and tooth normals (p, 3) of a gear in its body frame, per band and angle.
+
+    Sun and ring: the five planets' contacts on each helix half; planet: its sun and ring contacts.
+    """
+    points, normals = [], []
+    for circle, angles in _contact_bands(spec, component):
+        z = 0.5 * (circle.z_min_m + circle.z_max_m)
+        for a in angles:
+            e_r, e_t = np.array([math.cos(a), math.sin(a), 0.0]), np.array([-math.sin(a), math.cos(a), 0.0])
+            d = circle.direction
+            points.append(circle.radius_m * e_r + [0.0, 0.0, z])
+            normals.append(d[0] * e_r + d[1] * e_t + [0.0, 0.0, d[2]])
+    return np.array(points).reshape(-1, 3), np.array(normals).reshape(-1, 3)
+
+
 def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
     """Point [m] (component frame = gearbox frame) where ``gear`` ("sun" or "ring") is joined to its shaft.
 
@@ -97,8 +159,9 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
     name = COMPONENT_GEOMETRY[component]
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
+    circles = component_load_circles(spec, name, red.attachment_order)
     key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
-                        red.simulation_modes, _REDUCTION_VERSION)
+                        red.simulation_modes, [c.key() for c in circles], _REDUCTION_VERSION)
 
     def build() -> ReducedBody:
         from flexgear.fe.fem import fe_model
@@ -112,7 +175,7 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
         mesh = component_mesh(spec, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
-                      n_compare=0, keep_modes=red.simulation_modes)
+                      n_compare=0, keep_modes=red.simulation_modes or None, load_circles=circles)
 
     return cached_reduced_body(f"{name}-{level}-{key}", build)
 

@@ -24,13 +24,14 @@ opposite hand at z = +/-(b_h + gap)/2, each half the face width).
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import numpy as np
 
 from flexgear.geometry.involute import (
     Gear,
     GearMesh,
+    HelixHalf,
+    helix_halves,
     inv,
     inv_inverse,
     transverse_pressure_angle,
@@ -39,27 +40,6 @@ from flexgear.geometry.involute import (
 __all__ = ["HelixHalf", "helix_halves", "gear_pair_geometry"]
 
 _EZ = np.array([0.0, 0.0, 1.0])
-
-
-@dataclass(frozen=True)
-class HelixHalf:
-    """One helix of a single- or double-helical gear: axial mid-plane z [m], hand of gear 1, face-width share."""
-
-    z: float
-    hand: int
-    share: float
-
-
-def helix_halves(layout: str, helix_face_width: float, half_gap: float, hand: int = 1) -> list[HelixHalf]:
-    """Helix halves of a ``"single"`` or ``"double"`` (herringbone) layout; ``hand``: gear 1 in the half at +z."""
-    if hand not in (1, -1):
-        raise ValueError(f"hand must be +1 (right) or -1 (left), got {hand!r}")
-    if layout == "single":
-        return [HelixHalf(0.0, hand, 1.0)]
-    if layout == "double":
-        z = 0.5 * (helix_face_width + half_gap)
-        return [HelixHalf(z, hand, 0.5), HelixHalf(-z, -hand, 0.5)]
-    raise ValueError(f"helix_layout must be 'single' or 'double', got {layout!r}")
 
 
 def gear_pair_geometry(z1: int, z2: int, normal_module: float, helix_angle: float, pressure_angle: float,

@@ -21,6 +21,7 @@ import traceback
 import numpy as np
 import pandas as pd
 
+from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.progress import Progress
@@ -54,27 +55,33 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
         acc = data(key)
         cols[f"{side}_bearing_accel_x_m_per_s2"] = acc[:, 1]
         cols[f"{side}_bearing_accel_y_m_per_s2"] = acc[:, 2]
-    return pd.DataFrame({c: cols[c] for c in signal_columns(n)})
+    frame = pd.DataFrame({c: cols[c] for c in signal_columns(n)})
+    # optional columns (flexgear.mbs.deflection): loaded transmission error, flexible gears' mesh deflections
+    time = cols["time_s"]
+    extra = {"transmission_error_m": transmission_error(model, time, data("output_spin")[:, 1 + model.output_spin[1]])}
+    if model.kinematics is not None:
+        modal = {k[len("modes_"):]: data(k)[:, 1:] for k in sensors if k.startswith("modes_")}
+        extra.update(mesh_deflection_signals(model, time, modal))
+    return pd.concat([frame, pd.DataFrame(extra)], axis=1)
 
 
-def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], window_start: float) -> dict[str, float]:
-    """Share of the mesh approach taken up by the flexible gears' elastic deformation, per mesh kind.
+def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], signals: pd.DataFrame,
+                  window_start: float) -> dict[str, float]:
+    """Share of the mesh penetration that the flexible gears' deformation takes up, per mesh kind.
 
-    The contact coordinate is the penetration delta = (rigid approach) + (elastic terms), where the
-    elastic terms are negative when the gears yield under the mesh force: share = -mean(elastic) / mean(delta).
+    ``elastic_share_{kind}``: load-induced deflection (flexgear.mbs.deflection, relative to the gears' seats)
+    over the mean penetration delta of the contacts; ``centrifugal_share_{kind}``: the centrifugal part
+    likewise (negative: spin growth deepens the penetration).
     """
-    kin = model.kinematics
     defl = np.asarray(mbs.GetSensorStoredData(sensors["deflections"]))
-    keep = np.flatnonzero(defl[:, 0] >= window_start)[::10]
-    modal = [np.asarray(mbs.GetSensorStoredData(sensors[k]))[:, 1:] for k in sensors if k.startswith("modes_")]
-    q = np.hstack(modal)
-    first = kin.base.shape[1] - q.shape[1]
-    elastic = np.array([kin.matrix_at(defl[k, 0])[:, first:] @ q[k] for k in keep])
-    total = defl[keep, 1:]
+    total = defl[defl[:, 0] >= window_start, 1:]
+    w = signals[signals.time_s >= window_start]
     out = {}
     for kind in ("outer", "inner"):
         rows = [i for i, c in enumerate(model.contacts) if c.name.startswith(kind)]
-        out[f"elastic_share_{kind}"] = float(-elastic[:, rows].mean() / total[:, rows].mean())
+        for part, key in (("load", "elastic_share"), ("centrifugal", "centrifugal_share")):
+            cols = [c for c in w.columns if c.startswith(f"{kind}_deflection_{part}_")]
+            out[f"{key}_{kind}"] = float(w[cols].to_numpy().mean() / total[:, rows].mean())
     return out
 
 
@@ -206,7 +213,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         signals = _signals(mbs, model, sensors)
         window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:
-            meta.update(elastic_share(mbs, model, sensors, window_start))
+            meta.update(elastic_share(mbs, model, sensors, signals, window_start))
         for gear in model.joints:  # torque about the axis that each gear-shaft joint transmits
             torque = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}"]))
             meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
