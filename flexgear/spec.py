@@ -267,9 +267,13 @@ class ReductionSettings:
 
     fixed_interface_modes: int = _num(0, 200, integer=True)
     interface: str = _choice("rbe3", "rbe2")
-    simulation_modes: int = _num(1, 200, integer=True)
     modal_stiffness_damping_s: float = _num(0.0)
     contact_fourier_order: int = _num(1, 60, integer=True)
+    # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
+    attachment_order: int = _num(0, 60, integer=True)
+    # 0: keep every mode of the (attachment-corrected) basis; n > 0: only the n lowest (loses the
+    # static correction: for speed experiments only).
+    simulation_modes: int = _num(0, 400, integer=True, default=0)
 
 
 @dataclass(frozen=True)

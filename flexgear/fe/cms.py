@@ -45,10 +45,12 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 from threadpoolctl import threadpool_limits
 
+from flexgear.fe.attachment import LoadCircle, load_patterns, modal_basis
 from flexgear.fe.fem import FEModel, rigid_body_modes
 from flexgear.geometry.massprops import MassProperties
 
-__all__ = ["Interface", "ReducedBody", "interface", "rbe3_weights", "reduce", "full_free_modes", "ffrf_invariants"]
+__all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights", "reduce", "reduction_basis",
+           "full_free_modes", "ffrf_invariants"]
 
 _EPS = np.zeros((3, 3, 3))
 _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
@@ -307,8 +309,10 @@ def ffrf_invariants(mass_scalar: sp.spmatrix, nodes: np.ndarray, modes: np.ndarr
             "mXRefTildePsi": xref_tilde_psi, "mXRefTildePsiTilde": xref_tilde_psi_tilde}
 
 
-def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int) -> tuple[np.ndarray, int]:
-    """Classical Craig-Bampton basis with rigid interface patches."""
+def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int,
+                patterns: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Classical Craig-Bampton basis with rigid interface patches, plus the static responses to the load
+    ``patterns`` (3n, p) with the interface nodes clamped."""
     bnodes = np.unique(np.concatenate([i.nodes for i in interfaces]))
     bdofs = (3 * bnodes[:, None] + np.arange(3)).ravel()
     mask = np.ones(fe.n_dof, bool)
@@ -334,18 +338,55 @@ def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int) -> tuple
         _, vec = sla.eigsh(k_ii, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", tol=1e-10)
         fixed = np.zeros((fe.n_dof, n_modes))
         fixed[idofs] = vec
-    return np.hstack([static, fixed]), lu.L.nnz + lu.U.nnz
+    attached = np.zeros_like(patterns)
+    if patterns.shape[1]:
+        attached[idofs] = lu.solve(np.ascontiguousarray(patterns[idofs]))
+    return static, fixed, attached, lu.L.nnz + lu.U.nnz
+
+
+@dataclass
+class BasisParts:
+    """The reduction basis before compression: interface static modes (3n, 6 J), fixed-interface modes
+    (3n, n_modes, lowest first), attachment modes (3n, sum 2 N + 1, per circle in the order of
+    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor size."""
+
+    static: np.ndarray
+    fixed: np.ndarray
+    attached: np.ndarray
+    nnz: int
+    solver: _FreeBodySolver | None = None
+
+
+@threadpool_limits.wrap(limits=1, user_api="blas")
+def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str = "rbe3",
+                    load_circles: list[LoadCircle] | None = None) -> BasisParts:
+    """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation."""
+    circles = list(load_circles or [])
+    patterns = (np.hstack([load_patterns(fe.nodes, c) for c in circles]) if circles
+                else np.zeros((fe.n_dof, 0)))
+    if kind != "rbe3":
+        return BasisParts(*_rbe2_basis(fe, itfs, n_modes, patterns))
+    solver = _FreeBodySolver(fe)
+    con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
+    static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
+    fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))
+    attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
+    return BasisParts(static, fixed, attached, solver.nnz_factor, solver)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
 def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: str = "rbe3",
-           n_compare: int = 12, keep_modes: int | None = None) -> ReducedBody:
+           n_compare: int = 12, keep_modes: int | None = None,
+           load_circles: list[LoadCircle] | None = None) -> ReducedBody:
     """Craig-Bampton reduction of ``fe`` with ``interfaces`` and ``n_modes`` fixed-interface modes.
 
-    ``kind``: "rbe3" (distributing interfaces, default) or "rbe2" (rigid patches). The flexible
-    basis has 6 J + n_modes - 6 free-free modes of the reduced model (all of them, or the lowest
-    ``keep_modes``). ``n_compare`` lowest free-free modes of the full FE model are computed for the
-    comparison stored in the result (0 skips it).
+    ``kind``: "rbe3" (distributing interfaces, default) or "rbe2" (rigid patches). ``load_circles``
+    (flexgear.fe.attachment.LoadCircle): their Fourier load patterns' static responses with the
+    interfaces held join the basis as attachment modes (exact compliance under the contact kernel's
+    loads). The basis is mass-orthonormalised (dependent directions dropped) and its free-free modes
+    are the flexible coordinates: 6 J + n_modes + sum(2 N + 1) - 6 of them, less dropped ones (all,
+    or the lowest ``keep_modes``, which loses the static correction). ``n_compare`` lowest free-free
+    modes of the full FE model are computed for the comparison stored in the result (0 skips it).
     """
     if kind not in ("rbe3", "rbe2"):
         raise ValueError(f"reduce: kind must be 'rbe3' or 'rbe2', got {kind!r}")
@@ -353,33 +394,17 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
         raise ValueError("reduce: at least one interface is needed (it fixes the static modes' rigid part)")
     itfs = [interface(fe, i) if isinstance(i, str) else i for i in interfaces]
     t0 = time.perf_counter()
-    solver = None
-    if kind == "rbe3":
-        solver = _FreeBodySolver(fe)
-        con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
-        static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
-        fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))
-        basis, nnz = np.hstack([static, fixed]), solver.nnz_factor
-    else:
-        basis, nnz = _rbe2_basis(fe, itfs, n_modes)
-    m = fe.M
-    mt = m @ basis
-    m_red, k_red = basis.T @ mt, basis.T @ (fe.K @ basis)
-    m_red, k_red = (m_red + m_red.T) / 2, (k_red + k_red.T) / 2
-    lam, vec = la.eigh(k_red, m_red)
-    if lam[6] < 1e-8 * abs(lam[-1]) or np.any(np.abs(lam[:6]) > 1e-6 * lam[6]):
-        raise RuntimeError(f"reduce: expected exactly 6 rigid-body modes, eigenvalues start {lam[:8]}")
-    keep = slice(6, None if keep_modes is None else 6 + keep_modes)
-    lam, vec = lam[keep], vec[:, keep]
-    modes = basis @ vec  # mass-normalised: vec^T m_red vec = I
+    parts = reduction_basis(fe, itfs, n_modes, kind, load_circles)
+    modes, lam, dropped = modal_basis(np.hstack([parts.static, parts.fixed, parts.attached]), fe.K, fe.M)
+    if keep_modes is not None:
+        modes, lam = modes[:, :keep_modes], lam[:keep_modes]
     t_reduce = time.perf_counter() - t0
     full = np.zeros(0)
     if n_compare:
-        if solver is None:
-            solver = _FreeBodySolver(fe)
-        full = full_free_modes(fe, n_compare, solver)[0]
+        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
     invariants = ffrf_invariants(fe.mass_scalar, fe.nodes, modes)
-    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_nnz": float(nnz),
+    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_nnz": float(parts.nnz),
+            "attachment_vectors": float(parts.attached.shape[1]), "dropped_directions": float(dropped),
             "reduce_time_s": t_reduce, "total_time_s": time.perf_counter() - t0}
     return ReducedBody(fe.nodes, modes, lam, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), full, itfs, kind,
                        n_modes, fe.mass_properties(), invariants, fe.surface_triangles, info)

@@ -6,6 +6,11 @@ Interfaces (where a component is connected; RBE3, distributing, by default):
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
 - output shaft: "bolt_circle", the bolt-hole walls of its web, and "bearing_seat" (``bearing_seat_width_mm``
   at the far end of the tube).
+Load circles (attachment modes, flexgear.fe.attachment): each gear's contact bands, one per mesh and
+helix half, at the mesh's operating pitch radius (sun: the sun-planet mesh; planet: both meshes; ring:
+the planet-ring mesh), over the half's face width, loaded along the tooth normal in the gear's local
+frame, with the band the contact kernel reads (one normal module). The shafts carry their loads at
+their interfaces, whose static modes the basis holds anyway.
 The mesh is the component's cached mesh at the variant's level (flexgear.fe.mesh); the tooth
 compliance itself is in the contact law. Results are cached by a hash of the geometry, the
 mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body).
@@ -13,22 +18,26 @@ mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
 from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
+from flexgear.geometry.involute import gear_set_geometry, tooth_normal_local
 from flexgear.geometry.layout import component_layout, geometry_hash
+from flexgear.geometry.pair import helix_halves
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
-__all__ = ["component_interfaces", "component_reduced_body", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
-           "joint_point"]
+__all__ = ["component_interfaces", "component_load_circles", "component_reduced_body", "COMPONENT_GEOMETRY",
+           "JOINT_INTERFACES", "joint_point"]
 
 """Variant component name -> geometry component name."""
 
-_REDUCTION_VERSION = 3  # 3: shaft-sun seat, bolt circle and bearing seats as interfaces
+_REDUCTION_VERSION = 4  # 4: attachment modes on the contact bands, whole compressed basis kept
 _TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
 
 
@@ -70,6 +79,32 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
     return [joint, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
+def component_load_circles(spec: GearboxSpec, component: str, order: int) -> list[LoadCircle]:
+    """Load circles of ``component``'s contact bands (see the module docstring); [] for shafts or order 0.
+
+    Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
+    pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it.
+    """
+    if component not in ("sun", "planet", "ring") or order == 0:
+        return []
+    geo = gear_set_geometry(spec)
+    sigma = math.copysign(1.0, spec.load_case.input_speed_rad_s)
+    band = spec.gears.normal_module_m
+    # (mesh, hand of gear 1, drive sign, is this component gear 1)
+    meshes = {"sun": [(geo.sun_planet, 1, sigma, True)],
+              "planet": [(geo.sun_planet, 1, sigma, False), (geo.planet_ring, -1, -sigma, True)],
+              "ring": [(geo.planet_ring, -1, -sigma, False)]}[component]
+    width = geo.helix_face_width
+    circles = []
+    for mesh, hand, drive, first in meshes:
+        radius = mesh.operating_pitch_radii[0 if first else 1]
+        for half in helix_halves(geo.helix_layout, width, geo.half_gap, hand):
+            n_r, n_t, n_z = tooth_normal_local(mesh, drive, half.hand)
+            direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
+            circles.append(LoadCircle(radius, half.z - width / 2, half.z + width / 2, order, direction, band))
+    return circles
+
+
 def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
     """Point [m] (component frame = gearbox frame) where ``gear`` ("sun" or "ring") is joined to its shaft.
 
@@ -96,8 +131,9 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
     name = COMPONENT_GEOMETRY[component]
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
+    circles = component_load_circles(spec, name, red.attachment_order)
     key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
-                        red.simulation_modes, _REDUCTION_VERSION)
+                        red.simulation_modes, [c.key() for c in circles], _REDUCTION_VERSION)
 
     def build() -> ReducedBody:
         from flexgear.fe.fem import fe_model
@@ -110,7 +146,7 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
         mesh = component_mesh(spec, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
-                      n_compare=0, keep_modes=red.simulation_modes)
+                      n_compare=0, keep_modes=red.simulation_modes or None, load_circles=circles)
 
     return cached_reduced_body(f"{name}-{level}-{key}", build)
 

@@ -35,6 +35,7 @@ __all__ = [
     "Gear",
     "GearMesh",
     "Mesh",
+    "tooth_normal_local",
     "GearSetGeometry",
     "solve_profile_shifts",
     "gear_set_geometry",
@@ -172,6 +173,13 @@ class GearMesh:
         return self.gear1.base_pitch
 
     @property
+    def operating_pitch_radii(self) -> tuple[float, float]:
+        """r_w1 = a z1 / (z2 +/- z1), r_w2 = a z2 / (z2 +/- z1) [m] (- for an internal gear 2)."""
+        z1, z2, a = self.gear1.teeth, self.gear2.teeth, self.centre_distance
+        den = z2 - z1 if self.internal else z1 + z2
+        return a * z1 / den, a * z2 / den
+
+    @property
     def transverse_contact_ratio(self) -> float:
         """eps_alpha from the tip radii, base radii and operating centre distance."""
         g1, g2 = self.gear1, self.gear2
@@ -209,6 +217,20 @@ class GearMesh:
 
 Mesh = GearMesh
 """Deprecated alias of :class:`GearMesh` (kept for one release; 'mesh' alone also means an FE mesh)."""
+
+
+def tooth_normal_local(mesh: GearMesh, drive_sign: float, hand: int) -> tuple[float, float, float]:
+    """Tooth normal (force on gear 2) at the pitch point in gear 1's local (radial, tangential, axial) frame.
+
+    n = cos(beta_b) t - h s sin(beta_b) e_z with t = sin(alpha_wt) e_r + s cos(alpha_wt) e_t: the normal
+    of flexgear.mbs.contacts.pair_contacts (s: ``drive_sign``, h: ``hand`` of gear 1 in the helix half). An
+    internal gear 2 has the same local components; an external gear 2 (e_r, e_t reversed)
+    (-n_r, -n_t, n_z).
+    """
+    s = 1.0 if drive_sign >= 0 else -1.0
+    alpha, beta_b = mesh.operating_pressure_angle, mesh.gear1.base_helix_angle
+    return (math.cos(beta_b) * math.sin(alpha), s * math.cos(beta_b) * math.cos(alpha),
+            -hand * s * math.sin(beta_b))
 
 
 @dataclass(frozen=True)

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.fe.attachment import LoadCircle, circle_band, fourier_basis, local_directions
 from flexgear.laws.ramps import drive_angle
 
 __all__ = ["ModalColumn", "modal_contact_coefficients", "ContactKinematics", "PreStepChain"]
@@ -52,37 +53,21 @@ def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.n
 
     ``nodes`` (n, 3) and ``modes`` (3n, m) in the body frame (gear centre at the origin, z the axis);
     ``point`` the contact point relative to the gear centre at zero spin; ``normal`` the tooth normal;
-    nodes within ``radial_band`` of the contact radius and ``half_width`` of its axial position are
-    fitted by a least-squares Fourier series of ``order`` harmonics in alpha.
+    nodes within ``radial_band`` of the contact radius and ``half_width`` of its axial position (the
+    band of flexgear.fe.attachment.circle_band, the same the attachment modes load) are fitted by a
+    least-squares Fourier series of ``order`` harmonics in alpha.
     """
     r, z, psi = math.hypot(point[0], point[1]), point[2], math.atan2(point[1], point[0])
-    rho, ang = np.hypot(nodes[:, 0], nodes[:, 1]), np.arctan2(nodes[:, 1], nodes[:, 0])
-    n_terms = 2 * order + 1
-    band = radial_band
-    for _ in range(8):
-        sel = np.flatnonzero((np.abs(rho - r) <= band) & (np.abs(nodes[:, 2] - z) <= half_width))
-        if len(sel) >= 4 * n_terms:
-            break
-        band *= 1.5
-    else:
-        raise ValueError(f"only {len(sel)} mesh nodes near the contact circle r = {r:.4f} m, z = {z:.4f} m: "
-                         f"too few for a Fourier fit of order {order}")
-    alpha = ang[sel]
-    # tooth normal carried with the material point: R(alpha - psi) n
-    ca, sa = np.cos(alpha - psi), np.sin(alpha - psi)
-    n_b = np.stack([ca * normal[0] - sa * normal[1], sa * normal[0] + ca * normal[1],
-                    np.full_like(alpha, normal[2])], axis=1)
+    circle = LoadCircle(r, z - half_width, z + half_width, order, radial_band_m=radial_band)
+    sel = circle_band(nodes, circle)
+    alpha = np.arctan2(nodes[sel, 1], nodes[sel, 0])
+    # tooth normal carried with the material point: R(alpha - psi) n, constant in the local frame
+    c, s = math.cos(psi), math.sin(psi)
+    local = (c * normal[0] + s * normal[1], -s * normal[0] + c * normal[1], normal[2])
     phi = modes.reshape(len(nodes), 3, -1)[sel]  # (k, 3, m)
-    samples = np.einsum("kd,kdm->km", n_b, phi)
-
-    def basis(a: np.ndarray) -> np.ndarray:
-        cols = [np.ones_like(a)]
-        for h in range(1, order + 1):
-            cols += [np.cos(h * a), np.sin(h * a)]
-        return np.stack(cols, axis=1)
-
-    coef, *_ = np.linalg.lstsq(basis(alpha), samples, rcond=None)
-    return basis(2 * np.pi * np.arange(n_grid) / n_grid) @ coef
+    samples = np.einsum("kd,kdm->km", local_directions(alpha, local), phi)
+    coef, *_ = np.linalg.lstsq(fourier_basis(alpha, order), samples, rcond=None)
+    return fourier_basis(2 * np.pi * np.arange(n_grid) / n_grid, order) @ coef
 
 
 class ContactKinematics:

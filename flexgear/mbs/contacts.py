@@ -27,7 +27,7 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_series
+from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_series, tooth_normal_local
 from flexgear.geometry.pair import _EZ, helix_halves
 from flexgear.laws.contact import ContactLaw, friction_forces, impact_force, periodic_value
 from flexgear.laws.ramps import drive_angle
@@ -387,12 +387,12 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
                          f"{mesh.centre_distance} m")
     s = 1.0 if drive_sign >= 0 else -1.0
     if mesh.internal:
-        e, r_w1 = -d / a, a * g1.teeth / (g2.teeth - g1.teeth)
+        e = -d / a
     else:
-        e, r_w1 = d / a, a * g1.teeth / (g1.teeth + g2.teeth)
+        e = d / a
+    r_w1 = mesh.operating_pitch_radii[0]
     alpha = mesh.operating_pressure_angle
     t_dir = math.sin(alpha) * e + s * math.cos(alpha) * np.cross(_EZ, e)
-    beta_b = g1.base_helix_angle
     helix_width = g1.face_width / (2 if helix_layout == "double" else 1)
     n_harm = contact_assumed.stiffness_harmonics
     stiffness, sliding, lever = contact_line_series(mesh, helix_width, n_harm)
@@ -404,7 +404,8 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
         phase_per_drive_angle = g1.teeth * (spins[0] - carrier_spin) * s / (2 * math.pi)
     out = []
     for k, half in enumerate(helix_halves(helix_layout, helix_width, half_gap, hand), start=1):
-        normal = math.cos(beta_b) * t_dir - half.hand * s * math.sin(beta_b) * _EZ
+        n_r, n_t, n_z = tooth_normal_local(mesh, s, half.hand)
+        normal = n_r * e + n_t * np.cross(_EZ, e) + n_z * _EZ
         point = c1 + r_w1 * e + [0.0, 0.0, half.z]
         grad1, grad2 = contact_gradients(c1, c2, point, normal, t_dir)
         out.append(GearContact(
