@@ -359,14 +359,16 @@ class BasisParts:
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str = "rbe3",
-                    load_circles: list[LoadCircle] | None = None) -> BasisParts:
-    """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation."""
+                    load_circles: list[LoadCircle] | None = None,
+                    solver: _FreeBodySolver | None = None) -> BasisParts:
+    """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation
+    (``solver``: the free body's, if already made)."""
     circles = list(load_circles or [])
     patterns = (np.hstack([load_patterns(fe.nodes, c) for c in circles]) if circles
                 else np.zeros((fe.n_dof, 0)))
     if kind != "rbe3":
         return BasisParts(*_rbe2_basis(fe, itfs, n_modes, patterns))
-    solver = _FreeBodySolver(fe)
+    solver = solver or _FreeBodySolver(fe)
     con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
     fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))

@@ -26,7 +26,7 @@ from flexgear.fe.attachment import LoadCircle, kernel_load
 from flexgear.fe.cms import Interface, ReducedBody, _FreeBodySolver, _rbe3_rows, interface, rbe3_weights
 from flexgear.fe.fem import FEModel, rigid_body_modes
 
-__all__ = ["static_compliance", "surface_node_areas", "point_loads"]
+__all__ = ["static_compliance", "surface_node_areas", "point_loads", "free_body_solver"]
 
 _SOLVER: list = [None, None]  # (FE model, its free-body solver): the last one, reused by the next call
 
@@ -73,7 +73,8 @@ def _kernel_loads(nodes: np.ndarray, circles: Sequence[LoadCircle], points, dire
     return np.stack(cols, axis=1)
 
 
-def _fe_solver(fe: FEModel) -> _FreeBodySolver:
+def free_body_solver(fe: FEModel) -> _FreeBodySolver:
+    """The free-body factorisation of ``fe`` (flexgear.cms), kept for the next call on the same model."""
     if _SOLVER[0] is not fe:
         _SOLVER[:] = [fe, _FreeBodySolver(fe)]
     return _SOLVER[1]
@@ -114,7 +115,7 @@ def static_compliance(model: FEModel | ReducedBody, points, directions, held: In
         return (ft_phi / model.stiffness) @ ft_phi.T
     if not isinstance(model, FEModel):
         raise TypeError(f"static_compliance: model must be an FEModel or a ReducedBody, got {type(model).__name__}")
-    con = _fe_solver(model).constrained(sp.csr_matrix(_rbe3_rows(model, itf)))
+    con = free_body_solver(model).constrained(sp.csr_matrix(_rbe3_rows(model, itf)))
     u = con.solve(f, np.zeros((6, f.shape[1])))
     c = f.T @ u
     return 0.5 * (c + c.T)

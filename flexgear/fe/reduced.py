@@ -18,6 +18,7 @@ mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body
 
 from __future__ import annotations
 
+import dataclasses
 import math
 from collections.abc import Callable
 from pathlib import Path
@@ -32,8 +33,8 @@ from flexgear.geometry.layout import component_layout, geometry_hash
 from flexgear.geometry.pair import helix_halves
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
-__all__ = ["component_interfaces", "component_load_circles", "component_reduced_body", "COMPONENT_GEOMETRY",
-           "JOINT_INTERFACES", "joint_point"]
+__all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
+           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point"]
 
 """Variant component name -> geometry component name."""
 
@@ -79,30 +80,57 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
     return [joint, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
-def component_load_circles(spec: GearboxSpec, component: str, order: int) -> list[LoadCircle]:
-    """Load circles of ``component``'s contact bands (see the module docstring); [] for shafts or order 0.
+def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
+    """(load circle of order 0, angles of the contacts on it [rad]) per contact band of a gear.
 
     Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
-    pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it.
+    pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it; planet 1
+    (at angle 0) meets the sun at angle pi and the ring at 0 about its own centre.
     """
-    if component not in ("sun", "planet", "ring") or order == 0:
+    if component not in ("sun", "planet", "ring"):
         return []
     geo = gear_set_geometry(spec)
     sigma = math.copysign(1.0, spec.load_case.input_speed_rad_s)
-    band = spec.gears.normal_module_m
-    # (mesh, hand of gear 1, drive sign, is this component gear 1)
-    meshes = {"sun": [(geo.sun_planet, 1, sigma, True)],
-              "planet": [(geo.sun_planet, 1, sigma, False), (geo.planet_ring, -1, -sigma, True)],
-              "ring": [(geo.planet_ring, -1, -sigma, False)]}[component]
+    planets = np.asarray(geo.planet_angles, float)
+    # (mesh, hand of gear 1, drive sign, is this component gear 1, contact angles on this component)
+    meshes = {"sun": [(geo.sun_planet, 1, sigma, True, planets)],
+              "planet": [(geo.sun_planet, 1, sigma, False, np.array([math.pi])),
+                         (geo.planet_ring, -1, -sigma, True, np.array([0.0]))],
+              "ring": [(geo.planet_ring, -1, -sigma, False, planets)]}[component]
     width = geo.helix_face_width
-    circles = []
-    for mesh, hand, drive, first in meshes:
+    out = []
+    for mesh, hand, drive, first, angles in meshes:
         radius = mesh.operating_pitch_radii[0 if first else 1]
         for half in helix_halves(geo.helix_layout, width, geo.half_gap, hand):
             n_r, n_t, n_z = tooth_normal_local(mesh, drive, half.hand)
             direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
-            circles.append(LoadCircle(radius, half.z - width / 2, half.z + width / 2, order, direction, band))
-    return circles
+            circle = LoadCircle(radius, half.z - width / 2, half.z + width / 2, 0, direction,
+                                spec.gears.normal_module_m)
+            out.append((circle, angles))
+    return out
+
+
+def component_load_circles(spec: GearboxSpec, component: str, order: int) -> list[LoadCircle]:
+    """Load circles of ``order`` on ``component``'s contact bands (module docstring); [] for shafts or order 0."""
+    if order == 0:
+        return []
+    return [dataclasses.replace(c, order=order) for c, _ in _contact_bands(spec, component)]
+
+
+def component_contacts(spec: GearboxSpec, component: str) -> tuple[np.ndarray, np.ndarray]:
+    """Contact points (p, 3) [m] and tooth normals (p, 3) of a gear in its body frame, per band and angle.
+
+    Sun and ring: the five planets' contacts on each helix half; planet: its sun and ring contacts.
+    """
+    points, normals = [], []
+    for circle, angles in _contact_bands(spec, component):
+        z = 0.5 * (circle.z_min_m + circle.z_max_m)
+        for a in angles:
+            e_r, e_t = np.array([math.cos(a), math.sin(a), 0.0]), np.array([-math.sin(a), math.cos(a), 0.0])
+            d = circle.direction
+            points.append(circle.radius_m * e_r + [0.0, 0.0, z])
+            normals.append(d[0] * e_r + d[1] * e_t + [0.0, 0.0, d[2]])
+    return np.array(points).reshape(-1, 3), np.array(normals).reshape(-1, 3)
 
 
 def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
