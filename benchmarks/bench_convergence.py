@@ -131,7 +131,7 @@ def main() -> None:
     ap.add_argument("--level", default="coarse")
     ap.add_argument("--orders", type=int, nargs="+", default=[0, 2, 4, 6, 8])
     ap.add_argument("--modes", type=int, nargs="+", default=[0, 10, 20, 40])
-    ap.add_argument("--kernel-orders", type=int, nargs="+", default=[4, 8, 16, 32])
+    ap.add_argument("--kernel-orders", type=int, nargs="*", default=[4, 8, 16, 32])
     ap.add_argument("--gearbox", default=str(Path(__file__).resolve().parents[1] / "model_variants/gearbox.toml"))
     args = ap.parse_args()
     spec = load_gearbox(args.gearbox)

@@ -26,7 +26,7 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     fe = fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), material, 1)
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
     sel = np.flatnonzero(np.abs(r - (r_out if interface_outer else r_in)) < 1e-6)
-    return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes)
+    return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes or None)
 
 
 def annulus_source(spec, component: str, level: str):
