@@ -74,7 +74,7 @@ def _kernel_loads(nodes: np.ndarray, circles: Sequence[LoadCircle], points, dire
 
 
 def free_body_solver(fe: FEModel) -> _FreeBodySolver:
-    """The free-body factorisation of ``fe`` (flexgear.cms), kept for the next call on the same model."""
+    """The free-body factorisation of ``fe`` (flexgear.fe.cms), kept for the next call on the same model."""
     if _SOLVER[0] is not fe:
         _SOLVER[:] = [fe, _FreeBodySolver(fe)]
     return _SOLVER[1]
