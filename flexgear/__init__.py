@@ -27,6 +27,7 @@ _LAZY = {
     "MassProperties": "geometry.massprops", "combine_mass_properties": "geometry.massprops",
     # FE and reduction
     "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.cms",
+    "LoadCircle": "fe.attachment", "static_compliance": "fe.compliance",
     # laws
     "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",
     # multibody: bodies, elements, contacts
