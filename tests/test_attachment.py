@@ -188,3 +188,31 @@ def test_shaft_seat_compliance_reduced_equals_full_fe_and_beam_theory(component)
         assert beam[0, 0] == pytest.approx(lateral, rel=0.05)
         assert beam[1, 1] == pytest.approx(lateral, rel=0.05)
         assert beam[5, 5] == pytest.approx(torsion, rel=0.02)
+
+
+def test_spinning_ring_centrifugal_growth_matches_thin_ring_solution():
+    """Radial growth of a free slender ring spinning at omega: u = rho omega^2 R^3 / E (membrane hoop stress
+    sigma = rho omega^2 R^2), full FE and the reduced body (free-free modes, the floating frame's
+    centrifugal modal force Phi^T M (omega^2 x_perp)) with a radial load circle in its basis."""
+    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.fem import rigid_body_modes
+
+    fe = fe_model(ring_mesh(0.004), STEEL, order=2)
+    omega = 1000.0  # rad/s
+    x_perp = fe.nodes * [1.0, 1.0, 0.0]
+    load = (omega**2 * (fe.mass_scalar @ x_perp)).ravel()  # self-equilibrated body force [N]
+    rigid = rigid_body_modes(fe.nodes)
+    full = _FreeBodySolver(fe).constrained((fe.M @ rigid).T).solve(load[:, None], np.zeros((6, 1)))[:, 0]
+    circle = fg.LoadCircle(RING_R + RING_T / 2, -RING_B / 2, RING_B / 2, 2)
+    body = fg.reduce(fe, [interface(fe, "top")], 10, n_compare=0, load_circles=[circle])
+    reduced = body.modes @ ((body.modes.T @ load) / body.stiffness)
+    theta = np.arctan2(fe.nodes[:, 1], fe.nodes[:, 0])
+    mass = fe.mass_scalar @ np.ones(fe.n_nodes)
+
+    def growth(u):  # mass-weighted mean radial displacement [m]
+        u = u.reshape(-1, 3)
+        return float(mass @ (u[:, 0] * np.cos(theta) + u[:, 1] * np.sin(theta)) / mass.sum())
+
+    theory = STEEL.density_kg_m3 * omega**2 * RING_R**3 / STEEL.youngs_modulus_pa
+    assert growth(full) == pytest.approx(theory, rel=0.02)
+    assert growth(reduced) == pytest.approx(growth(full), rel=0.02)
