@@ -32,7 +32,7 @@ def _cmd_matrix(a: argparse.Namespace) -> int:
     from flexgear.study.matrix import run_matrix
 
     table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end,
-                       workers=a.workers, scheduler=a.scheduler, progress=True)
+                       workers=a.workers, scheduler=a.scheduler, progress=True, reference=a.reference)
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
     return 0
@@ -104,6 +104,9 @@ def _parser() -> argparse.ArgumentParser:
     m.add_argument("--out", default="results")
     m.add_argument("--workers", type=int, default=2)
     m.add_argument("--scheduler", default=None, help="Dask scheduler address (default: local processes)")
+    m.add_argument("--reference", default=None, metavar="NAME",
+                   help="screen against this variant (dynamic indicators, Bias against its values) instead of "
+                        "theory (default: [screening] reference of the gearbox file)")
     m.set_defaults(func=_cmd_matrix)
 
     lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox (or variant) file")

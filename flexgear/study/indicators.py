@@ -22,11 +22,13 @@ Settled window (``[screening] window = "settled"``, :func:`settled_start`): afte
 the run is cut into blocks of ``settle_block_mesh_cycles`` mesh cycles. Each settling signal gets
 one value per block: the planet-mean mesh forces and the two speeds their block means (a drift),
 the mesh-force ripples and bearing accelerations RMS their block values (a decaying vibration).
-Its final value is the mean of the last ``settle_final_blocks`` blocks. The run has settled at
-the start of the first block after which every later block of every settling signal lies
-within the tolerance of its final value: ``settle_mean_tolerance_pct`` for the drifts,
-``settle_amplitude_tolerance_pct`` for the vibrations. For y = A + B e^(-t/tau) this is the first
-block start t with |B| e^(-t/tau) <= tol |A| (to a block), tau·ln(|B| / (tol |A|)).
+Its final value is the mean of the last ``settle_final_blocks`` blocks, and must differ from
+the mean of the blocks just before by at most the tolerance (else the run has not settled). The
+run has settled at the start of the first block after which every later block of every settling
+signal lies within the tolerance of its final value, if at least ``sample_count`` blocks remain:
+``settle_mean_tolerance_pct`` for the drifts, ``settle_amplitude_tolerance_pct`` for the
+vibrations. For y = A + B e^(-t/tau) this is the first block start t with |B| e^(-t/tau) <= tol |A|
+(to a block), tau·ln(|B| / (tol |A|)).
 """
 
 from __future__ import annotations
@@ -150,17 +152,24 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
 
 
 def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: float, block_cycles: int,
-                  final_blocks: int, mean_tol_pct: float, amplitude_tol_pct: float) -> tuple[float | None, str]:
-    """Start [s] of the settled part of a run (module docstring), or None if it never settles.
+                  final_blocks: int, mean_tol_pct: float, amplitude_tol_pct: float,
+                  min_blocks: int = 1) -> tuple[float | None, str]:
+    """Start [s] of the settled part of a run (module docstring), or None if it does not settle.
 
-    Returns (start, explanation); ``after_s`` is the end of the ramps.
+    Returns (start, explanation); ``after_s`` is the end of the ramps. Besides the band test, the
+    final value itself must have stopped moving: the mean of the last ``final_blocks`` blocks may
+    differ from the mean of the ``final_blocks`` before them by at most the tolerance (for a decay
+    with a time constant near the two groups' length this bounds the residual to about 1.4
+    tolerances), and the settled part must hold at least ``min_blocks`` blocks (the screening
+    asks for one block per sample).
     """
     t = signals["time_s"].to_numpy()
     block = block_cycles / mesh_frequency_hz
     count = int((t[-1] - after_s) // block)
-    if count < final_blocks + 1:
-        return None, (f"only {max(count, 0)} blocks of {block_cycles} mesh cycles ({1e3 * block:.3g} ms) after "
-                      f"the ramps at {after_s:g} s; the settling test needs {final_blocks + 1}")
+    if count < max(2 * final_blocks, min_blocks):
+        return None, (f"not settled: only {max(count, 0)} blocks of {block_cycles} mesh cycles ({1e3 * block:.3g} "
+                      f"ms) after the ramps at {after_s:g} s; the settling test needs "
+                      f"{max(2 * final_blocks, min_blocks)}")
     starts = t[-1] - block * np.arange(count, 0, -1)
     slices = [slice(int(a), int(b)) for a, b in zip(np.searchsorted(t, starts), np.searchsorted(t, starts + block),
                                                     strict=True)]
@@ -172,13 +181,16 @@ def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: floa
         for key in SETTLING_SIGNALS[kind]:
             v = values[key]
             final = v[-final_blocks:].mean()
+            if abs(final - v[-2 * final_blocks:-final_blocks].mean()) > tol / 100.0 * abs(final):
+                return None, (f"not settled: the final value of {key} still moves by more than {tol:g} % between "
+                              f"the last two groups of {final_blocks} blocks of {block_cycles} mesh cycles")
             bad = np.flatnonzero(np.abs(v - final) > tol / 100.0 * abs(final))
             k = int(bad[-1]) + 1 if bad.size else 0
             if k > first_ok:
                 first_ok, slowest = k, key
-    if first_ok > count - final_blocks:
-        return None, (f"not settled: {slowest} still moves by more than its tolerance in the last {final_blocks} "
-                      f"blocks of {block_cycles} mesh cycles")
+    if count - first_ok < min_blocks:
+        return None, (f"not settled: {slowest} settles {count - first_ok} blocks of {block_cycles} mesh cycles "
+                      f"before the end; the window needs {min_blocks}")
     start = float(starts[first_ok])
     why = (f"settled at {start:.4g} s: every later block of {block_cycles} mesh cycles within "
            f"{mean_tol_pct:g} % (speeds, mean forces) and {amplitude_tol_pct:g} % (ripple, bearing RMS) of its "

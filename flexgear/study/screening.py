@@ -162,7 +162,7 @@ def analysis_window(meta: dict, t_first: float, t_last: float, settings: Screeni
         if ramp < t_last and f_mesh > 0:
             start, why = settled_start(signals, max(ramp, t_first), f_mesh, settings.settle_block_mesh_cycles,
                                        settings.settle_final_blocks, settings.settle_mean_tolerance_pct,
-                                       settings.settle_amplitude_tolerance_pct)
+                                       settings.settle_amplitude_tolerance_pct, settings.sample_count)
             if start is not None:
                 return Window(start, t_last, True, why)
             return Window(max(ramp, t_first), t_last, False, f"after the ramps, {ramp:g}-{t_last:g} s, NOT steady: "
