@@ -1,4 +1,4 @@
-"""Command line: ``flexgear run | matrix | lpm | compare | report | meshes``.
+"""Command line: ``flexgear run | matrix | sweep | lpm | compare | report | meshes | animate``.
 
 Each subcommand is a thin wrapper over one library function; the heavy modules are imported
 only by the subcommand that needs them.
@@ -35,6 +35,18 @@ def _cmd_matrix(a: argparse.Namespace) -> int:
                        workers=a.workers, scheduler=a.scheduler, progress=True, reference=a.reference)
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    return 0
+
+
+def _cmd_sweep(a: argparse.Namespace) -> int:
+    from flexgear.study.sweep import load_sweep, run_sweep
+
+    plan = load_sweep(a.sweep, all_combinations=True if a.all_combinations else None)
+    out = Path(a.out) if a.out else Path("results") / f"sweep_{plan.name}"
+    table = run_sweep(plan, out, t_end_s=a.t_end, workers=a.workers, scheduler=a.scheduler, reference=a.reference)
+    wanted = ["variant", *plan.parameters, "eps_beta", "status", "wall_time_s", "distance_pct", "zone"]
+    print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    print(f"sweep table -> {out / 'sweep.csv'}; report: flexgear report {out}")
     return 0
 
 
@@ -108,6 +120,17 @@ def _parser() -> argparse.ArgumentParser:
                    help="screen against this variant (dynamic indicators, Bias against its values) instead of "
                         "theory (default: [screening] reference of the gearbox file)")
     m.set_defaults(func=_cmd_matrix)
+
+    sw = sub.add_parser("sweep", help="run a parameter sweep file (grid over gearbox fields x variants)")
+    sw.add_argument("sweep", help="sweep file (TOML; see flexgear.study.sweep)")
+    sw.add_argument("--out", default=None, help="results folder (default: results/sweep_<name>)")
+    sw.add_argument("--t-end", type=float, default=None, help="simulated time [s] (default: the load case's)")
+    sw.add_argument("--workers", type=int, default=2)
+    sw.add_argument("--scheduler", default=None, help="Dask scheduler address (default: local processes)")
+    sw.add_argument("--all-combinations", action="store_true",
+                    help="run every base variant in all 2^5 rigid/flexible forms")
+    sw.add_argument("--reference", default=None, metavar="NAME", help="screen against this variant")
+    sw.set_defaults(func=_cmd_sweep)
 
     lp = sub.add_parser("lpm", help="run the lumped-parameter model of a gearbox (or variant) file")
     lp.add_argument("gearbox")

@@ -111,3 +111,11 @@ def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -
                            wall_time_s=1.0 + flex)
     res.meta.update(components=dict(variant.components), t_end_s=t_end_s)
     return res
+
+
+def slow_runner(variant, t_end_s: float | None = None, progress: bool = False) -> RunResult:
+    """:func:`fake_runner` that takes 1.5 s per run (time to kill a sweep between two runs)."""
+    import time
+
+    time.sleep(1.5)
+    return fake_runner(variant, t_end_s, progress)
