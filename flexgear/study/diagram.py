@@ -72,7 +72,7 @@ def _zones(ax: Axes, tea: float, ms: list[int], xmax: float, ymax: float, names:
 def decision_diagram(ax: Axes, screening: pd.DataFrame, lines, xlim: float | None = None,
                      ylim: float | None = None, title: str = "") -> list[str]:
     """Draw the diagram of a screening table (columns variant, status, bias_pct, cv_pct, selected,
-    zone, distance_pct); returns "n  variant: ..." per numbered marker."""
+    zone, distance_pct); returns "n  variant: Bias, CV, zone" per numbered marker (in ``lines.unit``)."""
     tea, ms = lines.tea_pct, list(lines.multipliers)
     ok = screening[screening["status"] == "ok"].reset_index(drop=True)
     xmax = xlim or max(1.3 * tea, 1.15 * float(ok["bias_pct"].max()) if len(ok) else 0.0)
@@ -87,8 +87,8 @@ def decision_diagram(ax: Axes, screening: pd.DataFrame, lines, xlim: float | Non
     legend = []
     inside = ok[(ok["bias_pct"] <= xmax) & (ok["cv_pct"] <= ymax)]
     for i, row in enumerate(ok.itertuples(), start=1):
-        legend.append(f"{i}  {row.variant}: Bias {row.bias_pct:.3g}, CV {row.cv_pct:.3g} {lines.unit}, "
-                      f"{row.zone}" + (" (selected)" if row.selected else ""))
+        legend.append(f"{i}  {row.variant}: {row.bias_pct:.3g}, {row.cv_pct:.3g}, {row.zone}"
+                      + (" (selected)" if row.selected else ""))
     if len(inside):
         pts = inside[["bias_pct", "cv_pct"]].to_numpy(dtype=float)
         disp = ax.transData.transform(pts)

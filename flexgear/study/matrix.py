@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import json
 import sys
 import time
 from collections.abc import Callable, Sequence
@@ -209,7 +210,10 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     table, indicators, selection = screening_tables(results, settings, reference)
     write_table(table, out_dir / "screening")
     write_table(indicators, out_dir / "screening_indicators")
-    text = f"selected: {selection.variant}\nrule: {selection.rule}\n{selection.reasoning}\n"
+    ref = settings.reference if reference is None else reference
+    atomic_write_bytes(out_dir / "screening.json", json.dumps({"reference": ref}).encode())
+    text = (f"selected: {selection.variant}\nrule: {selection.rule}\nreference: {ref or 'theory'}\n"
+            f"{selection.reasoning}\n")
     atomic_write_bytes(out_dir / "selection.txt", text.encode())
     _say(progress, f"selected {selection.variant}: {selection.reasoning}")
     return table

@@ -34,7 +34,7 @@ from flexgear.cache import atomic_write_bytes
 from flexgear.spec import COMPONENTS, SpecError, load_variant
 from flexgear.study.matrix import run_matrix, write_table
 
-__all__ = ["SweepPlan", "load_sweep", "sweep_points", "write_variants", "run_sweep", "toml_text"]
+__all__ = ["SweepPlan", "SweepResult", "load_sweep", "sweep_points", "write_variants", "run_sweep", "toml_text"]
 
 _VARIANT_FIELDS = ("mesh_level", "rigid_mass_properties")
 
@@ -161,7 +161,8 @@ def write_variants(plan: SweepPlan, out_dir: Path) -> tuple[list[Path], list[dic
                     else:
                         table, fieldname = key.split(".")
                         overrides.setdefault(table, {})[fieldname] = value
-                name = base["name"] + suffix + (f"__{_label(point)}" if point else "")
+                varying = {k: v for k, v in point.items() if len(plan.parameters[k]) > 1}
+                name = base["name"] + suffix + (f"__{_label(varying)}" if varying else "")
                 data["name"] = name
                 data["components"] = comps
                 if overrides:
@@ -184,6 +185,20 @@ def _eps_beta(path: Path) -> float:
     return float(geo.sun_planet.overlap_ratio(geo.helix_face_width))
 
 
+def _indicator_means(run_dir: Path, settings) -> dict[str, float]:
+    """Every indicator's mean over the run's settled window (flexgear.study.indicators); {} if it failed."""
+    from flexgear.results import load_result
+    from flexgear.study.screening import indicator_samples
+
+    if not (run_dir / "run.json").exists():
+        return {}
+    result = load_result(run_dir)
+    if not result.ok:
+        return {}
+    window, samples = indicator_samples(result, settings)
+    return {"window_start_s": window.start_s, **{k: float(v.mean()) for k, v in samples.items()}}
+
+
 def run_sweep(plan: SweepPlan, out_dir: str | Path, t_end_s: float | None = None, workers: int = 2,
               scheduler: str | None = None, progress: bool = True, runner=None,
               reference: str | None = None) -> pd.DataFrame:
@@ -194,8 +209,9 @@ def run_sweep(plan: SweepPlan, out_dir: str | Path, t_end_s: float | None = None
         row["eps_beta"] = _eps_beta(path)
     matrix = run_matrix(paths, out_dir, t_end_s=t_end_s, workers=workers, scheduler=scheduler, progress=progress,
                         runner=runner, reference=reference)
-    indicators = pd.read_parquet(out_dir / "screening_indicators.parquet")
-    means = indicators.pivot_table(index="variant", columns="indicator", values="mean")
+    settings = load_variant(paths[0]).gearbox.screening
+    means = pd.DataFrame([_indicator_means(out_dir / row["variant"], settings) for row in rows],
+                         index=[row["variant"] for row in rows])
     table = (pd.DataFrame(rows)
              .merge(matrix[["variant", "status", "reason", "wall_time_s", "t_end_s", "bias_pct", "cv_pct",
                             "distance_pct", "zone"]], on="variant", how="left")
@@ -206,3 +222,35 @@ def run_sweep(plan: SweepPlan, out_dir: str | Path, t_end_s: float | None = None
             "variants": [str(p) for p in plan.variants]}
     atomic_write_bytes(out_dir / "sweep.json", json.dumps(meta, indent=2).encode())
     return table
+
+
+@dataclass(frozen=True)
+class SweepResult:
+    """A finished sweep read back from its folder: ``sweep.json`` (``meta``) and ``sweep.parquet``."""
+
+    meta: dict[str, Any]
+    table: pd.DataFrame
+
+    @classmethod
+    def load(cls, out_dir: str | Path) -> SweepResult:
+        out_dir = Path(out_dir)
+        return cls(json.loads((out_dir / "sweep.json").read_text()), pd.read_parquet(out_dir / "sweep.parquet"))
+
+    @property
+    def parameters(self) -> list[str]:
+        return list(self.meta["parameters"])
+
+    def plot(self, ax, y: str, x: str | None = None, label: str = "", **style) -> None:
+        """Indicator mean ``y`` (a screening indicator key) against ``x`` (default: the first swept
+        field), one line per base variant and value of the other swept fields; failed runs left out."""
+        x = x or (self.parameters[0] if self.parameters else "eps_beta")
+        ok = self.table[self.table["status"] == "ok"]
+        varying = [p for p in self.parameters if len(self.meta["parameters"][p]) > 1]
+        # eps_beta follows from the face width: a face-width sweep plotted over eps_beta is one line
+        others = [p for p in varying if p != x and not (x == "eps_beta" and p.endswith("face_width_mm"))]
+        for keys, part in ok.groupby(["base", *others], sort=True):
+            keys = keys if isinstance(keys, tuple) else (keys,)
+            text = ", ".join([str(keys[0])] + [f"{o.split('.')[-1]} {v:g}" if isinstance(v, float) else str(v)
+                                               for o, v in zip(others, keys[1:], strict=True)])
+            part = part.sort_values(x)
+            ax.plot(part[x], part[y], "o-", label=(label + " " + text).strip(), **{"lw": 1.0, "ms": 4, **style})
