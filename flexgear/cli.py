@@ -19,7 +19,7 @@ def _cmd_run(a: argparse.Namespace) -> int:
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)
-    result = run_variant(variant, t_end_s=a.t_end, progress=True)
+    result = run_variant(variant, t_end_s=a.t_end, progress=True, record_states_every=a.states)
     out = save_result(result, Path(a.out) / variant.name)
     print(f"{variant.name}: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.1f} s -> {out}")
     if not result.ok:
@@ -85,6 +85,14 @@ def _cmd_report(a: argparse.Namespace) -> int:
     return 0
 
 
+def _cmd_animate(a: argparse.Namespace) -> int:
+    from flexgear.report.animate import write_animation
+
+    path = write_animation(Path(a.run_dir), a.out, scale=a.scale)
+    print(f"animation -> {path} (open in ParaView)")
+    return 0
+
+
 def _cmd_meshes(a: argparse.Namespace) -> int:
     from flexgear.fe.mesh import build_meshes
     from flexgear.fe.reduced import component_reduced_body
@@ -108,6 +116,9 @@ def _parser() -> argparse.ArgumentParser:
     r.add_argument("variant")
     r.add_argument("--t-end", type=float, default=None, help="simulated time [s] (default: the load case's)")
     r.add_argument("--out", default="results", help="results folder (default: results)")
+    r.add_argument("--states", type=int, default=0, metavar="N",
+                   help="also record the bodies' states (frames, modal coordinates) every N steps, for "
+                        "`flexgear animate` (default: 0, none)")
     r.set_defaults(func=_cmd_run)
 
     m = sub.add_parser("matrix", help="run a matrix of variant files and screen them")
@@ -147,6 +158,12 @@ def _parser() -> argparse.ArgumentParser:
     rp.add_argument("results")
     rp.add_argument("--output", default="reports/screening_report.pdf")
     rp.set_defaults(func=_cmd_report)
+
+    an = sub.add_parser("animate", help="VTK time series (.pvd + .vtu) of the deformed bodies of a run")
+    an.add_argument("run_dir", help="a run folder whose run recorded states (flexgear run ... --states N)")
+    an.add_argument("--out", default=None, help="output folder (default: RUN_DIR/animation)")
+    an.add_argument("--scale", type=float, default=1.0, help="factor on the elastic deformation (default: 1)")
+    an.set_defaults(func=_cmd_animate)
 
     me = sub.add_parser("meshes", help="build (or load from cache) the component meshes and reduced bodies")
     me.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml")

@@ -16,6 +16,7 @@ import pandas as pd
 
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
+from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import Variant, as_dict, spec_hash
 
@@ -77,16 +78,20 @@ def _meta(variant: Variant, t_end: float) -> dict:
 
 
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
-                mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None) -> RunResult:
+                mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
+                record_states_every: int = 0) -> RunResult:
     """Run ``variant`` for ``t_end_s`` (default: the load case's end time).
 
-    Never raises for a model or solver failure: the result then has status "failed" and the reason.
+    ``record_states_every`` > 0 also records the bodies' states every that many steps (extra table
+    ``states``, flexgear.mbs.states; for ``flexgear animate``). Never raises for a model or solver
+    failure: the result then has status "failed" and the reason.
     """
     import exudyn as exu
 
     t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
     meta = _meta(variant, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
+    extra: dict[str, pd.DataFrame] = {}
     try:
         if not (t_end > 0 and math.isfinite(t_end)):
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
@@ -94,6 +99,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         mbs = sc.AddSystem()
         model = build_star_gearbox(mbs, variant, mass_source, reduced_source)
         sensors = add_gearbox_sensors(mbs, model)
+        states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
         mbs.SolveDynamic(simulation_settings(variant, t_end, progress),
@@ -107,10 +113,13 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
             meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
             raise FloatingPointError("the solution diverged (non-finite signals)")
+        if states:
+            extra["states"] = state_table(mbs, states, record_states_every)
+            meta.update(state_bodies=state_bodies(model), record_states_every=record_states_every)
         meta.update(status="ok", reason="", build_time_s=build_s)
     except Exception as exc:  # recorded, not raised: a failed variant must not stop a matrix
         signals = None
         meta.update(status="failed", reason=f"{type(exc).__name__}: {exc}",
                     traceback=traceback.format_exc(limit=5))
     meta.update(wall_time_s=time.perf_counter() - wall0, cpu_time_s=time.process_time() - cpu0)
-    return RunResult(meta, signals)
+    return RunResult(meta, signals, extra)
