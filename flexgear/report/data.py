@@ -92,7 +92,8 @@ def gather(results_dir: str | Path) -> ReportData:
     ref_name = json.loads(recorded.read_text()).get("reference", "") if recorded.exists() else settings.reference
     study = screen(runs.values(), settings, reference="")
     reference = screen(runs.values(), settings, reference=ref_name) if ref_name and ref_name in runs else None
-    sweep = SweepResult.load(results_dir) if (results_dir / "sweep.json").exists() else None
+    sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
+    sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)
     return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep)
 
 

@@ -277,8 +277,13 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
     return [("Tables 6 and 7: every variant and the lumped model, beside the study's", draw)]
 
 
-def _peak(d: ReportData, name: str, side: str) -> float:
+def _peak(d: ReportData, folder, name: str, side: str) -> float:
+    """Largest radial bearing acceleration of a sweep run in its settled window (as Table 6)."""
+    from flexgear.results import load_result
+
     r = d.runs.get(name)
+    if r is None and folder is not None and (folder / name / "run.json").exists():
+        r = load_result(folder / name)
     if r is None or not r.ok:
         return np.nan
     w = d.window(r)
@@ -292,8 +297,8 @@ def sweep_pages(d: ReportData) -> list[Page]:
         return []
     sw = d.sweep
     table = sw.table.copy()
-    table["input_bearing_peak"] = [_peak(d, n, "input") for n in table["variant"]]
-    table["output_bearing_peak"] = [_peak(d, n, "output") for n in table["variant"]]
+    table["input_bearing_peak"] = [_peak(d, sw.folder, n, "input") for n in table["variant"]]
+    table["output_bearing_peak"] = [_peak(d, sw.folder, n, "output") for n in table["variant"]]
     params = sw.parameters
     keep = ["variant", *params, "eps_beta", "status", "wall_time_s", "input_bearing_peak", "output_bearing_peak",
             "input_bearing_rms", "outer_mesh_ripple", "dynamic_factor", "distance_pct"]
@@ -303,7 +308,7 @@ def sweep_pages(d: ReportData) -> list[Page]:
     shown = table[[c for c in keep if c in table.columns]].rename(columns=lambda c: names.get(c, c.split(".")[-1]))
     from flexgear.study.sweep import SweepResult
 
-    plotted = SweepResult(sw.meta, table)
+    plotted = SweepResult(sw.meta, table, sw.folder)
 
     def draw_table_page(fig: Figure) -> None:
         ax = fig.add_axes([0.03, 0.07, 0.94, 0.83])

@@ -230,11 +230,13 @@ class SweepResult:
 
     meta: dict[str, Any]
     table: pd.DataFrame
+    folder: Path | None = None
 
     @classmethod
     def load(cls, out_dir: str | Path) -> SweepResult:
         out_dir = Path(out_dir)
-        return cls(json.loads((out_dir / "sweep.json").read_text()), pd.read_parquet(out_dir / "sweep.parquet"))
+        return cls(json.loads((out_dir / "sweep.json").read_text()), pd.read_parquet(out_dir / "sweep.parquet"),
+                   out_dir)
 
     @property
     def parameters(self) -> list[str]:
