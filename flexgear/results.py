@@ -43,6 +43,14 @@ def signal_columns(planet_count: int) -> list[str]:
     - ``outer_mesh_force_{i}_n``: normal force of the sun-planet mesh of planet i (1-based)
     - ``inner_mesh_force_{i}_n``: normal force of the planet-ring mesh of planet i
     - ``{input,output}_bearing_accel_{x,y}_m_per_s2``: radial acceleration at the shaft bearings
+
+    Optional columns a backend may add after these (flexgear.mbs.deflection):
+
+    - ``transmission_error_m``: loaded transmission error along the line of action at the output (rigid and
+      elastic; positive when the output lags its kinematic position; its steady mean is the loaded static TE)
+    - ``{outer,inner}_deflection_load_{i}_m``, ``{outer,inner}_deflection_centrifugal_{i}_m``: elastic
+      deflection of the flexible gears of mesh i along the tooth normal, relative to each gear's bore or seat
+      interface, load-induced and centrifugal parts (present when a gear of the mesh is flexible)
     """
     cols = ["time_s", "input_speed_deg_per_s", "output_speed_deg_per_s", "transmission_ratio", "input_torque_nm"]
     cols += [f"outer_mesh_force_{i}_n" for i in range(1, planet_count + 1)]

@@ -31,6 +31,7 @@ __all__ = [
     "Bearings",
     "Contact",
     "ContactAssumed",
+    "SupportsAssumed",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",
@@ -213,6 +214,9 @@ class Contact:
     damping_fraction_of_stiffness: float = _num(0.0)
     penetration_depth_m: float = _num(0.0, lo_open=True)
     friction_coefficient: float = _num(0.0, 1.0)
+    # "impact": the study's ADAMS law (section 2.1, the fields above); "iso6336": linear mesh stiffness of
+    # ISO 6336-1 (flexgear.laws.iso6336) with eq. 13 damping ([contact_assumed] mesh_damping_ratio)
+    law: str = field(default="impact", metadata={"choices": ("impact", "iso6336"), "doc": "contact law"})
 
 
 @dataclass(frozen=True)
@@ -222,6 +226,9 @@ class ContactAssumed:
     stiffness_harmonics: int = _num(0, 10, integer=True)
     stiffness_variation: str = _choice("contact_lines", "constant")
     friction_regularisation_m_per_s: float = _num(0.0, lo_open=True)
+    mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0,
+                                                              "doc": "xi of eq. 13 (iso6336 law)"})
+    application_factor: float = field(default=1.0, metadata={"lo": 1.0, "doc": "K_A of ISO 6336-1 (iso6336 law)"})
 
 
 @dataclass(frozen=True)
@@ -365,6 +372,19 @@ class LumpedAssumed:
 
 
 @dataclass(frozen=True)
+class SupportsAssumed:
+    """Where the bearings, the speed drive and the load torque act (flexgear.geometry.supports).
+
+    ``placement`` "bearing_seats": bushings at the shafts' bearing seats and the planets' bores, drive and load at
+    the input shaft's and output shaft's bearing-seat interfaces; "gear_centres": all on the body frames at the
+    gear mid-planes (the former model, kept for comparison).
+    """
+
+    placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
+                                                              "doc": "where supports act"})
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -383,6 +403,7 @@ class GearboxSpec:
     reduction_assumed: ReductionSettings
     screening: ScreeningSettings
     lumped_assumed: LumpedAssumed
+    supports_assumed: SupportsAssumed = field(default_factory=SupportsAssumed)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
@@ -473,7 +494,8 @@ def load_gearbox(path: str | Path) -> GearboxSpec:
     unknown = sorted(set(raw) - set(tables))
     if unknown:
         raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
-    for name in tables:
+    optional = {f.name for f in dataclasses.fields(GearboxSpec) if f.default_factory is not dataclasses.MISSING}
+    for name in tables - optional:
         if name not in raw:
             raise SpecError(path, name, "missing (required)")
     if not isinstance(raw["title"], str):
@@ -484,7 +506,8 @@ def load_gearbox(path: str | Path) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     kwargs: dict[str, Any] = {"source": path, "title": raw["title"]}
     for name in tables - {"title", "meshing_assumed"}:
-        kwargs[name] = _build(hints[name], raw[name], path, name)
+        if name in raw:
+            kwargs[name] = _build(hints[name], raw[name], path, name)
     kwargs["meshing_assumed"] = {
         level: _build(MeshingSettings, table, path, f"meshing_assumed.{level}")
         for level, table in meshing.items()

@@ -92,8 +92,15 @@ def test_study_gearbox_modes(spec):
     res = modal_analysis(spec)
     assert res.frequencies_hz[0] < 1e-6 and res.kinds[0] == "rotational"
     held = modal_analysis(spec, hold_input=True)
-    assert held.frequencies_hz[0] > 100.0  # the prescribed drive removes the rigid-body mode
+    assert held.frequencies_hz[0] > 1.0  # the prescribed drive removes the rigid-body mode
     assert {"rotational", "translational", "planet"} == set(held.kinds)
+    # bearings at their seats (flexgear.geometry.supports): the ring + output shaft floats on its single
+    # bearing 0.17 m away (1/k = 1/k_r + L^2/k_t at the gear centre), following through the free planet
+    # spins: the lowest pair is its translation on that condensed support, sqrt(k/m_app)/(2 pi) = 36.6 Hz
+    p = LumpedParameters.from_spec(spec)
+    floating = math.sqrt(p.ring.bearing_stiffness_n_per_m / p.ring.mass_kg) / (2 * math.pi)
+    assert held.kinds[0] == held.kinds[1] == "translational"
+    assert held.frequencies_hz[0] == pytest.approx(floating, rel=0.05)
 
 
 def test_friction_table_length_matches_stiffness_harmonics(spec):
@@ -145,10 +152,17 @@ def test_dynamic_run_settles_to_theory(spec, arrangement):
 
 def test_phasing_cancels_bearing_harmonics(spec):
     """Sequentially phased planets (z_s = 44, N = 5): the sun's bearing sees only harmonics k with
-    k z_s mod N = +-1 (1, 4, 6, 9 ...); 2, 3 and 5 cancel (Parker & Lin)."""
+    k z_s mod N = +-1 (1, 4, 6, 9 ...); 2, 3 and 5 cancel (Parker & Lin).
+
+    Stated for a steady cyclically symmetric response: bearings at the gear centres here. With the bearings at
+    their seats the sun and ring float (36-50 Hz, lightly damped) and their free whirl, modulated by the
+    mesh stiffness, puts sidebands next to the cancelled harmonics (2x: ~2e-5 of 1x, measured).
+    """
+    from flexgear.spec import SupportsAssumed
     from flexgear.study.compare import harmonic_amplitudes
 
-    s = short_case(spec, friction=0.02, variation="contact_lines")
+    s = short_case(spec, friction=0.02, variation="contact_lines").with_changes(
+        supports_assumed=SupportsAssumed("gear_centres"))
     res = run_lumped(s, t_end_s=0.08)
     w = res.signals[res.signals["time_s"] >= 0.06]
     amps = harmonic_amplitudes(w["input_bearing_accel_x_m_per_s2"].to_numpy(), 1e-5, theory(s).mesh_frequency,

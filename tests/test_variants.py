@@ -36,6 +36,10 @@ def test_table3_variant_runs_at_theory(n):
     drive = w.input_torque_nm.mean()
     assert drive == pytest.approx(th["input_torque_nm"], rel=0.01)
     if "joint_torque_sun_nm" in result.meta:
-        assert abs(result.meta["joint_torque_sun_nm"]) == pytest.approx(abs(drive), rel=0.01)
+        # the run averages joint torques from min(ramp end, 0.8 t_end) (flexgear.mbs.run): compare over that window
+        # (with the bearings at their seats the floating sun still settles 20-40 ms after the ramps)
+        lc = variant.gearbox.load_case
+        same = s[s.time_s >= min(lc.ramp_time_s, 0.8 * 0.05)].input_torque_nm.mean()
+        assert abs(result.meta["joint_torque_sun_nm"]) == pytest.approx(abs(same), rel=0.01)
     if "joint_torque_ring_nm" in result.meta:
         assert abs(result.meta["joint_torque_ring_nm"]) == pytest.approx(th["output_torque_nm"], rel=0.01)

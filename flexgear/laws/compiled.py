@@ -11,7 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["impact_normal_force", "backlash_linear_force", "mesh_friction_forces", "periodic_values", "ramp_state"]
+__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force",
+           "mesh_friction_forces", "periodic_values", "ramp_state"]
 
 
 @njit(cache=True)
@@ -21,6 +22,14 @@ def impact_normal_force(delta: float, delta_t: float, stiffness: float, exponent
     pen = max(delta, 0.0)
     ramp = min(pen / depth, 1.0)
     return max(stiffness * pen**exponent + damping_max * ramp * ramp * (3.0 - 2.0 * ramp) * delta_t, 0.0)
+
+
+@njit(cache=True)
+def linear_normal_force(delta: float, delta_t: float, stiffness: float, damping: float) -> float:  # pragma: no cover
+    """Compiled twin of ``flexgear.laws.contact.linear_force`` [N] (stiffness already times s(phi))."""
+    if delta <= 0.0:
+        return 0.0
+    return max(stiffness * delta + damping * delta_t, 0.0)
 
 
 @njit(cache=True)
@@ -36,10 +45,11 @@ def backlash_linear_force(delta: float, delta_t: float, stiffness: float, dampin
 
 @njit(cache=True)
 def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, damping_max, depth,  # noqa: PLR0913
-                         means, cos_c, sin_c, mu, reg, sliding_rows, spin_rows):  # pragma: no cover - compiled
+                         means, cos_c, sin_c, mu, reg, sliding_rows, spin_rows, linear=False):  # pragma: no cover
     """Generalized friction forces Q = -(A^T f_slide + B^T f_spin) of all contacts.
 
-    Same law as laws.contact.impact_force (normal force with the stiffness series), laws.contact.periodic_value
+    Same law as laws.contact.impact_force (``linear``: laws.contact.linear_force; normal force with the
+    stiffness series), laws.contact.periodic_value
     (series index 0: stiffness factor, 1: sliding direction kappa, 2: lever lambda [m]) and
     laws.contact.friction_forces (f = mu F tanh(Omega lambda_mean / v_reg) (kappa, lambda)).
     """
@@ -54,8 +64,11 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
                 x = 2.0 * math.pi * (h + 1) * phase[i]
                 v += cos_c[k, i, h] * math.cos(x) + sin_c[k, i, h] * math.sin(x)
             val[k] = v
-        normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
-                                     depth[i])
+        if linear:
+            normal = linear_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], damping_max[i])
+        else:
+            normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
+                                         depth[i])
         f = mu[i] * normal * math.tanh(spin_rate[i] * means[2, i] / reg[i])
         q -= sliding_rows[i] * (f * val[1]) + spin_rows[i] * (f * val[2])
     return q

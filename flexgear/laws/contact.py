@@ -1,7 +1,9 @@
 """Gear contact laws as small functions of numpy or Exudyn symbolic arrays (``m`` = the math module).
 
-The ADAMS impact law of the study (section 2.1), the periodic mesh-stiffness series of eq. 11-12 and
-tooth friction; their compiled (numba) twins are in :mod:`flexgear.laws.compiled`.
+Two normal laws, chosen by ``[contact] law``: the ADAMS impact law of the study (section 2.1,
+"impact") and a linear mesh stiffness from ISO 6336-1 with the damping of eq. 13 ("iso6336",
+:func:`linear_force`, stiffness from :mod:`flexgear.laws.iso6336`); the periodic mesh-stiffness
+series of eq. 11-12 and tooth friction. Their compiled (numba) twins are in :mod:`flexgear.laws.compiled`.
 """
 
 from __future__ import annotations
@@ -13,25 +15,81 @@ from typing import Any
 import numpy as np
 
 from flexgear.geometry.involute import PeriodicSeries
-from flexgear.spec import Contact
+from flexgear.spec import Contact, GearboxSpec
 
-__all__ = ["ContactLaw", "impact_force", "backlash_linear_force", "periodic_value", "friction_forces"]
+__all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "periodic_value",
+           "friction_forces", "mesh_damping", "mesh_laws"]
+
+LAWS = ("impact", "iso6336")
 
 
 @dataclass(frozen=True)
 class ContactLaw:
-    """Impact-function parameters of one contact half (section 2.1)."""
+    """Normal-law parameters of one contact (helix half).
 
-    stiffness: float  # N/m^exponent
+    ``kind`` "impact" (section 2.1): stiffness [N/m^exponent], damping_max [N s/m] reached at
+    penetration_depth [m]. ``kind`` "iso6336": linear, exponent 1, stiffness [N/m] and constant damping
+    ``damping_max`` [N s/m] while the teeth touch (penetration_depth unused, 0).
+    """
+
+    stiffness: float
     exponent: float
-    damping_max: float  # N s/m, reached at the penetration depth
-    penetration_depth: float  # m
+    damping_max: float
+    penetration_depth: float
+    kind: str = "impact"
 
     @classmethod
     def from_contact(cls, contact: Contact, share: float = 1.0) -> ContactLaw:
         """The study's law scaled to a ``share`` of the face width (one helix half: 0.5)."""
         k = contact.stiffness * share
         return cls(k, contact.exponent, contact.damping_fraction_of_stiffness * k, contact.penetration_depth_m)
+
+    def share(self, share: float) -> ContactLaw:
+        """The law of a ``share`` of the face width: stiffness and damping scale with it."""
+        return ContactLaw(self.stiffness * share, self.exponent, self.damping_max * share, self.penetration_depth,
+                          self.kind)
+
+
+def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, damping_ratio: float) -> float:
+    """Eq. 13: c = 2 xi sqrt(k m1 m2 / (m1 + m2)) [N s/m] (mesh damping from the damping ratio xi).
+
+    The study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m.
+    """
+    return 2.0 * damping_ratio * math.sqrt(stiffness_n_per_m * mass1_kg * mass2_kg / (mass1_kg + mass2_kg))
+
+
+def mesh_laws(spec: GearboxSpec) -> dict[str, ContactLaw]:
+    """The whole-face-width law of the sun-planet ("outer") and planet-ring ("inner") meshes.
+
+    ``[contact] law = "impact"``: the study's law for both. ``"iso6336"``: k = c_gamma_alpha b / cos^2(beta_b)
+    along the tooth normal (flexgear.laws.iso6336, b = total active face width, line load from the
+    theoretical input torque shared by the planets, K_A = ``[contact_assumed] application_factor``) and
+    c from eq. 13 with ``[contact_assumed] mesh_damping_ratio`` and the gears' exact masses.
+    """
+    if spec.contact.law == "impact":
+        law = ContactLaw.from_contact(spec.contact)
+        return {"outer": law, "inner": law}
+    from flexgear.geometry.involute import gear_set_geometry
+    from flexgear.geometry.layout import component_mass_properties
+    from flexgear.laws.iso6336 import tooth_stiffness
+    from flexgear.theory import theory
+
+    geo = gear_set_geometry(spec)
+    ga, ca = spec.gears_assumed, spec.contact_assumed
+    b = ga.face_width_m
+    f_t = theory(spec).input_torque / (geo.planet_count * geo.sun.reference_radius)
+    line_load = ca.application_factor * f_t / (b * 1e3)
+    mass = {c: component_mass_properties(spec, c).mass for c in ("sun", "planet", "ring")}
+    out = {}
+    for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"),
+                               ("inner", geo.planet_ring, "planet", "ring")):
+        gear1, gear2 = mesh.gear1, mesh.gear2
+        iso = tooth_stiffness(gear1.teeth, gear2.teeth, gear1.shift, gear2.shift, gear1.helix_angle,
+                              gear1.base_helix_angle, gear1.normal_pressure_angle, ga.dedendum_coefficient,
+                              mesh.transverse_contact_ratio, line_load, internal=mesh.internal)
+        k = iso.normal_stiffness_n_per_m(b, gear1.base_helix_angle)
+        out[kind] = ContactLaw(k, 1.0, mesh_damping(k, mass[g1], mass[g2], ca.mesh_damping_ratio), 0.0, "iso6336")
+    return out
 
 
 def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m: Any = np) -> Any:
@@ -52,6 +110,25 @@ def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m
         power = m.pow(pen, law.exponent)
     force = law.stiffness * factor * power
     return mx(force + damp * delta_t, 0.0)
+
+
+def linear_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m: Any = np) -> Any:
+    """Normal force of the linear ISO 6336 law [N]; ``m`` is numpy or ``exudyn.symbolic``.
+
+    F = max(0, k s(phi) delta + c delta_t) while the teeth touch (delta > 0), 0 otherwise (eq. 11-13 on the
+    drive flank; the teeth cannot pull).
+    """
+    force = law.stiffness * factor * delta + law.damping_max * delta_t
+    if m is np:
+        return np.where(np.asarray(delta) > 0.0, np.maximum(force, 0.0), 0.0)
+    return m.IfThenElse(delta > 0.0, m.max(force, 0.0), m.Real(0.0))
+
+
+def normal_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m: Any = np) -> Any:
+    """Normal force [N] of ``law`` (its ``kind``): :func:`impact_force` or :func:`linear_force`."""
+    if law.kind == "iso6336":
+        return linear_force(delta, delta_t, law, factor, m)
+    return impact_force(delta, delta_t, law, factor, m)
 
 
 def backlash_linear_force(delta: Any, delta_t: Any, stiffness: Any, damping: Any, backlash: Any) -> Any:

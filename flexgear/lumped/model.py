@@ -34,6 +34,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.geometry.massprops import combine_mass_properties
+from flexgear.geometry.supports import condensed_radial_stiffness, gearbox_supports
+from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = [
@@ -131,64 +134,82 @@ class LumpedParameters:
         """Parameters of the spec's gearbox (``hold_input``: also hold the sun's spin, as the prescribed drive does).
 
         - masses and spin inertias: flexgear.geometry.layout.component_mass_properties (sun + input shaft,
+          the in-plane mass the apparent mass at the gear centre of the joined parts, see ``mi``;
           ring + output shaft for the star arrangement; for the planetary arrangement the output
           shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*)
-        - bearing stiffness: Table 2 radial ("leveling") stiffness; damping c = k * damping_per_stiffness_s
+        - bearing stiffness: the Table 2 bearing at its place (``[supports_assumed]``, flexgear.geometry.supports)
+          condensed to the gear centre, 1/k = 1/k_r + L^2/k_t (L: gear to bearing centre; the tilt statically
+          condensed); damping c = k * damping_per_stiffness_s
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width
         - mesh damping: eq. 13, c = 2 xi sqrt(k_m m_1 m_2 / (m_1 + m_2)) with the gear masses
           (the study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m)
+        - with ``[contact] law = "iso6336"`` both from flexgear.laws.contact.mesh_laws, the multibody model's law
         - pressure angles: operating transverse pressure angles of the two meshes (flexgear.geometry.involute)
         """
         from flexgear.geometry.layout import component_mass_properties
 
         geo = gear_set_geometry(spec)
-        la, b = spec.lumped_assumed, spec.bearings
+        la = spec.lumped_assumed
         names = GEOMETRY_COMPONENTS
         props = {c: component_mass_properties(spec, c) for c in names}
         star = spec.gears.arrangement == "star"
 
+        supports = gearbox_supports(spec)
+
         def member(mass: float, inertia: float, radius: float, bearing, held: bool = False) -> MemberParameters:
             if held:
                 return MemberParameters.from_inertia(max(mass, 0.0), inertia, radius, math.inf)
-            k = bearing.radial_stiffness_n_per_m
+            # the bearing at its seat condensed to the gear centre (flexgear.geometry.supports)
+            k = condensed_radial_stiffness(supports[bearing])
             return MemberParameters.from_inertia(mass, inertia, radius, k,
-                                                 bearing_damping_n_s_per_m=k * bearing.damping_per_stiffness_s)
+                                                 bearing_damping_n_s_per_m=k * supports[bearing].damping_per_stiffness)
 
         def mi(*names: str) -> tuple[float, float]:
-            return sum(props[n].mass for n in names), sum(props[n].inertia[2, 2] for n in names)
+            """Apparent in-plane mass at the gear centre and spin inertia of the rigidly joined parts.
 
-        sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, b.input_shaft)
-        planet = member(*mi("planet"), geo.planet.base_radius, b.planet)
+            A rigid shaft and gear whose centre of mass lies d off the gear plane answer an in-plane force at
+            the gear centre with translation and tilt: m_app = 1 / (1/m + d^2/I_t) (I_t: tilt inertia about
+            the centre of mass), the mass the multibody model's gear centre shows (d = 0: m).
+            """
+            body = combine_mass_properties(*(props[n] for n in names))
+            d = float(body.com[2])
+            tilt = 0.5 * float(body.inertia[0, 0] + body.inertia[1, 1])
+            apparent = body.mass if d == 0.0 else 1.0 / (1.0 / body.mass + d**2 / tilt)
+            return apparent, sum(props[n].inertia[2, 2] for n in names)
+
+        sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, "input_shaft")
+        planet = member(*mi("planet"), geo.planet.base_radius, "planet")
         if star:
-            ring = member(*mi("ring", "output_shaft"), geo.ring.base_radius, b.output_shaft)
+            ring = member(*mi("ring", "output_shaft"), geo.ring.base_radius, "output_shaft")
             carrier = member(0.0, 0.0, geo.centre_distance, None, held=True)
             fixed: tuple[str, ...] = ("carrier",)
         else:
             ring = member(*mi("ring"), geo.ring.base_radius, None, held=True)
             m_out, i_out = mi("output_shaft")
             carrier = member(la.carrier_mass_kg + m_out, la.carrier_inertia_kg_m2 + i_out, geo.centre_distance,
-                             b.output_shaft)
+                             "output_shaft")
             fixed = ("ring",)
         if hold_input:
             fixed = (*fixed, "sun")
-        k_m = la.mesh_stiffness_per_width_n_per_m2 * spec.gears_assumed.face_width_m
         m_s, m_p, m_r = props["sun"].mass, props["planet"].mass, props["ring"].mass
+        if spec.contact.law == "iso6336":  # the multibody model's law and damping (flexgear.laws.contact.mesh_laws)
+            laws = mesh_laws(spec)
+            k_s, k_r = laws["outer"].stiffness, laws["inner"].stiffness
+            c_s, c_r = laws["outer"].damping_max, laws["inner"].damping_max
+        else:  # the study's lumped model: eq. 10 with an assumed C_gamma, eq. 13
+            k_s = k_r = la.mesh_stiffness_per_width_n_per_m2 * spec.gears_assumed.face_width_m
+            c_s = mesh_damping(k_s, m_s, m_p, la.mesh_damping_ratio)
+            c_r = mesh_damping(k_r, m_p, m_r, la.mesh_damping_ratio)
         return cls(
             sun=sun, ring=ring, carrier=carrier, planet=planet, planet_count=geo.planet_count,
-            sun_mesh_stiffness_n_per_m=k_m, ring_mesh_stiffness_n_per_m=k_m,
+            sun_mesh_stiffness_n_per_m=k_s, ring_mesh_stiffness_n_per_m=k_r,
             sun_pressure_angle_rad=geo.sun_planet.operating_pressure_angle,
             ring_pressure_angle_rad=geo.planet_ring.operating_pressure_angle,
             fixed=fixed, base_helix_angle_rad=geo.sun.base_helix_angle,
             planet_angles_rad=tuple(float(a) for a in geo.planet_angles),
-            sun_mesh_damping_n_s_per_m=mesh_damping(k_m, m_s, m_p, la.mesh_damping_ratio),
-            ring_mesh_damping_n_s_per_m=mesh_damping(k_m, m_p, m_r, la.mesh_damping_ratio),
+            sun_mesh_damping_n_s_per_m=c_s, ring_mesh_damping_n_s_per_m=c_r,
             source=str(spec.source),
         )
-
-
-def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, damping_ratio: float) -> float:
-    """Eq. 13: c = 2 xi sqrt(k m1 m2 / (m1 + m2)) [N s/m] (mesh damping from the damping ratio xi)."""
-    return 2.0 * damping_ratio * math.sqrt(stiffness_n_per_m * mass1_kg * mass2_kg / (mass1_kg + mass2_kg))
 
 
 @dataclass(frozen=True)

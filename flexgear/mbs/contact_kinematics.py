@@ -105,6 +105,7 @@ class ContactKinematics:
         self.spin = np.array([c.spin_per_drive_angle for c in columns])
         self.n_modes = np.array([c.values.shape[1] for c in columns])
         self.first = np.array([column_offsets[c.body] for c in columns])
+        self.bodies = [c.body for c in columns]
         self.matrix = base.copy()
 
     def matrix_at(self, t: float) -> np.ndarray:

@@ -29,7 +29,7 @@ import numpy as np
 
 from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_series
 from flexgear.geometry.pair import _EZ, helix_halves
-from flexgear.laws.contact import ContactLaw, friction_forces, impact_force, periodic_value
+from flexgear.laws.contact import ContactLaw, friction_forces, normal_force, periodic_value
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body
 from flexgear.mbs.elements import _keep_alive
@@ -235,7 +235,7 @@ def _normal_law_function(c: GearContact, factor: Any, esym: Any):
     """
 
     def law(mbs, t, itemNumber, displacement, velocity, stiffness, damping, offset):  # noqa: N803
-        return impact_force(displacement, velocity, c.law, factor, esym)
+        return normal_force(displacement, velocity, c.law, factor, esym)
 
     return law
 
@@ -310,8 +310,11 @@ class MeshFriction:
         self.offsets = np.array([c.phase_offset for c in contacts])
         self.phase_rate = np.array([c.phase_per_drive_angle for c in contacts])
         # every contact's law and series stacked into arrays: one vectorised evaluation per step
+        kinds = {c.law.kind for c in contacts}
+        if len(kinds) != 1:
+            raise ValueError(f"tooth friction needs one contact law for all contacts, got {sorted(kinds)}")
         self.law = ContactLaw(*(np.array([getattr(c.law, f) for c in contacts])
-                                for f in ("stiffness", "exponent", "damping_max", "penetration_depth")))
+                                for f in ("stiffness", "exponent", "damping_max", "penetration_depth")), kinds.pop())
         self.series = {name: _stack([getattr(c, name) for c in contacts]) for name in ("stiffness", "sliding", "lever")}
         self._cos = np.ascontiguousarray([np.atleast_2d(self.series[k].cos_coeffs).T
                                           for k in ("stiffness", "sliding", "lever")])
@@ -325,7 +328,7 @@ class MeshFriction:
         """Generalized friction forces on the frame coordinates (reference implementation, numpy)."""
         phase = self.phase_rate * drive_angle(t, self.ramp_time, self.drive_speed) - self.offsets
         value = {name: periodic_value(phase, series) for name, series in self.series.items()}
-        normal = impact_force(delta, delta_t, self.law, value["stiffness"])
+        normal = normal_force(delta, delta_t, self.law, value["stiffness"])
         f_slide, f_spin = friction_forces(normal, self.spin_rows @ q_t, value["sliding"], value["lever"],
                                           self.mu, self.reg, self.series["lever"].mean)
         return -(self.sliding_rows.T @ f_slide + self.spin_rows.T @ f_spin)
@@ -338,7 +341,8 @@ class MeshFriction:
         law = self.law
         return mesh_friction_forces(
             phase, delta, delta_t, q_t, law.stiffness, law.exponent, law.damping_max, law.penetration_depth,
-            self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows)
+            self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows,
+            law.kind == "iso6336")
 
     def __call__(self, mbs, t: float) -> bool:
         """Pre-step user function: friction from the state at the start of the step."""
@@ -364,7 +368,7 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
                   contact_assumed: ContactAssumed, *, helix_layout: str = "single", half_gap: float = 0.0,
                   hand: int = 1, drive_sign: float = 1.0, spins: tuple[float, float] | None = None,
                   carrier_spin: float = 0.0, phase_offset: float = 0.0,
-                  phase_per_drive_angle: float | None = None) -> list[GearContact]:
+                  phase_per_drive_angle: float | None = None, law: ContactLaw | None = None) -> list[GearContact]:
     """Gear contacts (one per helix half) of ``mesh`` between bodies ``body1`` and ``body2``.
 
     ``centre1``/``centre2``: gear centres in the ground frame [m] at the reference configuration; their
@@ -376,7 +380,8 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
     (1, -z1/z2) external, (1, z1/z2) internal); ``carrier_spin``: that of the carrier holding the
     centres (0 when fixed). The mesh phase in cycles is phase_per_drive_angle * theta - phase_offset,
     by default z1 (spin1 - carrier_spin) drive_sign / (2 pi) mesh cycles per drive angle theta.
-    Names: ``f"{name}_half{k}"``.
+    ``law``: the whole-face-width normal law (flexgear.laws.contact.mesh_laws; default the study's impact law
+    from ``contact``), shared by the halves in proportion to their face width. Names: ``f"{name}_half{k}"``.
     """
     g1, g2 = mesh.gear1, mesh.gear2
     c1, c2 = np.asarray(centre1, float), np.asarray(centre2, float)
@@ -408,7 +413,8 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
         point = c1 + r_w1 * e + [0.0, 0.0, half.z]
         grad1, grad2 = contact_gradients(c1, c2, point, normal, t_dir)
         out.append(GearContact(
-            f"{name}_half{k}", body1, body2, grad1, grad2, ContactLaw.from_contact(contact, half.share),
+            f"{name}_half{k}", body1, body2, grad1, grad2,
+            ContactLaw.from_contact(contact, half.share) if law is None else law.share(half.share),
             stiffness, sliding, lever, contact.friction_coefficient,
             contact_assumed.friction_regularisation_m_per_s, phase_offset, phase_per_drive_angle,
             point, normal, (float(spins[0]), float(spins[1])), helix_width))

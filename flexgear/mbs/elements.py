@@ -1,8 +1,10 @@
-"""Linear elements and supports on body frame coordinates: bushings, fixed joints, speed drive, load torque.
+"""Linear elements and supports: bushings, bearings at their seats, fixed joints, speed drive, load torque.
 
-Element contract (as ROSS's): every linear element gives a 6x6 stiffness and damping matrix on the
+Element contract (as ROSS's): every linear frame element gives a 6x6 stiffness and damping matrix on the
 frame coordinates (u_x, u_y, u_z, phi_x, phi_y, phi_z) of one body; all of them are summed into one
-``ObjectGenericODE2`` over the frame nodes.
+``ObjectGenericODE2`` over the frame nodes. Bearings where they are (:func:`add_support`), the drive and
+the load at an interface (:func:`interface_spin_marker`) act through the interface's exact virtual-node
+motion for a flexible body (flexgear.mbs.flexible) and at the same point of a rigid body.
 """
 
 from __future__ import annotations
@@ -11,6 +13,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.geometry.supports import Support
 from flexgear.laws.ramps import drive_angle, ramp_fraction
 from flexgear.mbs.bodies import Body
 from flexgear.spec import Bearing
@@ -73,8 +76,88 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_
     return obj, marker
 
 
-def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float) -> int:
-    """Prescribe the spin angle of ``body`` to the STEP speed ramp's integral (position level).
+def add_support(mbs, body: Body, support: Support) -> list[int]:
+    """A Table 2 bearing at its place (flexgear.geometry.supports): three spring-dampers from ground to the axis.
+
+    Springs (``Support.spring_points``) at points on the body's axis at ``support.centre_z`` (+- a) of its
+    frame: ``ObjectConnectorCartesianSpringDamper`` with stiffness k and damping k * damping_per_stiffness,
+    to a ``MarkerSuperElementPosition`` on a virtual node moving rigidly with the interface
+    ``support.interface`` of a flexible body (``FlexibleBody.point_markers``, placed at the same points) or a
+    body-fixed marker of a rigid body. Points on the axis: the spin does not move them, so the bearing
+    leaves the spin free and damps only translation and tilt. Returns the connectors.
+    """
+    from exudyn.itemInterface import (
+        MarkerBodyPosition,
+        MarkerNodePosition,
+        NodePointGround,
+        ObjectConnectorCartesianSpringDamper,
+        VObjectConnectorCartesianSpringDamper,
+    )
+
+    springs = support.spring_points()
+    if body.flexible:
+        markers = body.point_markers.get(support.interface, [])
+        if len(markers) != len(springs):
+            raise KeyError(f"flexible body {body.name!r} needs {len(springs)} point markers on interface "
+                           f"{support.interface!r} (add_flexible_body point_markers); has {len(markers)}")
+    else:
+        markers = [mbs.AddMarker(MarkerBodyPosition(bodyNumber=body.obj, localPosition=[0.0, 0.0, float(z)]))
+                   for z, _ in springs]
+    out = []
+    for k, ((z, stiffness), marker) in enumerate(zip(springs, markers, strict=True)):
+        ground = mbs.AddNode(NodePointGround(referenceCoordinates=list(map(float, body.position + [0.0, 0.0, z]))))
+        out.append(mbs.AddObject(ObjectConnectorCartesianSpringDamper(
+            name=f"bearing_{body.name}_{k}", markerNumbers=[mbs.AddMarker(MarkerNodePosition(nodeNumber=ground)),
+                                                            marker],
+            stiffness=[float(s) for s in stiffness],
+            damping=[float(support.damping_per_stiffness * s) for s in stiffness],
+            visualization=VObjectConnectorCartesianSpringDamper(show=False))))
+    return out
+
+
+def support_points(support: Support) -> list[np.ndarray]:
+    """Points [m, component frame] of the bearing's springs: the ``point_markers`` a flexible body needs."""
+    return [np.array([0.0, 0.0, z]) for z, _ in support.spring_points()]
+
+
+def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, int, int]:
+    """A coordinate marker on the spin angle of ``body`` at ``interface`` [rad]: drive and load act on it.
+
+    Rigid body (or ``interface`` None): the frame's spin coordinate. Flexible body: an auxiliary coordinate s
+    tied by one linear constraint to s = phi_z + r . q, r the interface's elastic rotation about the axis per
+    modal coordinate (``ReducedBody.interface_motion`` row 5, the rotation its RBE3 virtual-node marker
+    carries; first order in the elastic rotation and tilt). A torque on s reaches the body there.
+    Returns (marker, node, coordinate index in the node) of that spin angle.
+    """
+    from exudyn.itemInterface import (
+        MarkerNodeCoordinate,
+        MarkerNodeCoordinates,
+        MarkerObjectODE2Coordinates,
+        NodeGenericODE2,
+        ObjectConnectorCoordinateVector,
+        ObjectGenericODE2,
+    )
+
+    if interface is None or not body.flexible:
+        return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5)), body.node, 5
+    r = body.reduced.interface_motion(interface)[5]
+    spin = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_{interface}_spin", numberOfODE2Coordinates=1,
+                                       referenceCoordinates=[0.0], initialCoordinates=[0.0],
+                                       initialCoordinates_t=[0.0]))
+    span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_{interface}_span",
+                                           nodeNumbers=[body.node, body.modal_node]))
+    row = np.concatenate([np.eye(6)[5], r])[None, :]
+    mbs.AddObject(ObjectConnectorCoordinateVector(
+        name=f"{body.name}_{interface}_spin_tie",
+        markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=spin)),
+                       mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
+        scalingMarker0=np.ones((1, 1)), scalingMarker1=row, offset=np.zeros(1)))
+    return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=spin, coordinate=0)), spin, 0
+
+
+def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float, marker: int | None = None) -> int:
+    """Prescribe the spin angle of ``body`` (or the coordinate of ``marker``, :func:`interface_spin_marker`)
+    to the STEP speed ramp's integral (position level).
 
     Returns the constraint; its ``Force`` output is the drive torque [N·m].
     """
@@ -84,7 +167,7 @@ def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float) -> int:
 
     ground = mbs.AddNode(NodePointGround())
     m0 = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=ground, coordinate=0))
-    m1 = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
+    m1 = marker if marker is not None else mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
     drive = mbs.AddObject(ObjectConnectorCoordinate(name="drive", markerNumbers=[m0, m1]))
 
     def offset(mbs, t, itemNumber, lOffset):  # noqa: N803
@@ -96,13 +179,15 @@ def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float) -> int:
     return drive
 
 
-def add_load_torque(mbs, body: Body, torque: float, ramp_time: float) -> int:
-    """Torque ``torque`` [N·m] about the body's spin axis, ramped by STEP(t, 0, 0, T, 1)."""
+def add_load_torque(mbs, body: Body, torque: float, ramp_time: float, marker: int | None = None) -> int:
+    """Torque ``torque`` [N·m] about the body's spin axis (or on the coordinate of ``marker``,
+    :func:`interface_spin_marker`), ramped by STEP(t, 0, 0, T, 1)."""
     from exudyn import symbolic as esym
     from exudyn.itemInterface import LoadCoordinate, MarkerNodeCoordinate
     from exudyn.utilities import CreateSymbolicUserFunction
 
-    marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
+    if marker is None:
+        marker = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5))
     load = mbs.AddLoad(LoadCoordinate(name="load_torque", markerNumber=marker, load=torque))
 
     def ramped(mbs, t, load):

@@ -21,7 +21,7 @@ import numpy as np
 from flexgear.fe.cms import ReducedBody
 from flexgear.mbs.bodies import Body
 
-__all__ = ["FlexibleBody", "add_flexible_body", "interface_virtual_nodes"]
+__all__ = ["FlexibleBody", "add_flexible_body", "interface_virtual_nodes", "interface_point_modes"]
 
 
 
@@ -32,6 +32,7 @@ class FlexibleBody(Body):
     modal_node: int = -1
     interface_markers: dict[str, int] = field(default_factory=dict)
     reduced: ReducedBody | None = None
+    point_markers: dict[str, list[int]] = field(default_factory=dict)  # interface -> position markers
 
 
 def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):
@@ -43,24 +44,27 @@ def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: fl
     moves exactly as the RBE3 marker over the interface's real node set (same weighted least-squares
     rotation), at the cost of six nodes instead of hundreds. Returns (positions (6, 3), modes (18, m)).
     """
+    p = reduced.interface(name).point if point is None else np.asarray(point, float)
+    positions = np.array([p + sign * arm * np.eye(3)[k] for k in range(3) for sign in (1.0, -1.0)])
+    return positions, interface_point_modes(reduced, name, positions)
+
+
+def interface_point_modes(reduced: ReducedBody, name: str, points) -> np.ndarray:
+    """(3 n_points, m) displacements of ``points`` [m, body frame] moving rigidly with interface ``name``.
+
+    u = t + theta x (x - p) per mode, (t, theta) = ``reduced.interface_motion(name)``, p its RBE3 point.
+    """
     itf = reduced.interface(name)
-    p = itf.point if point is None else np.asarray(point, float)
     motion = reduced.interface_motion(name)
     t, th = motion[:3], motion[3:]
-    positions, rows = [], []
-    for k in range(3):
-        for sign in (1.0, -1.0):
-            x = p + sign * arm * np.eye(3)[k]
-            positions.append(x)
-            rows.append(t + np.cross(th, x - itf.point, axis=0))  # u = t + theta x (x - p), per mode
-    return np.array(positions), np.vstack(rows)
+    return np.vstack([t + np.cross(th, np.asarray(x, float) - itf.point, axis=0) for x in points])
 
 
 def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_matrix=None,
                       velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                       stiffness_damping_s: float = 0.0, mass_damping_per_s: float = 0.0,
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
-                      show: bool = True) -> FlexibleBody:
+                      point_markers: dict[str, list] | None = None, show: bool = True) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -69,12 +73,15 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     ``interface_markers``: interfaces that get a ``MarkerSuperElementRigid`` (default all), as names
     (marker at the interface's RBE3 point) or as {name: marker point in the body frame [m]}. The
     markers act on six virtual nodes per interface (:func:`interface_virtual_nodes`) appended to the
-    mode basis; the floating-frame inertia terms come from the real mesh only.
+    mode basis; the floating-frame inertia terms come from the real mesh only. ``point_markers``:
+    {interface: points [m, body frame]}: one virtual node per point moving rigidly with the interface
+    (:func:`interface_point_modes`) and a ``MarkerSuperElementPosition`` on it (bearing springs at a seat).
     """
     import exudyn as exu
     from exudyn.itemInterface import (
         MarkerNodeCoordinates,
         MarkerNodeRigid,
+        MarkerSuperElementPosition,
         MarkerSuperElementRigid,
         NodeGenericODE2,
         ObjectFFRFreducedOrder,
@@ -110,6 +117,12 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         positions.append(x)
         modes.append(rows)
         count += len(x)
+    point_first = {}
+    for itf_name, pts in (point_markers or {}).items():
+        point_first[itf_name] = (count, len(pts))
+        positions.append(np.asarray(pts, float).reshape(-1, 3))
+        modes.append(interface_point_modes(reduced, itf_name, pts))
+        count += len(pts)
     damping = mass_damping_per_s + stiffness_damping_s * reduced.stiffness
     inv = reduced.invariants
     obj = mbs.AddObject(ObjectFFRFreducedOrder(
@@ -130,10 +143,14 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
             name=f"{name}_{itf_name}", bodyNumber=obj, offset=[0.0, 0.0, 0.0],
             meshNodeNumbers=np.arange(start, start + 6, dtype=np.int64), weightingFactors=np.full(6, 1.0 / 6.0),
             useAlternativeApproach=True, visualization={"show": False, "showMarkerNodes": False}))
+    points = {itf_name: [mbs.AddMarker(MarkerSuperElementPosition(
+        name=f"{name}_{itf_name}_point{k}", bodyNumber=obj, meshNodeNumbers=[start + k], weightingFactors=[1.0],
+        visualization={"show": False, "showMarkerNodes": False})) for k in range(n)]
+        for itf_name, (start, n) in point_first.items()}
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
-                        modal, markers, reduced)
+                        modal, markers, reduced, points)
 
 
 

@@ -22,9 +22,19 @@ import numpy as np
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
+from flexgear.geometry.supports import Support, gearbox_supports
+from flexgear.laws.contact import mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
-from flexgear.mbs.elements import Bushing, add_interface_joint, add_load_torque, add_speed_drive
+from flexgear.mbs.elements import (
+    Bushing,
+    add_interface_joint,
+    add_load_torque,
+    add_speed_drive,
+    add_support,
+    interface_spin_marker,
+    support_points,
+)
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import GearboxSpec, Variant
 from flexgear.theory import Theory, theory
@@ -50,6 +60,7 @@ class GearboxModel:
     input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
     joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
+    output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -74,16 +85,18 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
     spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
     common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
                   half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
+    laws = mesh_laws(spec)
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
         phase = zs * psi / (2 * math.pi)
         contacts += pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", geo.sun_planet, np.zeros(3),
                                   c_planet, hand=1, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
-                                  phase_offset=phase, **common)
+                                  phase_offset=phase, law=laws["outer"], **common)
         contacts += pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", geo.planet_ring, c_planet,
                                   np.zeros(3), hand=-1, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
-                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
+                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, law=laws["inner"],
+                                  **common)
     return contacts
 
 
@@ -112,18 +125,21 @@ def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
-                   joint: tuple[str, np.ndarray] | None = None) -> Body:
+                   joint: tuple[str, np.ndarray] | None = None, support: Support | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
-    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point.
+    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point;
+    ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support).
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
     from flexgear.mbs.flexible import add_flexible_body
 
+    points = {support.interface: support_points(support)} if support is not None else None
     return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
-                             interface_markers={joint[0]: joint[1]} if joint else [], show=False)
+                             interface_markers={joint[0]: joint[1]} if joint else [], point_markers=points,
+                             show=False)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -136,7 +152,10 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     (flexgear.fe.reduced.JOINT_INTERFACES, at flexgear.fe.reduced.joint_point): a flexible body
     through its interface node set's RBE3 motion, a rigid one at the point. The input bearing and the
     drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
-    body when shaft and gear are one), on the frame coordinates at the frame origin (gear mid-plane).
+    body when shaft and gear are one): with ``[supports_assumed] placement = "bearing_seats"`` at the
+    shafts' bearing seats and the planets' bores (flexgear.geometry.supports, flexgear.mbs.elements.add_support,
+    interface_spin_marker), through the seat interfaces' virtual-node motion of a flexible body;
+    with "gear_centres" on the frame coordinates at the frame origin (gear mid-plane).
     Rigid components carry the mass properties of the variant's ``rigid_mass_properties``: "mesh",
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
     "exact", the exact geometry's; ``mass_source`` overrides both.
@@ -159,6 +178,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     th = theory(spec)
     geo = gear_set_geometry(spec)
     level = variant.mesh_level
+    seats = spec.supports_assumed.placement == "bearing_seats"
+    supports = gearbox_supports(spec)
     bodies: list[Body] = []
     pairs = []
     ends = {}
@@ -172,19 +193,25 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
                                   (JOINT_INTERFACES[gear], point))
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   (JOINT_INTERFACES[shaft], point))
+                                   (JOINT_INTERFACES[shaft], point), supports[shaft] if seats else None)
             bodies += [lead, other]
             pairs.append((lead, other, (JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft]), point))
             ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
-                                     props, reduced))
+                                     props, reduced, support=supports["planet"] if seats else None))
     by_body = {bd.name: bd for bd in bodies}
     joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
     b = spec.bearings
     bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
+    planets = [f"planet{i + 1}" for i in range(geo.planet_count)]
+    if seats:  # bearings at their seats (flexgear.geometry.supports), not on the frames
+        bushings = []
+        placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
+        for body, key in placed:
+            add_support(mbs, by_body[body], supports[key])
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
@@ -193,12 +220,15 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m)
     springs = train.springs
-    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s)
+    seat = "bearing_seat" if seats else None  # drive and load at the shafts' seats (spline, flange)
+    spin_in = interface_spin_marker(mbs, by_body[ends["sun"]], seat)
+    spin_out = interface_spin_marker(mbs, by_body[ends["ring"]], seat)
+    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
     load = add_load_torque(mbs, by_body[ends["ring"]], -math.copysign(lc.load_torque_nm, th.output_speed),
-                           lc.ramp_time_s)
+                           lc.ramp_time_s, spin_out[0])
     halves = len(helix_halves(geo))
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        train.aux_node, ends["sun"], ends["ring"], joints)
+                        train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:])

@@ -156,6 +156,8 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
         "output_accel": mbs.AddSensor(SensorNode(nodeNumber=ring, outputVariableType=ovt.Acceleration,
                                                  storeInternal=True)),
     }
+    sensors["output_spin"] = mbs.AddSensor(SensorNode(nodeNumber=model.output_spin[0],
+                                                      outputVariableType=ovt.Coordinates, storeInternal=True))
     for gear, joint in model.joints.items():
         sensors[f"joint_{gear}"] = mbs.AddSensor(SensorObject(objectNumber=joint, outputVariableType=ovt.TorqueLocal,
                                                               storeInternal=True))

@@ -14,6 +14,7 @@ import traceback
 import numpy as np
 import pandas as pd
 
+from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
@@ -44,7 +45,14 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
         acc = data(key)
         cols[f"{side}_bearing_accel_x_m_per_s2"] = acc[:, 1]
         cols[f"{side}_bearing_accel_y_m_per_s2"] = acc[:, 2]
-    return pd.DataFrame({c: cols[c] for c in signal_columns(n)})
+    frame = pd.DataFrame({c: cols[c] for c in signal_columns(n)})
+    # optional columns (flexgear.mbs.deflection): loaded transmission error, flexible gears' mesh deflections
+    time = cols["time_s"]
+    extra = {"transmission_error_m": transmission_error(model, time, data("output_spin")[:, 1 + model.output_spin[1]])}
+    if model.kinematics is not None:
+        modal = {k[len("modes_"):]: data(k)[:, 1:] for k in sensors if k.startswith("modes_")}
+        extra.update(mesh_deflection_signals(model, time, modal))
+    return pd.concat([frame, pd.DataFrame(extra)], axis=1)
 
 
 def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], window_start: float) -> dict[str, float]:

@@ -1,0 +1,126 @@
+"""Deflection signals of a run: loaded transmission error and the flexible gears' elastic deflection per mesh.
+
+Post-processing of the stored sensors (no Python per step), optional signal columns of
+flexgear.results.signal_columns:
+
+- ``transmission_error_m``: loaded transmission error along the line of action at the output,
+  TE = r_b,out (theta_out,kin - theta_out) sign(omega_out), theta_out,kin = i theta_in (i = omega_out/omega_in
+  of the theory), theta_in the prescribed drive angle at the input seat, theta_out the output's spin where the
+  load acts (its seat interface for a flexible output shaft): rigid and elastic, positive when the output lags.
+  Its mean at steady speed is the loaded static transmission error.
+- ``{outer,inner}_deflection_{load,centrifugal}_{i}_m``: elastic deflection of the flexible gears of mesh i
+  along the tooth normal at the contact (mean of the helix halves), the amount by which the gears yield away
+  from each other (positive: the mesh approach is reduced), measured relative to each gear's seat interface
+  (bore of sun and planet, bolt circle of the ring: :data:`GEAR_SEATS`), not its floating frame. Split:
+  centrifugal = the quasi-static response to the spin, q_c = omega^2 K_r^-1 Q_c with
+  Q_c,j = sum_i m_i (x_i psi_ij,x + y_i psi_ij,y) (the zz entry of the FFRF invariant mXRefTildePsiTilde);
+  load = the rest (mesh, bearing and joint forces).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from flexgear.geometry.involute import gear_set_geometry
+from flexgear.laws.ramps import drive_angle
+from flexgear.spec import COMPONENT_GEOMETRY
+
+__all__ = ["GEAR_SEATS", "transmission_error", "centrifugal_modal_load", "mesh_deflection_signals"]
+
+GEAR_SEATS = {"sun": "bore", "planet": "bore", "ring": "bolt_circle"}
+"""Interface of each gear geometry that deflections are measured from."""
+
+
+def transmission_error(model, time_s: np.ndarray, output_angle: np.ndarray) -> np.ndarray:
+    """TE [m] (module docstring) from the output's spin angle [rad] at the load point, at times ``time_s``."""
+    spec, th = model.spec, model.theory
+    lc = spec.load_case
+    theta_in = np.asarray(drive_angle(np.asarray(time_s), lc.ramp_time_s, lc.input_speed_rad_s), float)
+    geo = gear_set_geometry(spec)
+    r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
+    sign = math.copysign(1.0, th.output_speed)
+    return r_out * (th.ratio * theta_in - np.asarray(output_angle, float)) * sign
+
+
+def centrifugal_modal_load(reduced) -> np.ndarray:
+    """Q_c [N per (rad/s)^2 per modal unit], (m,): the modal force of spinning at omega about z is omega^2 Q_c."""
+    inv = np.asarray(reduced.invariants["mXRefTildePsiTilde"], float)
+    return inv[2, 2::3].copy()
+
+
+def _body_geometry(name: str) -> str:
+    return COMPONENT_GEOMETRY.get(name.rstrip("0123456789"), name.rstrip("0123456789"))
+
+
+def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+    """Columns ``{outer,inner}_deflection_{load,centrifugal}_{i}_m`` of the flexible gears (module docstring).
+
+    ``modal``: {body name: (n_times, n_modes) modal coordinates}. Gear spin angles are the nominal ones
+    (spin per drive angle x prescribed angle), as the contact kinematics uses them.
+    """
+    kin = model.kinematics
+    lc = model.spec.load_case
+    t = np.asarray(time_s, float)
+    theta = np.asarray(drive_angle(t, lc.ramp_time_s, lc.input_speed_rad_s), float)
+    rate = np.gradient(theta, t) if len(t) > 1 else np.zeros_like(t)
+    n_contacts = len(model.contacts)
+    total = np.zeros((len(t), n_contacts))
+    centrifugal = np.zeros((len(t), n_contacts))
+    offsets = {}
+    for j, contact in enumerate(model.contacts):
+        for body_name, sign, spin in ((contact.body1, 1.0, contact.spin_per_drive_angle[0]),
+                                      (contact.body2, -1.0, contact.spin_per_drive_angle[1])):
+            body = model.bodies[body_name]
+            if not body.flexible:
+                continue
+            red = body.reduced
+            seat = GEAR_SEATS[_body_geometry(body_name)]
+            if body_name not in offsets:
+                q_c_unit = centrifugal_modal_load(red) / red.stiffness
+                offsets[body_name] = (red.interface_motion(seat), red.interface(seat).point, q_c_unit)
+            motion, p_seat, q_c_unit = offsets[body_name]
+            row = _column_row(kin, j, body_name)
+            ang = spin * theta  # nominal spin angle of the body
+            rel = np.asarray(contact.point, float) - body.position
+            ca, sa = np.cos(ang), np.sin(ang)
+            # contact point and tooth normal in the body frame: R(-ang) x
+            x_b = np.stack([ca * rel[0] + sa * rel[1], -sa * rel[0] + ca * rel[1], np.full_like(ang, rel[2])], 1)
+            nrm = np.asarray(contact.normal, float)
+            n_b = np.stack([ca * nrm[0] + sa * nrm[1], -sa * nrm[0] + ca * nrm[1], np.full_like(ang, nrm[2])], 1)
+            g = np.hstack([n_b, np.cross(x_b - p_seat, n_b)])  # (T, 6) seat rigid motion -> normal at contact
+            coeff = _column_values(kin, row, theta) - g @ motion  # (T, m): relative to the seat
+            q = modal[body_name]
+            total[:, j] += sign * np.einsum("tm,tm->t", coeff, q)
+            q_c = (spin * rate)[:, None] ** 2 * q_c_unit[None, :]
+            centrifugal[:, j] += sign * np.einsum("tm,tm->t", coeff, q_c)
+    out = {}
+    for kind in ("outer", "inner"):
+        groups: dict[int, list[int]] = {}
+        for j, c in enumerate(model.contacts):
+            if c.name.startswith(f"{kind}_mesh_"):
+                groups.setdefault(int(c.name.split("_")[2]), []).append(j)
+        for i, rows in sorted(groups.items()):
+            # the elastic terms enter the penetration with the sign that reduces it when the gears yield
+            cent = -centrifugal[:, rows].mean(1)
+            out[f"{kind}_deflection_load_{i}_m"] = -total[:, rows].mean(1) - cent
+            out[f"{kind}_deflection_centrifugal_{i}_m"] = cent
+    return out
+
+
+def _column_row(kin, contact: int, body: str) -> int:
+    """Index of the (contact, body) modal column in ``kin`` (flexgear.mbs.contact_kinematics.ContactKinematics)."""
+    for k in range(len(kin.rows)):
+        if kin.rows[k] == contact and kin.bodies[k] == body:
+            return k
+    raise KeyError(f"no modal column for contact {contact} on body {body!r}")
+
+
+def _column_values(kin, k: int, theta: np.ndarray) -> np.ndarray:
+    """c(alpha(t)) of modal column k, (T, m), interpolated as ContactKinematics.matrix_at does."""
+    alpha = np.mod(kin.psi[k] - kin.spin[k] * theta, 2 * np.pi) * (kin.n_grid / (2 * np.pi))
+    i0 = np.floor(alpha).astype(int) % kin.n_grid
+    w = (alpha - np.floor(alpha))[:, None]
+    table = kin.tables[k, :, :kin.n_modes[k]]
+    return (1 - w) * table[i0] + w * table[(i0 + 1) % kin.n_grid]
