@@ -317,7 +317,7 @@ def sweep_pages(d: ReportData) -> list[Page]:
         draw_table(ax, shown, top=0.92, fontsize=7, wrap=26)
 
     def draw_figures(fig: Figure) -> None:
-        x = "eps_beta" if any(p.endswith("face_width_mm") for p in params) else (params[0] if params else "eps_beta")
+        x = "eps_beta" if width else numeric[0]
         panels = (("input_bearing_peak", "input bearing, peak radial accel. [m/s²]"),
                   ("output_bearing_peak", "output bearing, peak radial accel. [m/s²]"),
                   ("input_bearing_rms", "input bearing accel. RMS [m/s²]"),
@@ -343,5 +343,10 @@ def sweep_pages(d: ReportData) -> list[Page]:
                    "themselves. Peak: largest radial acceleration in the settled window (as Table 6).", width=190,
                    fontsize=7.5)
     width = any(p.endswith("face_width_mm") for p in params)
-    what = "the face width (ε_β)" if width else ", ".join(params)
-    return [(f"Sweep table: {sw.meta['name']}", draw_table_page), (f"Sweep: sensitivity to {what}", draw_figures)]
+    numeric = [p for p in params if len(sw.meta["parameters"][p]) > 1
+               and all(isinstance(v, (int, float)) for v in sw.meta["parameters"][p])]
+    pages = [(f"Sweep table: {sw.meta['name']}", draw_table_page)]
+    if numeric:     # a sensitivity figure needs a swept number
+        what = "the face width (ε_β)" if width else ", ".join(numeric)
+        pages.append((f"Sweep: sensitivity to {what}", draw_figures))
+    return pages
