@@ -164,9 +164,9 @@ def overlay_pages(d: ReportData) -> list[Page]:
             continue
 
         def draw(fig: Figure, kind=kind, having=having, ylabel=ylabel) -> None:
-            top = fig.add_axes([0.07, 0.53, 0.9, 0.36])
-            zoom = fig.add_axes([0.07, 0.1, 0.42, 0.34])
-            last = fig.add_axes([0.55, 0.1, 0.42, 0.34])
+            top = fig.add_axes([0.1, 0.53, 0.87, 0.36])
+            zoom = fig.add_axes([0.1, 0.1, 0.38, 0.34])
+            last = fig.add_axes([0.59, 0.1, 0.38, 0.34])
             for n, r in having.items():
                 style = {"color": "k", "ls": "--", "lw": 1.0} if n == "lumped" else {"color": col[n]}
                 r.plot(top, kind, **style)
