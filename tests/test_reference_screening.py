@@ -20,10 +20,11 @@ def settings():
     return dataclasses.replace(load_gearbox(GEARBOX).screening, window="after_ramps")
 
 
-def _with_te(res, peak_to_peak: float):
+def _with_te(res, loaded: float):
+    """A loaded transmission error of mean ``loaded`` [m] with a ripple at the mesh frequency."""
     t = res.signals["time_s"].to_numpy()
     f = res.meta["theory"]["mesh_frequency_hz"]
-    res.signals["transmission_error_m"] = 0.5 * peak_to_peak * np.sin(2 * np.pi * f * t + 0.3)
+    res.signals["transmission_error_m"] = loaded + 0.05 * loaded * np.sin(2 * np.pi * f * t + 0.3)
     return res
 
 
@@ -35,7 +36,7 @@ def test_reference_has_zero_bias_and_known_differences_are_recovered(settings):
     heavier = synthetic_result("heavier")             # every outer mesh force 2 % higher, no TE signal
     cols = [c for c in heavier.signals.columns if c.startswith("outer_mesh_force_")]
     heavier.signals[cols] *= 1.02
-    noisier = _with_te(synthetic_result("noisier"), 2.2e-6)   # TE 10 % larger, all else equal
+    noisier = _with_te(synthetic_result("noisier"), 2.2e-6)   # loaded TE 10 % larger, all else equal
     s = screen([ref, louder, heavier, noisier], settings, reference="ref")
     tab = s.table.set_index("variant")
     ind = s.indicators.set_index(["variant", "indicator"])
@@ -55,7 +56,7 @@ def test_reference_has_zero_bias_and_known_differences_are_recovered(settings):
         assert ind.loc[("heavier", key), "bias_pct"] == pytest.approx(0.0, abs=1e-9)
     expect = tol.outer_mesh_force.weight * 2.0 / tol.outer_mesh_force.tea_pct / no_te * 100.0
     assert tab.loc["heavier", "bias_pct"] == pytest.approx(expect, rel=1e-6)
-    # noisier: TE present in both, 10 % larger peak-to-peak, full weights
+    # noisier: TE present in both, 10 % larger loaded TE, full weights
     assert ind.loc[("noisier", "transmission_error"), "bias_pct"] == pytest.approx(10.0, rel=1e-3)
     expect = tol.transmission_error.weight * 10.0 / tol.transmission_error.tea_pct * 100.0
     assert tab.loc["noisier", "bias_pct"] == pytest.approx(expect, rel=1e-3)

@@ -326,15 +326,15 @@ def _reference_means(results: list[RunResult], name: str, settings: ScreeningSet
 
 
 def _reference_reasoning(table: pd.DataFrame, indicators: pd.DataFrame, name: str) -> str:
-    """Why the variants differ from the reference: distance and the largest contributor of each."""
+    """Why the variants differ from the reference: distance and the two largest contributors of each."""
     parts = []
     for row in table[(table["status"] == "ok") & (table["variant"] != name)].itertuples():
         ind = indicators[indicators["variant"] == row.variant]
-        share = ind["weight"] * ind["bias_pct"] / ind["tea_pct"] * 100.0
-        top = ind.loc[share.idxmax()] if len(ind) else None
+        share = (ind["weight"] * ind["bias_pct"] / ind["tea_pct"]).sort_values(ascending=False)
+        top = [ind.loc[i] for i in share.index[:2]]
         parts.append(f"{row.variant} at distance {row.distance_pct:.3g} % of TEa"
-                     + (f" (largest: {top['indicator']} {top['bias_pct']:.3g} % off, TEa {top['tea_pct']:g} %)"
-                        if top is not None else ""))
+                     + (" (largest: " + ", ".join(f"{t['indicator']} {t['bias_pct']:.3g} % off (TEa {t['tea_pct']:g} %)"
+                                                  for t in top) + ")" if top else ""))
     return (f" Against reference {name} (Bias 0 by definition): " + "; ".join(parts) + ".") if parts else ""
 
 
