@@ -24,8 +24,7 @@ gives its CV like the study's:
 Settled window (``[screening] window = "settled"``, :func:`settled_start`): after the STEP ramps
 the run is cut into blocks of ``settle_block_mesh_cycles`` mesh cycles. Each settling signal gets
 one value per block: the planet-mean mesh forces and the two speeds their block means (a drift),
-the loaded transmission error (when recorded) its block mean, the mesh-force ripples and bearing
-accelerations RMS their block values (a decaying vibration).
+the mesh-force ripples and bearing accelerations RMS their block values (a decaying vibration).
 Its final value is the mean of the last ``settle_final_blocks`` blocks, and must differ from
 the mean of the blocks just before by at most the tolerance (else the run has not settled). The
 run has settled at the start of the first block after which every later block of every settling
@@ -71,12 +70,13 @@ DYNAMIC_INDICATORS: dict[str, str] = {
 
 ALL_INDICATORS = {**STUDY_INDICATORS, **DYNAMIC_INDICATORS}
 
-SETTLING_SIGNALS = {"mean": ("input_speed", "output_speed", "outer_mesh_force", "inner_mesh_force",
-                             "transmission_error"),
+SETTLING_SIGNALS = {"mean": ("input_speed", "output_speed", "outer_mesh_force", "inner_mesh_force"),
                     "amplitude": ("outer_mesh_ripple", "inner_mesh_ripple", "input_bearing_rms",
                                   "output_bearing_rms")}
-"""Signals of the settling test: drifts (mean tolerance) and vibrations (amplitude tolerance); the
-transmission error only when the run records it."""
+"""Signals of the settling test: drifts (mean tolerance) and vibrations (amplitude tolerance). Not the
+loaded transmission error: it integrates the output-speed error, so the last 0.01 % of the speed's
+creep moves it by more than 0.05 % long after the speeds and forces have settled (impact law, quick
+runs: about 1 % over 0.1 s); it is screened over the window the other signals set."""
 
 
 def segment_slices(t: np.ndarray, start: float, end: float, count: int) -> list[slice]:
