@@ -114,7 +114,8 @@ def run_time_chart(ax: Axes, runs: pd.DataFrame) -> None:
         if np.isfinite(a):
             ax.annotate(fmt(a, 3), (xi + w / 2, a), ha="center", va="bottom", fontsize=7, xytext=(0, 2),
                         textcoords="offset points", color="#555555")
-    ax.set_yscale("log")
+    if np.any(np.isfinite(ours) & (ours > 0)) or np.any(np.isfinite(adams)):
+        ax.set_yscale("log")
     ax.set_xticks(x, names, rotation=30 if len(names) > 9 else 0, fontsize=8)
     ax.set_ylabel("wall time per simulated second [s/s] (log scale)")
     finite = np.concatenate([ours[np.isfinite(ours) & (ours > 0)], adams[np.isfinite(adams)]])
