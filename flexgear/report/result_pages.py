@@ -297,14 +297,21 @@ def sweep_pages(d: ReportData) -> list[Page]:
         return []
     sw = d.sweep
     table = sw.table.copy()
+    if sw.folder is not None:   # indicator means again from the runs, with the report's screening settings
+        from flexgear.study.sweep import indicator_means
+
+        fresh = pd.DataFrame([indicator_means(sw.folder / n, d.settings) for n in table["variant"]],
+                             index=table.index)
+        table[list(fresh.columns)] = fresh
     table["input_bearing_peak"] = [_peak(d, sw.folder, n, "input") for n in table["variant"]]
     table["output_bearing_peak"] = [_peak(d, sw.folder, n, "output") for n in table["variant"]]
     params = sw.parameters
     keep = ["variant", *params, "eps_beta", "status", "wall_time_s", "input_bearing_peak", "output_bearing_peak",
-            "input_bearing_rms", "outer_mesh_ripple", "dynamic_factor", "distance_pct"]
+            "input_bearing_rms", "outer_mesh_ripple", "dynamic_factor", "transmission_error"]
     names = {"wall_time_s": "wall [s]", "input_bearing_peak": "input bearing peak [m/s²]",
              "output_bearing_peak": "output bearing peak [m/s²]", "input_bearing_rms": "input bearing RMS [m/s²]",
-             "outer_mesh_ripple": "outer ripple [%]", "dynamic_factor": "K_v", "distance_pct": "distance [%]"}
+             "outer_mesh_ripple": "outer ripple [%]", "dynamic_factor": "K_v",
+             "transmission_error": "loaded TE [m]"}
     shown = table[[c for c in keep if c in table.columns]].rename(columns=lambda c: names.get(c, c.split(".")[-1]))
     from flexgear.study.sweep import SweepResult
 

@@ -34,7 +34,8 @@ from flexgear.cache import atomic_write_bytes
 from flexgear.spec import COMPONENTS, SpecError, load_variant
 from flexgear.study.matrix import run_matrix, write_table
 
-__all__ = ["SweepPlan", "SweepResult", "load_sweep", "sweep_points", "write_variants", "run_sweep", "toml_text"]
+__all__ = ["SweepPlan", "SweepResult", "load_sweep", "sweep_points", "write_variants", "run_sweep", "toml_text",
+           "indicator_means"]
 
 _VARIANT_FIELDS = ("mesh_level", "rigid_mass_properties")
 
@@ -185,7 +186,7 @@ def _eps_beta(path: Path) -> float:
     return float(geo.sun_planet.overlap_ratio(geo.helix_face_width))
 
 
-def _indicator_means(run_dir: Path, settings) -> dict[str, float]:
+def indicator_means(run_dir: Path, settings) -> dict[str, float]:
     """Every indicator's mean over the run's settled window (flexgear.study.indicators); {} if it failed."""
     from flexgear.results import load_result
     from flexgear.study.screening import indicator_samples
@@ -210,7 +211,7 @@ def run_sweep(plan: SweepPlan, out_dir: str | Path, t_end_s: float | None = None
     matrix = run_matrix(paths, out_dir, t_end_s=t_end_s, workers=workers, scheduler=scheduler, progress=progress,
                         runner=runner, reference=reference)
     settings = load_variant(paths[0]).gearbox.screening
-    means = pd.DataFrame([_indicator_means(out_dir / row["variant"], settings) for row in rows],
+    means = pd.DataFrame([indicator_means(out_dir / row["variant"], settings) for row in rows],
                          index=[row["variant"] for row in rows])
     table = (pd.DataFrame(rows)
              .merge(matrix[["variant", "status", "reason", "wall_time_s", "t_end_s", "bias_pct", "cv_pct",
