@@ -38,7 +38,6 @@ _LAZY = {
     "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts",
     "Carrier": "mbs.carrier", "add_planet_bearing": "mbs.carrier",
     "GearTrain": "mbs.train", "add_gear_train": "mbs.train",
-    "LoadCircle": "fe.attachment", "static_compliance": "fe.compliance",
     # signals and solving
     "Recorder": "mbs.recording", "solve": "mbs.recording", "solver_settings": "mbs.recording",
     # the study's gearbox

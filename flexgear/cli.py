@@ -1,4 +1,4 @@
-"""Command line: flexgear run | matrix | lpm | compare | report | meshes.
+"""Command line: flexgear run | matrix | sweep | lpm | compare | report | animate | meshes.
 
 Each subcommand is a pair of functions, ``_args_<name>(parser)`` (its arguments, each with help text) and
 ``cmd_<name>(args) -> exit code`` (a thin wrapper over one library function), listed in ``SUBCOMMANDS``;
@@ -28,6 +28,9 @@ def _args_run(p: argparse.ArgumentParser) -> None:
     p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP)
     p.add_argument("--time-budget", type=float, default=None, metavar="S",
                    help="wall-time budget in s (default: [solver_assumed] wall_time_budget_s)")
+    p.add_argument("--states", type=int, default=0, metavar="N",
+                   help="also record the bodies' states (frames, modal coordinates) every N steps, for "
+                        "`flexgear animate` (default: 0, none)")
 
 
 def cmd_run(a: argparse.Namespace) -> int:
@@ -40,7 +43,8 @@ def cmd_run(a: argparse.Namespace) -> int:
     warning = ramp_warning(variant, variant.gearbox.load_case.end_time_s if a.t_end is None else a.t_end)
     if warning:
         say(f"warning: {variant.name}: {warning}")
-    result = run_variant(variant, t_end_s=a.t_end, progress=True, time_budget_s=a.time_budget)
+    result = run_variant(variant, t_end_s=a.t_end, progress=True, time_budget_s=a.time_budget,
+                         record_states_every=a.states)
     result.meta.update(input_hash=task.input_hash, variant_file=task.variant_file)
     out = Path(a.out) / variant.name
     save_task_result(task, result, out)
@@ -63,15 +67,42 @@ def _args_matrix(p: argparse.ArgumentParser) -> None:
                         "files' content and send the results back")
     p.add_argument("--time-budget", type=float, default=None, metavar="S",
                    help="wall-time budget per run in s (default: [solver_assumed] wall_time_budget_s)")
+    p.add_argument("--reference", default=None, metavar="NAME",
+                   help="screen against this variant (dynamic indicators, Bias against its values) instead of "
+                        "theory (default: [screening] reference of the gearbox file)")
 
 
 def cmd_matrix(a: argparse.Namespace) -> int:
     from flexgear.study.matrix import run_matrix
 
     table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end, workers=a.workers,
-                       scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget)
+                       scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget, reference=a.reference)
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    return 0
+
+
+# --------------------------------------------------------------------------- sweep
+def _args_sweep(p: argparse.ArgumentParser) -> None:
+    p.add_argument("sweep", help="sweep file (TOML; see flexgear.study.sweep)")
+    p.add_argument("--out", default=None, metavar="DIR", help="results folder (default: results/sweep_<name>)")
+    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--workers", type=int, default=2, metavar="N", help="local worker processes (default: %(default)s)")
+    p.add_argument("--scheduler", default=None, metavar="ADDR", help="Dask scheduler address (default: local)")
+    p.add_argument("--all-combinations", action="store_true",
+                   help="run every base variant in all 2^5 rigid/flexible forms")
+    p.add_argument("--reference", default=None, metavar="NAME", help="screen against this variant")
+
+
+def cmd_sweep(a: argparse.Namespace) -> int:
+    from flexgear.study.sweep import load_sweep, run_sweep
+
+    plan = load_sweep(a.sweep, all_combinations=True if a.all_combinations else None)
+    out = Path(a.out) if a.out else Path("results") / f"sweep_{plan.name}"
+    table = run_sweep(plan, out, t_end_s=a.t_end, workers=a.workers, scheduler=a.scheduler, reference=a.reference)
+    wanted = ["variant", *plan.parameters, "eps_beta", "status", "wall_time_s", "distance_pct", "zone"]
+    print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    print(f"sweep table -> {out / 'sweep.csv'}; report: flexgear report {out}")
     return 0
 
 
@@ -177,6 +208,21 @@ def cmd_report(a: argparse.Namespace) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- animate
+def _args_animate(p: argparse.ArgumentParser) -> None:
+    p.add_argument("run_dir", help="a run folder whose run recorded states (flexgear run ... --states N)")
+    p.add_argument("--out", default=None, metavar="DIR", help="output folder (default: RUN_DIR/animation)")
+    p.add_argument("--scale", type=float, default=1.0, help="factor on the elastic deformation (default: 1)")
+
+
+def cmd_animate(a: argparse.Namespace) -> int:
+    from flexgear.report.animate import write_animation
+
+    path = write_animation(Path(a.run_dir), a.out, scale=a.scale)
+    print(f"animation -> {path} (open in ParaView)")
+    return 0
+
+
 # --------------------------------------------------------------------------- meshes
 def _args_meshes(p: argparse.ArgumentParser) -> None:
     p.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml",
@@ -214,10 +260,12 @@ def cmd_meshes(a: argparse.Namespace) -> int:
 SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = [
     ("run", "run one variant file with the Exudyn backend", _args_run, cmd_run),
     ("matrix", "run a matrix of variant files (resumable) and screen them", _args_matrix, cmd_matrix),
+    ("sweep", "run a parameter sweep file (grid over gearbox fields x variants)", _args_sweep, cmd_sweep),
     ("lpm", "run the lumped-parameter model of a gearbox (or variant) file", _args_lpm, cmd_lpm),
     ("compare", "Tables 6 and 7 of two runs, or of the common runs of two results folders", _args_compare,
      cmd_compare),
     ("report", "PDF screening report from saved results", _args_report, cmd_report),
+    ("animate", "VTK time series (.pvd + .vtu) of the deformed bodies of a run", _args_animate, cmd_animate),
     ("meshes", "build (or load from the cache) the component meshes and reduced bodies", _args_meshes, cmd_meshes),
 ]
 

@@ -17,11 +17,23 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from flexgear.cache import atomic_write_bytes
 
-__all__ = ["RunResult", "signal_columns", "save_result", "load_result"]
+__all__ = ["RunResult", "SIGNAL_TYPES", "signal_columns", "save_result", "load_result", "envelope"]
+
+SIGNAL_TYPES: dict[str, tuple[str, str]] = {
+    "input_speed": ("input speed", "speed [°/s]"),
+    "output_speed": ("output speed", "speed [°/s]"),
+    "outer_mesh_force": ("outer (sun-planet) mesh force, mean of the planets", "normal force [N]"),
+    "inner_mesh_force": ("inner (planet-ring) mesh force, mean of the planets", "normal force [N]"),
+    "input_bearing_accel": ("input-shaft bearing, radial acceleration √(a_x² + a_y²)", "acceleration [m/s²]"),
+    "output_bearing_accel": ("output-shaft bearing, radial acceleration √(a_x² + a_y²)", "acceleration [m/s²]"),
+    "transmission_error": ("transmission error", "TE [µm]"),
+}
+"""Signal types a run can plot (:meth:`RunResult.plot`): key -> (title, axis label with unit)."""
 
 
 def signal_columns(planet_count: int) -> list[str]:
@@ -68,7 +80,58 @@ class RunResult:
     def name(self) -> str:
         return str(self.meta.get("variant", "?"))
 
+    def has(self, kind: str) -> bool:
+        """Whether the run recorded signal type ``kind`` (:data:`SIGNAL_TYPES`)."""
+        if self.signals is None:
+            return False
+        return kind != "transmission_error" or "transmission_error_m" in self.signals.columns
 
+    def signal(self, kind: str) -> np.ndarray:
+        """One signal type over ``time_s`` in its plotting unit (:data:`SIGNAL_TYPES`)."""
+        s = self.signals
+        if s is None:
+            raise ValueError(f"run {self.name!r} has no signals")
+        if kind in ("input_speed", "output_speed"):
+            return s[f"{kind}_deg_per_s"].to_numpy()
+        if kind in ("outer_mesh_force", "inner_mesh_force"):
+            mesh = kind.split("_")[0]
+            return s[[c for c in s.columns if c.startswith(f"{mesh}_mesh_force_")]].to_numpy().mean(axis=1)
+        if kind in ("input_bearing_accel", "output_bearing_accel"):
+            side = kind.split("_")[0]
+            return np.hypot(s[f"{side}_bearing_accel_x_m_per_s2"], s[f"{side}_bearing_accel_y_m_per_s2"]).to_numpy()
+        if kind == "transmission_error":
+            return s["transmission_error_m"].to_numpy() * 1e6
+        raise ValueError(f"unknown signal type {kind!r}; allowed: {', '.join(SIGNAL_TYPES)}")
+
+    def plot(self, ax, kind: str, zoom: tuple[float, float] | None = None, label: str | None = None,
+             **style) -> None:
+        """Draw signal type ``kind`` into matplotlib axes ``ax`` (min/max envelope of long signals),
+        optionally only the time span ``zoom`` [s]; ``style``: matplotlib line properties."""
+        t = self.signals["time_s"].to_numpy()
+        y = self.signal(kind)
+        if zoom is not None:
+            keep = (t >= zoom[0]) & (t <= zoom[1])
+            t, y = t[keep], y[keep]
+        tt, yy = envelope(t, y)
+        ax.plot(tt, yy, label=self.name if label is None else label, **{"lw": 0.8, **style})
+
+
+
+
+def envelope(t: np.ndarray, y: np.ndarray, bins: int = 1500) -> tuple[np.ndarray, np.ndarray]:
+    """Min/max envelope of a long signal for plotting (keeps the ripple's amplitude visible, drops points)."""
+    n = len(t)
+    if n <= 2 * bins:
+        return t, y
+    size = n // bins
+    m = size * bins
+    tb, yb = t[:m].reshape(bins, size), y[:m].reshape(bins, size)
+    lo, hi = yb.argmin(axis=1), yb.argmax(axis=1)
+    first, second = np.minimum(lo, hi), np.maximum(lo, hi)
+    rows = np.arange(bins)
+    tt = np.column_stack([tb[rows, first], tb[rows, second]]).ravel()
+    yy = np.column_stack([yb[rows, first], yb[rows, second]]).ravel()
+    return np.append(tt, t[m:]), np.append(yy, y[m:])
 
 
 def save_result(result: RunResult, run_dir: str | Path, inputs: dict[str, bytes] | None = None) -> Path:

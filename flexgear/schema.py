@@ -30,6 +30,8 @@ __all__ = [
     "MeshingSettings",
     "ReductionSettings",
     "IndicatorWeights",
+    "IndicatorTolerance",
+    "ReferenceIndicators",
     "ScreeningSettings",
     "LumpedAssumed",
     "GearboxSpec",
@@ -290,6 +292,35 @@ class IndicatorWeights:
 
 
 @dataclass(frozen=True)
+class IndicatorTolerance:
+    """Allowable total error TEa (%) and weight of one indicator in the reference screening."""
+
+    tea_pct: float = _num(0.0, 1000.0, lo_open=True)
+    weight: float = _num(0.0, 1.0)
+
+
+@dataclass(frozen=True)
+class ReferenceIndicators:
+    """TEa and weight of every indicator when variants are screened against a reference variant
+    (``[screening.reference_indicators]``; flexgear.study.indicators defines each indicator)."""
+
+    input_speed: IndicatorTolerance
+    output_speed: IndicatorTolerance
+    transmission_ratio: IndicatorTolerance
+    outer_mesh_force: IndicatorTolerance
+    inner_mesh_force: IndicatorTolerance
+    outer_mesh_ripple: IndicatorTolerance
+    inner_mesh_ripple: IndicatorTolerance
+    load_sharing: IndicatorTolerance
+    dynamic_factor: IndicatorTolerance
+    input_bearing_rms: IndicatorTolerance
+    output_bearing_rms: IndicatorTolerance
+    input_bearing_mesh1x: IndicatorTolerance
+    output_bearing_mesh1x: IndicatorTolerance
+    transmission_error: IndicatorTolerance
+
+
+@dataclass(frozen=True)
 class ScreeningSettings:
     """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
 
@@ -298,7 +329,7 @@ class ScreeningSettings:
 
     allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
     lines: str = _choice("westgard", "six_sigma")
-    window: str = _choice("after_ramps", "fixed")
+    window: str = _choice("settled", "after_ramps", "fixed")
     after_ramp_delay_s: float = _num(0.0)
     window_start_s: float = _num(0.0)
     window_end_s: float = _num(0.0, lo_open=True)
@@ -306,6 +337,14 @@ class ScreeningSettings:
     sample_count: int = _num(2, 10000, integer=True)
     selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
     weights: IndicatorWeights
+    reference_indicators: ReferenceIndicators
+    # settled window (flexgear.study.indicators.settled_start): blocks of whole mesh cycles, tolerances in %
+    settle_block_mesh_cycles: int = _num(1, 100000, integer=True)
+    settle_final_blocks: int = _num(1, 1000, integer=True)
+    settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
+    settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
+    # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
+    reference: str = _text(default="")
 
 
 @dataclass(frozen=True)

@@ -35,12 +35,14 @@ from flexgear.schema import (
     GearboxSpec,
     GearSet,
     GearSetAssumed,
+    IndicatorTolerance,
     IndicatorWeights,
     LoadCase,
     LumpedAssumed,
     Material,
     MeshingSettings,
     ReductionSettings,
+    ReferenceIndicators,
     ScreeningSettings,
     SolverSettings,
     SpecError,
@@ -64,6 +66,8 @@ __all__ = [
     "MeshingSettings",
     "ReductionSettings",
     "IndicatorWeights",
+    "IndicatorTolerance",
+    "ReferenceIndicators",
     "ScreeningSettings",
     "LumpedAssumed",
     "GearboxSpec",
@@ -205,6 +209,9 @@ def _check_consistency(spec: GearboxSpec) -> None:
     weights = dataclasses.astuple(spec.screening.weights)
     if abs(sum(weights) - 1.0) > 1e-9:
         raise SpecError(p, "screening.weights", "expected weights that sum to 1", sum(weights))
+    ref_weights = [w for _, w in dataclasses.astuple(spec.screening.reference_indicators)]
+    if abs(sum(ref_weights) - 1.0) > 1e-9:
+        raise SpecError(p, "screening.reference_indicators", "expected weights that sum to 1", sum(ref_weights))
     if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
         raise SpecError(p, "screening.window_end_s", "expected a value > window_start_s",
                         spec.screening.window_end_s)

@@ -122,3 +122,11 @@ def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -
     res.meta.update(components=dict(variant.components), t_end_s=t_end_s, worker_cwd=os.getcwd(),
                     worker_cache=os.environ.get("FLEXGEAR_CACHE_DIR", ""))
     return res
+
+
+def slow_runner(variant, t_end_s: float | None = None, progress: bool = False) -> RunResult:
+    """:func:`fake_runner` that takes 1.5 s per run (time to kill a sweep between two runs)."""
+    import time
+
+    time.sleep(1.5)
+    return fake_runner(variant, t_end_s, progress)

@@ -112,4 +112,5 @@ def test_quick_variants_match_table3():
     for n in range(1, 8):
         quick = load_variant(VARIANTS / "quick" / f"model{n}.toml")
         full = load_variant(VARIANTS / f"model{n}.toml")
-        assert quick.components == full.components and quick.gearbox.load_case.end_time_s <= 0.1
+        # quick: 0.2 s, long enough after its 0.02 s ramps for a settled window (flexgear.study.indicators)
+        assert quick.components == full.components and quick.gearbox.load_case.end_time_s <= 0.2

@@ -256,20 +256,6 @@ def helix_halves(layout: str, helix_face_width: float, half_gap: float, hand: in
     raise ValueError(f"helix_layout must be 'single' or 'double', got {layout!r}")
 
 
-def tooth_normal_local(mesh: GearMesh, drive_sign: float, hand: int) -> tuple[float, float, float]:
-    """Tooth normal (force on gear 2) at the pitch point in gear 1's local (radial, tangential, axial) frame.
-
-    n = cos(beta_b) t - h s sin(beta_b) e_z with t = sin(alpha_wt) e_r + s cos(alpha_wt) e_t: the normal
-    of flexgear.mbs.contacts.pair_contacts (s: ``drive_sign``, h: ``hand`` of gear 1 in the helix half). An
-    internal gear 2 has the same local components; an external gear 2 (e_r, e_t reversed)
-    (-n_r, -n_t, n_z).
-    """
-    s = 1.0 if drive_sign >= 0 else -1.0
-    alpha, beta_b = mesh.operating_pressure_angle, mesh.gear1.base_helix_angle
-    return (math.cos(beta_b) * math.sin(alpha), s * math.cos(beta_b) * math.cos(alpha),
-            -hand * s * math.sin(beta_b))
-
-
 @dataclass(frozen=True)
 class GearSetGeometry:
     """Sun, planet, ring and the two meshes of a single-stage planetary/star set."""

@@ -24,6 +24,7 @@ import pandas as pd
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
+from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import Variant, as_dict, spec_hash
@@ -187,11 +188,13 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
 
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
                 mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
-                time_budget_s: float | None = None) -> RunResult:
+                time_budget_s: float | None = None, record_states_every: int = 0) -> RunResult:
     """Run ``variant`` for ``t_end_s`` (default: the load case's end time).
 
-    ``time_budget_s`` overrides ``[solver_assumed] wall_time_budget_s``. Never raises for a model or
-    solver failure: the result then has status "failed" and the reason (see :class:`RunGuard`).
+    ``time_budget_s`` overrides ``[solver_assumed] wall_time_budget_s``. ``record_states_every`` > 0 also
+    records the bodies' states every that many steps (extra table ``states``, flexgear.mbs.states; for
+    ``flexgear animate``). Never raises for a model or solver failure: the result then has status
+    "failed" and the reason (see :class:`RunGuard`).
     """
     import exudyn as exu
 
@@ -199,6 +202,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
     meta = _meta(variant, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
+    extra: dict[str, pd.DataFrame] = {}
     try:
         if not (t_end > 0 and math.isfinite(t_end)):
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
@@ -206,6 +210,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         mbs = sc.AddSystem()
         model = build_star_gearbox(mbs, variant, mass_source, reduced_source)
         sensors = add_gearbox_sensors(mbs, model)
+        states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
         guard = RunGuard(model, variant, t_end, budget - build_s, progress)
@@ -219,10 +224,13 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
             meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
             raise FloatingPointError("diverged: non-finite signals")
+        if states:
+            extra["states"] = state_table(mbs, states, record_states_every)
+            meta.update(state_bodies=state_bodies(model), record_states_every=record_states_every)
         meta.update(status="ok", reason="", build_time_s=build_s, warning=ramp_warning(variant, t_end))
     except Exception as exc:  # recorded, not raised: a failed variant must not stop a matrix
         signals = None
         meta.update(status="failed", reason=f"{type(exc).__name__}: {exc}",
                     traceback=traceback.format_exc(limit=5))
     meta.update(wall_time_s=time.perf_counter() - wall0, cpu_time_s=time.process_time() - cpu0)
-    return RunResult(meta, signals)
+    return RunResult(meta, signals, extra)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import json
 import tomllib
 from dataclasses import dataclass
 from pathlib import Path
@@ -11,7 +12,8 @@ import pandas as pd
 from flexgear.report.figures import fmt
 from flexgear.results import RunResult, load_result
 from flexgear.spec import GearboxSpec, ScreeningSettings, SpecError, load_gearbox
-from flexgear.study.screening import DecisionLines, Selection, Window, analysis_window, screening_tables
+from flexgear.study.screening import DecisionLines, Screening, Selection, Window, analysis_window, screen
+from flexgear.study.sweep import SweepResult
 
 DEFAULT_GEARBOX = Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml"
 
@@ -27,17 +29,34 @@ class ReportData:
     gearbox_file: Path
     gearbox_note: str
     settings: ScreeningSettings
-    screening: pd.DataFrame
-    indicators: pd.DataFrame
-    selection: Selection
+    study: Screening                    # the study's mode: Bias against theory
+    reference: Screening | None         # against a reference variant, if one was used or configured
+    sweep: SweepResult | None = None
+
+    @property
+    def primary(self) -> Screening:
+        """The screening the selection is taken from: the reference screening if there is one."""
+        return self.reference if self.reference is not None else self.study
+
+    @property
+    def screening(self) -> pd.DataFrame:
+        return self.primary.table
+
+    @property
+    def indicators(self) -> pd.DataFrame:
+        return self.primary.indicators
+
+    @property
+    def selection(self) -> Selection:
+        return self.primary.selection
 
     @property
     def lines(self) -> DecisionLines:
-        return DecisionLines.from_settings(self.settings)
+        return self.primary.lines
 
     def window(self, result: RunResult) -> Window:
         t = result.signals["time_s"].to_numpy()
-        return analysis_window(result.meta, float(t[0]), float(t[-1]), self.settings)
+        return analysis_window(result.meta, float(t[0]), float(t[-1]), self.settings, result.signals)
 
 
 def _natural(name: str) -> tuple:
@@ -69,9 +88,13 @@ def gather(results_dir: str | Path) -> ReportData:
         gearbox_file, note = DEFAULT_GEARBOX, f"saved gearbox file is not valid now ({exc}); package default used"
         gearbox = load_gearbox(gearbox_file)
     settings = gearbox.screening
-    screening, indicators, selection = screening_tables(runs.values(), settings)
-    return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, screening, indicators,
-                      selection)
+    recorded = results_dir / "screening.json"
+    ref_name = json.loads(recorded.read_text()).get("reference", "") if recorded.exists() else settings.reference
+    study = screen(runs.values(), settings, reference="")
+    reference = screen(runs.values(), settings, reference=ref_name) if ref_name and ref_name in runs else None
+    sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
+    sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)
+    return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep)
 
 
 def _split_comment(line: str) -> tuple[str, str]:

@@ -2,18 +2,20 @@
 
 The report reads every run directory under ``results_dir`` (``run.json`` + ``signals.parquet``,
 see :mod:`flexgear.results`): Exudyn variants are screened (:mod:`flexgear.study.screening`) with the
-``[screening]`` settings of the gearbox file saved beside the runs (``<run>/inputs/``); a run of
-the lumped-parameter backend (e.g. ``results/lumped``) joins the time histories, spectra and
-Tables 6 and 7. Pages, in order: title and selection, gearbox data (study), assumptions,
-variant matrix (Table 3 as run), run times against the study's ADAMS times (Table 4), Westgard
-decision diagram, screening tables, per run time histories and bearing spectra, Tables 6 and 7,
-provenance (versions, configuration hashes, dates).
+``[screening]`` settings of the gearbox file saved beside the runs (``<run>/inputs/``), in the study's
+mode and, when the matrix used one (``screening.json``) or the gearbox names one, against a reference
+variant; a run of the lumped-parameter backend (e.g. ``results/lumped``) joins the overlays, spectra
+and Tables 6 and 7; a sweep (``sweep.json``) adds its table and sensitivity figures. Pages, in order:
+title (selection, load case), gearbox data (study), assumptions, variant matrix (Table 3 as run), run
+time per simulated second against the study's ADAMS times (Table 4), Westgard decision diagrams,
+screening tables, one page per signal type with all variants overlaid, bearing spectra, Tables 6 and
+7, sweep pages, provenance. This module lays pages out; the figures are drawn by the objects'
+``plot(ax)`` (:mod:`flexgear.report.result_pages`).
 """
 
 from __future__ import annotations
 
 import datetime as _dt
-import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -21,90 +23,62 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.patches import Patch  # noqa: E402
 
+from flexgear.report import result_pages as rp  # noqa: E402
 from flexgear.report.data import ReportData, documented_assumptions, gather  # noqa: E402
-from flexgear.report.figures import decision_diagram, draw_table, fmt, history_panel, run_time_chart, spectrum_panel  # noqa: E402
-from flexgear.results import RunResult  # noqa: E402
+from flexgear.report.figures import draw_table, fmt  # noqa: E402
+from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
 from flexgear.spec import COMPONENTS  # noqa: E402
-from flexgear.study.reference import ADAMS_TIME_S, STUDY_TABLE6, STUDY_TABLE7  # noqa: E402
-from flexgear.study.screening import INDICATORS  # noqa: E402
 
 __all__ = ["ReportData", "gather", "documented_assumptions", "build_report"]
 
 A4_LANDSCAPE_IN = (11.69, 8.27)
-_TABLE_LINES_PER_PAGE = 34
 
 
-
-
-
-
-
-
-
-
-# --------------------------------------------------------------------------- assumptions
-
-
-
-
-# --------------------------------------------------------------------------- pages
-Page = tuple[str, Callable[[Figure], None]]
-
-
-def _paginate(df: pd.DataFrame, wrap: dict[str, int], lines_per_page: int = _TABLE_LINES_PER_PAGE
-              ) -> list[pd.DataFrame]:
-    """Split a table into page-sized parts by the wrapped text lines of its rows."""
-    parts, start, used = [], 0, 0
-    for i, row in enumerate(df.itertuples(index=False)):
-        n = max(len(textwrap.wrap(fmt(v), wrap.get(c, 30))) or 1 for c, v in zip(df.columns, row, strict=True))
-        if used + n > lines_per_page and i > start:
-            parts.append(df.iloc[start:i])
-            start, used = i, 0
-        used += n
-    parts.append(df.iloc[start:])
-    return parts
-
-
-def _text_block(ax, text: str, width: int = 120, fontsize: float = 9, top: float = 1.0) -> None:
-    ax.axis("off")
-    wrapped = "\n".join(textwrap.fill(p, width) if p else "" for p in text.split("\n"))
-    ax.text(0.0, top, wrapped, va="top", ha="left", fontsize=fontsize, family="DejaVu Sans", transform=ax.transAxes)
-
-
-def _components_text(meta: dict) -> str:
-    comps = meta.get("components") or {}
-    flex = [c for c in COMPONENTS if comps.get(c) == "flexible"]
-    return "all rigid" if comps and not flex else ("flexible: " + ", ".join(flex) if flex else "–")
+def _load_case_text(d: ReportData) -> list[str]:
+    """The load case as run (per distinct case), beside the study's Table 5."""
+    lc = d.gearbox.load_case
+    cases: dict[tuple, list[str]] = {}
+    for n, r in d.runs.items():
+        spec_lc = (r.meta.get("spec") or {}).get("load_case") or {}
+        key = (spec_lc.get("input_speed_rpm", lc.input_speed_rpm), spec_lc.get("load_torque_nm", lc.load_torque_nm),
+               r.meta.get("ramp_time_s"), r.meta.get("t_end_s"), r.meta.get("step_size_s"))
+        cases.setdefault(key, []).append(n)
+    lines = [f"Load case as run: input {fmt(k[0])} rpm, load torque {fmt(k[1], 6)} N·m, STEP ramps over {fmt(k[2])} s, "
+             f"{fmt(k[3])} s simulated, step {fmt(k[4])} s ({', '.join(v)})" for k, v in cases.items()]
+    lines.append(f"Study, Table 5: input {fmt(lc.input_speed_rpm)} rpm, {fmt(lc.load_torque_nm, 6)} N·m, ramps over "
+                 f"{rp.STUDY_RAMP_S:g} s, {rp.STUDY_END_S:g} s simulated, step 1e-05 s.")
+    return lines
 
 
 def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) -> Callable[[Figure], None]:
     def draw(fig: Figure) -> None:
-        ax = fig.add_axes([0.06, 0.08, 0.88, 0.8])
+        ax = fig.add_axes([0.06, 0.05, 0.88, 0.85])
         ok = sum(r.ok for r in d.runs.values())
-        steady = d.screening.get("steady_window")
-        unsteady = [] if steady is None else list(d.screening.loc[steady == False, "variant"])  # noqa: E712
+        steady = d.study.table.get("steady_window")
+        unsteady = [] if steady is None else list(d.study.table.loc[steady == False, "variant"])  # noqa: E712
+        ref = d.reference
         lines = [f"Gearbox: {d.gearbox.title}",
                  f"Results: {d.results_dir.resolve()}  ({ok} of {len(d.runs)} variants finished"
                  + (", lumped-parameter run present)" if d.lumped is not None else ", no lumped-parameter run)"),
-                 f"Created: {created}",
-                 "",
-                 f"Selected model: {d.selection.variant or 'none'}",
-                 d.selection.reasoning,
-                 f"Screening: TEa = {d.settings.allowable_total_error_pct:g} %, lines "
-                 f"m = {', '.join(map(str, d.lines.multipliers))}, {d.settings.sample_count} samples per window, "
-                 f"weights 20 % per indicator unless configured otherwise, rule '{d.settings.selection}'."]
+                 f"Created: {created}", "", *_load_case_text(d), "",
+                 f"Selected model: {d.selection.variant or 'none'}"
+                 + (f" (screened against the reference {ref.reference})" if ref is not None else
+                    " (the study's mode: against theory)"),
+                 d.selection.reasoning]
+        if ref is not None:
+            lines += [f"In the study's mode (against theory, TEa = {d.settings.allowable_total_error_pct:g} %): "
+                      f"{d.study.selection.variant or 'none'}. {d.study.selection.reasoning}"]
+        lines += [f"Screening: lines m = {', '.join(map(str, d.lines.multipliers))}, {d.settings.sample_count} "
+                  f"samples per window, window '{d.settings.window}', rule '{d.settings.selection}'."]
         if unsteady:
-            lines += ["", "CAUTION: these runs end before the load ramps do (quick runs): " + ", ".join(unsteady)
-                      + ". Their windows are not steady, so their Bias and CV measure the ramp, not the model's "
-                      "accuracy."]
+            lines += ["", "CAUTION: these runs have no settled window (they end before their transients decay): "
+                      + ", ".join(unsteady) + ". Their Bias and CV measure the start-up, not the model's accuracy."]
         lines += ["", "Contents"] + [f"  page {p:>2}   {t}" for p, t in contents]
-        _text_block(ax, "\n".join(lines), width=125, fontsize=9.5)
+        text_block(ax, "\n".join(lines), width=150, fontsize=8.5)
     return draw
 
 
@@ -155,24 +129,6 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
     return draw
 
 
-def _table_pages(title: str, df: pd.DataFrame, wrap: dict[str, int], widths: list[float] | None,
-                 intro: str = "", fontsize: float = 8) -> list[Page]:
-    parts = _paginate(df, wrap, _TABLE_LINES_PER_PAGE - (4 if intro else 0))
-    pages = []
-    for k, part in enumerate(parts):
-        label = title if len(parts) == 1 else f"{title} ({k + 1}/{len(parts)})"
-
-        def draw(fig: Figure, part: pd.DataFrame = part, first: bool = k == 0) -> None:
-            ax = fig.add_axes([0.04, 0.07, 0.92, 0.83])
-            top = 1.0
-            if intro and first:
-                _text_block(ax, intro, width=160, fontsize=8.5)
-                top = 0.9
-            draw_table(ax, part, col_widths=widths, wrap=wrap, top=top, fontsize=fontsize)
-        pages.append((label, draw))
-    return pages
-
-
 def _variant_table(d: ReportData) -> pd.DataFrame:
     rows = []
     for name, r in d.runs.items():
@@ -181,149 +137,6 @@ def _variant_table(d: ReportData) -> pd.DataFrame:
                      "status": r.meta.get("status"), "simulated time [s]": r.meta.get("t_end_s"),
                      "reason": r.meta.get("reason") or ""})
     return pd.DataFrame(rows)
-
-
-def _run_time_page(d: ReportData) -> Callable[[Figure], None]:
-    rows = []
-    for name, r in d.runs.items():
-        num = name[5:] if name.startswith("model") and name[5:].isdigit() else None
-        rows.append({"variant": name, "components": _components_text(r.meta), "status": r.meta.get("status"),
-                     "t_end_s": r.meta.get("t_end_s", np.nan), "wall_time_s": r.meta.get("wall_time_s", np.nan)
-                     if r.ok else np.nan, "cpu_time_s": r.meta.get("cpu_time_s", np.nan) if r.ok else np.nan,
-                     "total_wall_time_s": r.meta.get("total_wall_time_s", np.nan),
-                     "adams_s": ADAMS_TIME_S.get(int(num), np.nan) if num else np.nan})
-    runs = pd.DataFrame(rows)
-
-    def draw(fig: Figure) -> None:
-        ax = fig.add_axes([0.07, 0.43, 0.88, 0.46])
-        run_time_chart(ax, runs)
-        tab = fig.add_axes([0.04, 0.07, 0.92, 0.27])
-        shown = runs.rename(columns={"t_end_s": "simulated [s]", "wall_time_s": "wall [s]",
-                                     "cpu_time_s": "CPU [s]", "total_wall_time_s": "worker total wall [s]",
-                                     "adams_s": "study ADAMS, 0.6 s [s]"})
-        draw_table(tab, shown, wrap={"components": 34}, fontsize=7.5)
-        fig.text(0.04, 0.355, "wall/CPU: the runner's model build + simulation; worker total: + file loading and "
-                 "saving. The study's times (Table 4) are for 0.6 s simulated on its own computer.", fontsize=7.5)
-    return draw
-
-
-def _diagram_page(d: ReportData) -> Callable[[Figure], None]:
-    """Zones at the TEa scale; a second panel when the points lie far outside it or crowd the origin."""
-    ok = d.screening[d.screening["status"] == "ok"]
-    tea = d.lines.tea_pct
-    zones = (1.3 * tea, 0.65 * tea)
-    pts = (1.25 * float(ok["bias_pct"].max()), 1.25 * float(ok["cv_pct"].max())) if len(ok) else zones
-    beyond = pts[0] > zones[0] or pts[1] > zones[1]
-    crowded = len(ok) > 0 and pts[0] < 0.15 * zones[0] and pts[1] < 0.15 * zones[1]
-
-    def draw(fig: Figure) -> None:
-        listing = "Composite points (weighted indicators):\n" + "\n".join(
-            f"  {r.variant}: Bias {fmt(r.bias_pct, 3)} %, CV {fmt(r.cv_pct, 3)} %, sigma {fmt(r.sigma, 3)}, {r.zone}"
-            for r in ok.itertuples())
-        if beyond or crowded:
-            a1 = fig.add_axes([0.07, 0.2, 0.4, 0.68])
-            a2 = fig.add_axes([0.56, 0.2, 0.4, 0.68])
-            if beyond:
-                decision_diagram(a1, d.screening, d.lines, max(pts[0], zones[0]), max(pts[1], zones[1]),
-                                 title="all variants (those near the origin: see the zones on the right)")
-                decision_diagram(a2, d.screening, d.lines, *zones, title="zones at the scale of TEa")
-            else:
-                decision_diagram(a1, d.screening, d.lines, *zones, title="zones at the scale of TEa", labels=False)
-                decision_diagram(a2, d.screening, d.lines, max(pts[0], 1e-9), max(pts[1], 1e-9),
-                                 title="zoom on the variants' points (all in the best zone)")
-            txt = fig.add_axes([0.07, 0.04, 0.88, 0.08])
-        else:
-            decision_diagram(fig.add_axes([0.08, 0.2, 0.6, 0.68]), d.screening, d.lines, *zones)
-            txt = fig.add_axes([0.71, 0.2, 0.26, 0.68])
-        _text_block(txt, listing, width=150 if beyond or crowded else 44, fontsize=8)
-        fig.text(0.07, 0.125, "Axes as in the study (Bias on x, CV on y); Westgard's own charts put Bias on y and "
-                 "CV on x. Lines: Bias + m·CV = TEa; a point on a line belongs to the better zone.", fontsize=8)
-    return draw
-
-
-def _screening_pages(d: ReportData) -> list[Page]:
-    s = d.screening.astype({"time_s": object, "steady_window": object, "selected": object})
-    s.loc[s["status"] != "ok", ["time_s", "steady_window", "selected"]] = None
-    comp = s[["variant", "status", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "time_s",
-              "steady_window", "selected"]].rename(columns={
-                  "bias_pct": "Bias [%]", "cv_pct": "CV [%]", "distance_pct": "distance [%]", "time_s": "wall [s]",
-                  "steady_window": "steady window"})
-    ind = d.indicators
-    wide = pd.DataFrame({"variant": list(dict.fromkeys(ind["variant"]))})
-    for key, label in INDICATORS.items():
-        part = ind[ind["indicator"] == key].set_index("variant")
-        wide[f"{label}: Bias [%]"] = wide["variant"].map(part["bias_pct"])
-        wide[f"{label}: CV [%]"] = wide["variant"].map(part["cv_pct"])
-
-    def draw(fig: Figure) -> None:
-        ax = fig.add_axes([0.04, 0.07, 0.92, 0.83])
-        ax.text(0, 1.0, "Composite point per variant", fontsize=9, weight="bold", transform=ax.transAxes)
-        y = draw_table(ax, comp, top=0.97, fontsize=7.5, max_height=0.4)
-        ax.text(0, y - 0.04, "Per indicator (samples: segment means of the window, see flexgear.study.screening)",
-                fontsize=9, weight="bold", transform=ax.transAxes)
-        y = draw_table(ax, wide, top=y - 0.07, fontsize=7, wrap=13, max_height=0.4)
-        _text_block(ax, f"Selected model: {d.selection.variant or 'none'}.  {d.selection.reasoning}", width=170,
-                    fontsize=8.5, top=y - 0.04)
-    return [("Screening results and selection", draw)]
-
-
-def _history_pages(d: ReportData, label: str, r: RunResult) -> list[Page]:
-    s, th = r.signals, r.meta["theory"]
-    t = s["time_s"].to_numpy()
-    w = d.window(r)
-    detail = (max(w.end_s - 0.001, w.start_s), w.end_s)
-    n = int(r.meta.get("planet_count") or sum(c.startswith("outer_mesh_force_") for c in s.columns))
-
-    def forces(kind: str) -> dict[str, np.ndarray]:
-        cols = {f"planet {i}": s[f"{kind}_mesh_force_{i}_n"].to_numpy() for i in range(1, n + 1)}
-        return {**cols, "planet mean": np.mean(list(cols.values()), axis=0)}
-
-    def draw_kin(fig: Figure) -> None:
-        gs = fig.add_gridspec(3, 3, left=0.07, right=0.98, top=0.9, bottom=0.16, hspace=0.6, wspace=0.38)
-        history_panel(fig.add_subplot(gs[0, 0]), t, {"input": s["input_speed_deg_per_s"].to_numpy()},
-                      "speed [°/s]", "input speed", w, reference=("theory", th["input_speed_deg_per_s"]),
-                      legend="lower right")
-        history_panel(fig.add_subplot(gs[0, 1]), t, {"output": s["output_speed_deg_per_s"].to_numpy()},
-                      "speed [°/s]", "output speed", w, reference=("theory", th["output_speed_deg_per_s"]),
-                      legend="upper right")
-        history_panel(fig.add_subplot(gs[0, 2]), t, {"output": s["output_speed_deg_per_s"].to_numpy()},
-                      "speed [°/s]", "output speed, screening window", zoom=(w.start_s, w.end_s),
-                      reference=("theory", th["output_speed_deg_per_s"]), legend="")
-        for row, kind, name in ((1, "outer", "outer (sun-planet)"), (2, "inner", "inner (planet-ring)")):
-            f = forces(kind)
-            history_panel(fig.add_subplot(gs[row, 0]), t, f, "normal force [N]", f"{name} mesh force", w,
-                          reference=("theory", th["mesh_force_n"]), legend="")
-            history_panel(fig.add_subplot(gs[row, 1]), t, {"planet mean": f["planet mean"]}, "normal force [N]",
-                          f"{name}, planet mean, window", zoom=(w.start_s, w.end_s),
-                          reference=("theory", th["mesh_force_n"]), legend="")
-            ax = fig.add_subplot(gs[row, 2])
-            history_panel(ax, t, f, "normal force [N]", f"{name}, last {1e3 * (detail[1] - detail[0]):.3g} ms",
-                          zoom=detail, reference=("theory", th["mesh_force_n"]), legend="")
-        handles, names = ax.get_legend_handles_labels()
-        green = Patch(color="#2ca02c", alpha=0.12, label="screening window")
-        fig.legend([*handles, green], [*names, green.get_label()], loc="lower center", ncol=len(names) + 1,
-                   fontsize=8, frameon=False, bbox_to_anchor=(0.5, 0.06))
-        fig.text(0.07, 0.04, f"Screening window: {w.rule}. Mesh forces: normal force per planet (both helix "
-                 "halves); planet mean: their average at each step.", fontsize=7.5)
-
-    def draw_acc(fig: Figure) -> None:
-        gs = fig.add_gridspec(2, 2, left=0.07, right=0.98, top=0.9, bottom=0.12, hspace=0.45, wspace=0.2)
-        sel = (t >= w.start_s) & (t <= w.end_s)
-        for col, side in enumerate(("input", "output")):
-            acc = {a: s[f"{side}_bearing_accel_{a}_m_per_s2"].to_numpy() for a in ("x", "y")}
-            history_panel(fig.add_subplot(gs[0, col]), t,
-                          {"x component": acc["x"], "radial magnitude √(x²+y²)": np.hypot(acc["x"], acc["y"])},
-                          "acceleration [m/s²]", f"{side}-shaft bearing, radial acceleration", w,
-                          legend="upper left")
-            spectrum_panel(fig.add_subplot(gs[1, col]), t[sel], {k: v[sel] for k, v in acc.items()},
-                           th["mesh_frequency_hz"], f"{side}-shaft bearing spectrum (x, y), window "
-                           f"{w.start_s:.3g}–{w.end_s:.3g} s")
-        fig.text(0.07, 0.04, "Spectra: Hann window, amplitude-corrected one-sided spectrum of the mean-removed "
-                 "signal over the screening window (flexgear.study.compare); dashed red: 1, 2, 4, 6, 9 × mesh "
-                 "frequency.",
-                 fontsize=7.5)
-
-    return [(f"Time histories: {label}", draw_kin), (f"Bearing accelerations and spectra: {label}", draw_acc)]
 
 
 def _provenance_pages(d: ReportData) -> list[Page]:
@@ -342,7 +155,7 @@ def _provenance_pages(d: ReportData) -> list[Page]:
 
     def draw(fig: Figure) -> None:
         ax = fig.add_axes([0.04, 0.07, 0.92, 0.83])
-        _text_block(ax, intro, width=170, fontsize=8.5)
+        text_block(ax, intro, width=170, fontsize=8.5)
         ax.text(0, 0.93, "Runs", fontsize=9, weight="bold", transform=ax.transAxes)
         y = draw_table(ax, prov, top=0.9, fontsize=7.5, max_height=0.5)
         ax.text(0, y - 0.05, "Software versions recorded by the runs", fontsize=9, weight="bold",
@@ -353,65 +166,6 @@ def _provenance_pages(d: ReportData) -> list[Page]:
 
 
 
-def _tables_6_7_pages(d: ReportData) -> list[Page]:
-    """Tables 6 and 7: theory, our multibody (selected) and lumped runs (flexgear.study.compare), the study's."""
-    from flexgear.study.compare import compare_results
-
-    mbd = d.runs.get(d.selection.variant) if d.selection.variant else None
-    ours = [r for r in (mbd, d.lumped) if r is not None and r.ok]
-    notes = []
-    if not ours:
-        t6 = pd.DataFrame(index=pd.Index(list(STUDY_TABLE6), name="indicator"))
-        t7 = pd.DataFrame(index=pd.Index(list(STUDY_TABLE7), name="mesh_harmonic"))
-        notes.append("No finished run to compare: only the study's values are shown.")
-    else:
-        t6 = None
-        if len(ours) == 2:
-            try:
-                t6, t7 = compare_results(*ours)
-            except ValueError as exc:          # e.g. runs of different lengths share no window
-                notes.append(f"The lumped run is not compared ({exc}).")
-                ours = ours[:1]
-        if t6 is None:
-            t6, t7 = compare_results(ours[0], ours[0])
-        w = t6.attrs["window_s"]
-        keep = 1 + len(ours)                   # one run only: drop its duplicate column
-        t6 = t6.iloc[:, :keep]
-        t7 = t7.iloc[:, :2 * len(ours)]
-        t6.columns = ["theory"] + [r.name if r.name == r.meta.get("backend") else f"{r.name} ({r.meta.get('backend')})"
-                                   for r in ours]
-        t7.columns = [f"{r.name}: {side}" for r in ours for side in ("input", "output")]
-        notes.append(f"flexgear values over the window {w[0]:.4g}–{w[1]:.4g} s (flexgear.study.compare); Table 7: "
-                     "x component of the bearing acceleration, windowed DTFT at each harmonic.")
-        if d.lumped is None:
-            notes.append(f"No lumped-parameter run in {d.results_dir} (run `flexgear lpm ... --out "
-                         f"{d.results_dir}`), so the lumped column is the study's only.")
-    study6 = pd.DataFrame(STUDY_TABLE6, index=["study theory", "study ADAMS", "study lumped"]).T
-    t6 = t6.join(study6, how="outer").reindex(list(STUDY_TABLE6))
-    study7 = pd.DataFrame(STUDY_TABLE7, index=["study ADAMS: input", "study ADAMS: output", "study lumped: input",
-                                            "study lumped: output"]).T
-    t7 = t7.join(study7, how="outer")
-    labels = {"input_speed_deg_per_s": "input speed [°/s]", "output_speed_deg_per_s": "output speed [°/s]",
-              "outer_mesh_force_n": "outer mesh force, mean [N]", "inner_mesh_force_n": "inner mesh force, mean [N]",
-              "input_bearing_peak_accel_m_per_s2": "input bearing peak radial accel. [m/s²]",
-              "output_bearing_peak_accel_m_per_s2": "output bearing peak radial accel. [m/s²]"}
-    t6 = t6.rename(index=labels).reset_index(names="Table 6 (time domain)")
-    t7 = t7.reset_index(names="× mesh frequency")
-
-    def draw(fig: Figure) -> None:
-        ax = fig.add_axes([0.04, 0.07, 0.92, 0.83])
-        ax.text(0, 1.0, "Table 6: time-domain indicators", fontsize=9, weight="bold", transform=ax.transAxes)
-        shown = t6.astype(object)
-        for i, name in enumerate(shown.iloc[:, 0]):
-            digits = 4 if "accel" in name else 9
-            shown.iloc[i, 1:] = [fmt(v, digits) for v in shown.iloc[i, 1:]]
-        y = draw_table(ax, shown, top=0.97, fontsize=7.5, wrap=22)
-        ax.text(0, y - 0.05, "Table 7: bearing acceleration amplitude at multiples of the mesh frequency [m/s²]",
-                fontsize=9, weight="bold", transform=ax.transAxes)
-        y = draw_table(ax, t7, top=y - 0.08, fontsize=7.5, wrap=16)
-        _text_block(ax, " ".join(notes), width=170, fontsize=8, top=y - 0.04)
-    return [("Tables 6 and 7: theory, multibody, lumped-parameter model", draw)]
-
 
 def build_report(results_dir: str | Path, output: str | Path = Path("reports/screening_report.pdf")) -> Path:
     """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF)."""
@@ -420,19 +174,14 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
     created = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
     assumptions = documented_assumptions(d.gearbox_file)
     body: list[Page] = [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
-    body += _table_pages("Assumptions: every value the study does not give", assumptions,
-                         {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
-                         f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
-    body += _table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
-    body += [("Run times against the study's ADAMS times (Table 4)", _run_time_page(d)),
-             ("Westgard decision diagram (section 2.2, Fig. 2)", _diagram_page(d))]
-    body += _screening_pages(d)
-    shown = [(n, r) for n, r in d.runs.items() if r.ok]
-    if d.lumped is not None and d.lumped.ok:
-        shown.append(("lumped-parameter model", d.lumped))
-    for name, r in shown:
-        body += _history_pages(d, name + (" (selected)" if name == d.selection.variant else ""), r)
-    body += _tables_6_7_pages(d)
+    body += table_pages("Assumptions: every value the study does not give", assumptions,
+                        {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
+                        f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
+    body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
+    body += [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
+    if rp.shown_runs(d):
+        body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d)]
+    body += rp.sweep_pages(d)
     body += _provenance_pages(d)
     contents = [(i + 2, title) for i, (title, _) in enumerate(body)]
     pages: list[Page] = [("flexgear screening report", _title_page(d, contents, created)), *body]

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
@@ -30,6 +31,8 @@ __all__ = [
     "steady_window",
     "compare_results",
     "load_case_differences",
+    "BearingSpectrum",
+    "mark_harmonics",
 ]
 
 TABLE7_HARMONICS = (1, 2, 4, 6, 9)
@@ -187,3 +190,53 @@ def load_case_differences(a: RunResult, b: RunResult, rel: float = 1e-9) -> list
         if va is not None and vb is not None and not math.isclose(va, vb, rel_tol=rel):
             out.append(f"{label} {va:g} vs {vb:g}")
     return out
+HARMONIC_PROMINENCE = 10.0
+"""A harmonic k of the mesh frequency is "present" when its amplitude is this many times the median
+amplitude of the spectrum between (k - 1/2) and (k + 1/2) times the mesh frequency (20 dB)."""
+
+
+@dataclass(frozen=True)
+class BearingSpectrum:
+    """Amplitude spectrum of a bearing's x acceleration over a window (:func:`amplitude_spectrum`)."""
+
+    name: str
+    side: str
+    frequency_hz: np.ndarray
+    amplitude: np.ndarray
+    mesh_frequency_hz: float
+
+    @classmethod
+    def of(cls, result: RunResult, side: str, window: tuple[float, float], label: str | None = None
+           ) -> BearingSpectrum:
+        sel = _select(result, window)
+        dt = float(np.median(np.diff(sel["time_s"].to_numpy())))
+        f, a = amplitude_spectrum(_accel(sel, side, "x"), dt)
+        return cls(label or result.name, side, f, a, float(result.meta["theory"]["mesh_frequency_hz"]))
+
+    def present(self, max_harmonic: int = 10) -> list[int]:
+        """Harmonics k = 1..max_harmonic of the mesh frequency that stand out (HARMONIC_PROMINENCE)."""
+        out = []
+        for k in range(1, max_harmonic + 1):
+            band = np.abs(self.frequency_hz / self.mesh_frequency_hz - k) <= 0.5
+            near = np.abs(self.frequency_hz / self.mesh_frequency_hz - k) <= 0.02
+            if band.any() and near.any() and self.amplitude[near].max() > HARMONIC_PROMINENCE * np.median(
+                    self.amplitude[band]):
+                out.append(k)
+        return out
+
+    def plot(self, ax, max_harmonic: int = 10, **style) -> None:
+        """Log-amplitude spectrum up to max_harmonic + 1/2 times the mesh frequency, in kHz."""
+        keep = (self.frequency_hz > 0) & (self.frequency_hz <= (max_harmonic + 0.5) * self.mesh_frequency_hz)
+        ax.semilogy(self.frequency_hz[keep] / 1e3, self.amplitude[keep], label=self.name, **{"lw": 0.7, **style})
+
+
+def mark_harmonics(ax, mesh_frequency_hz: float, present: Sequence[int], study: Sequence[int] = TABLE7_HARMONICS
+                   ) -> None:
+    """Dashed markers at every harmonic in ``present`` and the study's (Table 7), the study's in red."""
+    top = ax.get_ylim()[1]
+    for k in sorted(set(present) | set(study)):
+        red = k in study
+        ax.axvline(k * mesh_frequency_hz / 1e3, color="#d62728" if red else "#555555", lw=0.8 if red else 0.6,
+                   ls="--", alpha=0.8)
+        ax.text(k * mesh_frequency_hz / 1e3, top, f"{k}×", color="#d62728" if red else "#555555", fontsize=7.5,
+                ha="center", va="bottom", weight="bold" if red else "normal")

@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import json
 import socket
 import sys
 import time
@@ -216,29 +217,42 @@ def _row(name: str, meta: dict, resumed: bool) -> dict[str, Any]:
 
 
 def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSettings,
-                     progress: bool = False) -> pd.DataFrame:
-    """Screen saved runs ``out_dir/<name>`` and write the screening tables and ``selection.txt``."""
+                     progress: bool = False, reference: str | None = None) -> pd.DataFrame:
+    """Screen saved runs ``out_dir/<name>`` and write the screening tables and ``selection.txt``;
+    ``reference``: a variant name to screen against (default ``settings.reference``)."""
     results = [load_result(out_dir / n) if (out_dir / n / "run.json").exists()
                else _failed(n, "no saved run") for n in names]
-    table, indicators, selection = screening_tables(results, settings)
+    table, indicators, selection = screening_tables(results, settings, reference)
     write_table(table, out_dir / "screening")
     write_table(indicators, out_dir / "screening_indicators")
-    text = f"selected: {selection.variant}\nrule: {selection.rule}\n{selection.reasoning}\n"
+    ref = settings.reference if reference is None else reference
+    atomic_write_bytes(out_dir / "screening.json", json.dumps({"reference": ref}).encode())
+    text = (f"selected: {selection.variant}\nrule: {selection.rule}\nreference: {ref or 'theory'}\n"
+            f"{selection.reasoning}\n")
     atomic_write_bytes(out_dir / "selection.txt", text.encode())
     _say(progress, f"selected {selection.variant}: {selection.reasoning}")
     return table
 
 
+def _check_reference(reference: str, names: Sequence[str]) -> None:
+    """A reference variant must be one of the matrix's variants (checked before any run)."""
+    if reference and reference not in names:
+        raise ValueError(f"screening reference {reference!r} is not one of the variants "
+                         f"({', '.join(names)}); allowed: one of them, or '' for the study's mode")
+
+
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
-               runner: Runner | None = None, time_budget_s: float | None = None) -> pd.DataFrame:
+               runner: Runner | None = None, time_budget_s: float | None = None,
+               reference: str | None = None) -> pd.DataFrame:
     """Run the variant files, save each run, screen them; return the results + screening table.
 
     ``runner(variant, t_end_s=..., progress=...) -> RunResult`` defaults to
     :func:`flexgear.mbs.run.run_variant`; it must be importable by the worker processes.
     ``scheduler`` is a Dask scheduler address (``tcp://host:8786``); None uses ``workers`` local
     processes. ``time_budget_s`` overrides each variant's ``[solver_assumed] wall_time_budget_s``.
-    See the module docstring for the files written and the resume rule.
+    ``reference``: screen against this variant (:func:`flexgear.study.screening.screen`; default the
+    gearbox's ``[screening] reference``). See the module docstring for the files written and the resume rule.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
@@ -276,11 +290,12 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
                 _say(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
                 continue
         tasks.append(task)
+    _check_reference(reference if reference is not None else (settings.reference if settings else ""), names)
     metas.update(_execute(tasks, workers, scheduler, runner, out_dir, progress))
     table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])
     write_table(table, out_dir / "matrix_results")
     if settings is None:
         settings = load_gearbox(Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml").screening
-    screening = screen_directory(out_dir, names, settings, progress)
+    screening = screen_directory(out_dir, names, settings, progress, reference)
     cols = ["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "selected"]
     return table.merge(screening[cols], on="variant", how="left")

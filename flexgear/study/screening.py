@@ -29,13 +29,21 @@ plane into zones. A point satisfies line m when Bias + m·CV <= TEa; a point exa
 belongs to the better zone (the line's criterion is met; a relative tolerance of 1e-12 absorbs
 round-off). The zone is the number of lines met: 0 = non-conforming ... The sigma metric is
 (TEa - Bias) / CV. The study draws Bias on x and CV on y; Westgard's charts swap the axes.
+
+Reference mode (``[screening] reference = "model7"`` or ``flexgear matrix --reference model7``): the
+five study indicators are fixed by kinematics and torque balance and cannot tell flexible from
+rigid variants apart, so the dynamic indicators of :mod:`flexgear.study.indicators` join them and
+every Bias is taken against the reference variant's mean (the reference has Bias 0 and sits on
+the CV axis). Each indicator i has its own TEa_i and weight w_i (``[screening.reference_indicators]``);
+the composite point is Bias_c = Σ w_i Bias_i / TEa_i · 100 and CV_c likewise, in % of the
+allowable error, judged against TEa = 100 %.
 """
 
 from __future__ import annotations
 
 import dataclasses
 import math
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 from dataclasses import dataclass
 
 import numpy as np
@@ -43,6 +51,8 @@ import pandas as pd
 
 from flexgear.results import RunResult
 from flexgear.spec import ScreeningSettings
+from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, segment_slices, settled_start
+from flexgear.study.selection import Selection, select_variant
 
 __all__ = [
     "INDICATORS",
@@ -56,19 +66,15 @@ __all__ = [
     "bias_pct",
     "cv_pct",
     "sigma_metric",
-    "indicator_signals",
+    "indicator_samples",
+    "Screening",
+    "screen",
     "screen_result",
     "screening_tables",
     "select_variant",
 ]
 
-INDICATORS: dict[str, str] = {
-    "input_speed": "input speed",
-    "output_speed": "output speed",
-    "transmission_ratio": "transmission ratio",
-    "outer_mesh_force": "outer (sun-planet) mesh force",
-    "inner_mesh_force": "inner (planet-ring) mesh force",
-}
+INDICATORS: dict[str, str] = STUDY_INDICATORS
 """The study's five indicators (section 2.2): key -> readable name."""
 
 _THEORY_KEYS = {
@@ -94,10 +100,17 @@ class DecisionLines:
 
     tea_pct: float
     multipliers: tuple[int, ...] = (2, 3, 4)
+    normalised: bool = False   # reference mode: Bias and CV in % of each indicator's own TEa, TEa = 100
 
     @classmethod
-    def from_settings(cls, settings: ScreeningSettings) -> DecisionLines:
+    def from_settings(cls, settings: ScreeningSettings, reference: str | None = None) -> DecisionLines:
+        if reference if reference is not None else settings.reference:
+            return cls(100.0, _LINE_SETS[settings.lines], True)
         return cls(settings.allowable_total_error_pct, _LINE_SETS[settings.lines])
+
+    @property
+    def unit(self) -> str:
+        return "% of TEa" if self.normalised else "%"
 
     @property
     def zone_names(self) -> tuple[str, ...]:
@@ -137,8 +150,24 @@ class Window:
     rule: str
 
 
-def analysis_window(meta: dict, t_first: float, t_last: float, settings: ScreeningSettings) -> Window:
-    """The window of a run per ``settings.window`` (see gearbox.toml ``[screening]``)."""
+def analysis_window(meta: dict, t_first: float, t_last: float, settings: ScreeningSettings,
+                    signals: pd.DataFrame | None = None) -> Window:
+    """The window of a run per ``settings.window`` (see gearbox.toml ``[screening]``).
+
+    ``"settled"`` needs the run's ``signals`` (flexgear.study.indicators.settled_start); a run that
+    does not settle is screened after its ramps and marked not steady.
+    """
+    if settings.window == "settled" and signals is not None:
+        ramp = float(meta.get("ramp_time_s", 0.0)) + settings.after_ramp_delay_s
+        f_mesh = float((meta.get("theory") or {}).get("mesh_frequency_hz", 0.0))
+        if ramp < t_last and f_mesh > 0:
+            start, why = settled_start(signals, max(ramp, t_first), f_mesh, settings.settle_block_mesh_cycles,
+                                       settings.settle_final_blocks, settings.settle_mean_tolerance_pct,
+                                       settings.settle_amplitude_tolerance_pct, settings.sample_count)
+            if start is not None:
+                return Window(start, t_last, True, why)
+            return Window(max(ramp, t_first), t_last, False, f"after the ramps, {ramp:g}-{t_last:g} s, NOT steady: "
+                          + why)
     if settings.window == "fixed":
         start, end = max(settings.window_start_s, t_first), min(settings.window_end_s, t_last)
         if end <= start:
@@ -180,21 +209,6 @@ def cv_pct(samples: np.ndarray) -> float:
     return float(np.std(samples, ddof=1) / abs(np.mean(samples)) * 100.0)
 
 
-def indicator_signals(signals: pd.DataFrame) -> dict[str, np.ndarray]:
-    """The five indicator signals from a signal table (mesh forces averaged over the planets)."""
-    out = {
-        "input_speed": signals["input_speed_deg_per_s"].to_numpy(),
-        "output_speed": signals["output_speed_deg_per_s"].to_numpy(),
-        "transmission_ratio": signals["transmission_ratio"].to_numpy(),
-    }
-    for mesh in ("outer", "inner"):
-        cols = [c for c in signals.columns if c.startswith(f"{mesh}_mesh_force_") and c.endswith("_n")]
-        if not cols:
-            raise ValueError(f"signal table has no {mesh}_mesh_force_<i>_n columns")
-        out[f"{mesh}_mesh_force"] = signals[cols].to_numpy().mean(axis=1)
-    return out
-
-
 # --------------------------------------------------------------------------- one variant
 @dataclass(frozen=True)
 class IndicatorResult:
@@ -206,6 +220,8 @@ class IndicatorResult:
     bias_pct: float
     cv_pct: float
     samples: tuple[float, ...]
+    tea_pct: float = math.nan
+    weight: float = math.nan
 
 
 @dataclass(frozen=True)
@@ -223,132 +239,152 @@ class VariantScreening:
     zone_rank: int
 
 
-def screen_result(result: RunResult, settings: ScreeningSettings) -> VariantScreening:
-    """Screen one finished run against ``result.meta["theory"]``."""
+def indicator_samples(result: RunResult, settings: ScreeningSettings, keys: tuple[str, ...] | None = None
+                      ) -> tuple[Window, dict[str, np.ndarray]]:
+    """The run's window and each indicator's samples in it (``sample_count`` segments)."""
     if not result.ok or result.signals is None:
         raise ValueError(f"{result.name}: run did not finish ({result.meta.get('reason')})")
     t = result.signals["time_s"].to_numpy()
-    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings)
-    theory = result.meta["theory"]
-    weights = dataclasses.asdict(settings.weights)
+    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings, result.signals)
+    slices = segment_slices(t, window.start_s, window.end_s, settings.sample_count)
+    f_mesh = float(result.meta["theory"]["mesh_frequency_hz"])
+    return window, indicator_segments(result.signals, slices, f_mesh, keys)
+
+
+def screen_result(result: RunResult, settings: ScreeningSettings,
+                  reference: dict[str, float] | None = None) -> VariantScreening:
+    """Screen one finished run.
+
+    ``reference`` None: the study's mode, the five indicators against ``result.meta["theory"]``,
+    composite Bias and CV the weighted sums in %. Otherwise the reference variant's indicator means
+    (key -> value): every indicator both runs have, each Bias and CV divided by its own TEa
+    (``[screening.reference_indicators]``), composite = weighted sum in % of TEa (weights of the
+    indicators present, rescaled to sum 1).
+    """
+    lines = DecisionLines.from_settings(settings, "ref" if reference is not None else "")
+    if reference is None:
+        window, samples = indicator_samples(result, settings, tuple(INDICATORS))
+        theory = result.meta["theory"]
+        targets = {k: float(theory[_THEORY_KEYS[k]]) for k in samples}
+        weights = dataclasses.asdict(settings.weights)
+        teas = dict.fromkeys(samples, settings.allowable_total_error_pct)
+    else:
+        window, samples = indicator_samples(result, settings)
+        samples = {k: v for k, v in samples.items() if k in reference}
+        targets = {k: float(reference[k]) for k in samples}
+        tol = {k: getattr(settings.reference_indicators, k) for k in samples}
+        total = sum(t.weight for t in tol.values())
+        weights = {k: t.weight / total for k, t in tol.items()}
+        teas = {k: t.tea_pct for k, t in tol.items()}
     indicators = {}
-    for key, y in indicator_signals(result.signals).items():
-        x = sample_means(t, y, window, settings.sample_count)
-        th = float(theory[_THEORY_KEYS[key]])
+    for key, x in samples.items():
         mean = float(np.mean(x))
-        indicators[key] = IndicatorResult(key, th, mean, bias_pct(mean, th), cv_pct(x), tuple(map(float, x)))
-    bias = sum(weights[k] * r.bias_pct for k, r in indicators.items())
-    cv = sum(weights[k] * r.cv_pct for k, r in indicators.items())
-    lines = DecisionLines.from_settings(settings)
+        indicators[key] = IndicatorResult(key, targets[key], mean, bias_pct(mean, targets[key]), cv_pct(x),
+                                          tuple(map(float, x)), teas[key], weights[key])
+    scale = {k: (100.0 / r.tea_pct if lines.normalised else 1.0) for k, r in indicators.items()}
+    bias = sum(weights[k] * r.bias_pct * scale[k] for k, r in indicators.items())
+    cv = sum(weights[k] * r.cv_pct * scale[k] for k, r in indicators.items())
     return VariantScreening(result.name, window, indicators, bias, cv, math.hypot(bias, cv),
                             sigma_metric(bias, cv, lines.tea_pct), lines.zone(bias, cv), lines.rank(bias, cv))
 
 
 # --------------------------------------------------------------------------- many variants
-@dataclass(frozen=True)
-class Selection:
-    """The selected variant (None if the rule selects none) and the reasoning, in words."""
-
-    variant: str | None
-    rule: str
-    reasoning: str
-
-
 def _run_time(meta: dict) -> float:
     """Time a variant is judged by: the runner's wall time of the simulation (s)."""
     value = meta.get("wall_time_s")
     return float(value) if value is not None else math.nan
 
 
-def screening_tables(results: Iterable[RunResult], settings: ScreeningSettings
-                     ) -> tuple[pd.DataFrame, pd.DataFrame, Selection]:
-    """Screening table (one row per run), per-indicator table, and the selection.
+@dataclass(frozen=True)
+class Screening:
+    """A screened set of runs: one row per run (``table``), one per run and indicator
+    (``indicators``), the selection, the decision lines and the reference variant ("" = theory)."""
+
+    table: pd.DataFrame
+    indicators: pd.DataFrame
+    selection: Selection
+    lines: DecisionLines
+    reference: str = ""
+
+    def plot(self, ax, xlim: float | None = None, ylim: float | None = None, title: str = "") -> list[str]:
+        """Westgard decision diagram of the composite points (numbered markers); returns the legend
+        lines "n: variant ..." in marker order (flexgear.study.diagram.decision_diagram)."""
+        from flexgear.study.diagram import decision_diagram
+
+        return decision_diagram(ax, self.table, self.lines, xlim, ylim, title)
+
+
+def _reference_means(results: list[RunResult], name: str, settings: ScreeningSettings) -> dict[str, float]:
+    ref = next((r for r in results if r.name == name), None)
+    if ref is None:
+        raise ValueError(f"screening reference {name!r} is not among the runs "
+                         f"({', '.join(r.name for r in results) or 'none'})")
+    if not ref.ok:
+        raise ValueError(f"screening reference {name!r} did not finish ({ref.meta.get('reason')})")
+    _, samples = indicator_samples(ref, settings)
+    return {k: float(np.mean(v)) for k, v in samples.items()}
+
+
+def _reference_reasoning(table: pd.DataFrame, indicators: pd.DataFrame, name: str) -> str:
+    """Why the variants differ from the reference: distance and the two largest contributors of each."""
+    parts = []
+    for row in table[(table["status"] == "ok") & (table["variant"] != name)].itertuples():
+        ind = indicators[indicators["variant"] == row.variant]
+        share = (ind["weight"] * ind["bias_pct"] / ind["tea_pct"]).sort_values(ascending=False)
+        top = [ind.loc[i] for i in share.index[:2]]
+        parts.append(f"{row.variant} at distance {row.distance_pct:.3g} % of TEa"
+                     + (" (largest: " + ", ".join(f"{t['indicator']} {t['bias_pct']:.3g} % off (TEa {t['tea_pct']:g} %)"
+                                                  for t in top) + ")" if top else ""))
+    return (f" Against reference {name} (Bias 0 by definition): " + "; ".join(parts) + ".") if parts else ""
+
+
+def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None) -> Screening:
+    """Screen runs in the study's mode (``reference`` "") or against a reference variant (its name);
+    default ``settings.reference``.
 
     Failed runs, and runs whose signals cannot be screened, get a row with status "failed" and
-    their reason; they are not candidates for selection.
+    their reason; they are not candidates for selection. A missing or failed reference raises.
     """
-    lines = DecisionLines.from_settings(settings)
+    results = list(results)
+    ref_name = settings.reference if reference is None else reference
+    lines = DecisionLines.from_settings(settings, ref_name)
+    ref = _reference_means(results, ref_name, settings) if ref_name else None
     rows, ind_rows = [], []
     for res in results:
         row = {"variant": res.name, "status": res.meta.get("status", "failed"),
-               "reason": res.meta.get("reason") or "", "time_s": _run_time(res.meta)}
+               "reason": res.meta.get("reason") or "", "time_s": _run_time(res.meta),
+               "t_end_s": res.meta.get("t_end_s", math.nan)}
         if res.ok:
             try:
-                s = screen_result(res, settings)
+                s = screen_result(res, settings, ref)
             except (ValueError, KeyError) as exc:
                 row.update(status="failed", reason=f"screening: {exc}")
             else:
                 row.update(bias_pct=s.bias_pct, cv_pct=s.cv_pct, distance_pct=s.distance_pct, sigma=s.sigma,
                            zone=s.zone, zone_rank=s.zone_rank, steady_window=s.window.steady,
-                           window_start_s=s.window.start_s, window_end_s=s.window.end_s)
+                           window_start_s=s.window.start_s, window_end_s=s.window.end_s, window_rule=s.window.rule)
                 for r in s.indicators.values():
-                    ind_rows.append({"variant": res.name, "indicator": r.name, "theory": r.theory, "mean": r.mean,
-                                     "bias_pct": r.bias_pct, "cv_pct": r.cv_pct,
-                                     "sigma": sigma_metric(r.bias_pct, r.cv_pct, lines.tea_pct),
-                                     "zone": lines.zone(r.bias_pct, r.cv_pct)})
+                    tea = r.tea_pct
+                    ind_rows.append({"variant": res.name, "indicator": r.name, "target": r.theory, "mean": r.mean,
+                                     "bias_pct": r.bias_pct, "cv_pct": r.cv_pct, "tea_pct": tea,
+                                     "weight": r.weight, "sigma": sigma_metric(r.bias_pct, r.cv_pct, tea),
+                                     "zone": DecisionLines(tea, lines.multipliers).zone(r.bias_pct, r.cv_pct)})
         rows.append(row)
     columns = ["variant", "status", "reason", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "zone_rank",
-               "time_s", "steady_window", "window_start_s", "window_end_s"]
+               "time_s", "t_end_s", "steady_window", "window_start_s", "window_end_s", "window_rule"]
     table = pd.DataFrame(rows).reindex(columns=columns)
+    indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "target", "mean", "bias_pct", "cv_pct",
+                                                 "tea_pct", "weight", "sigma", "zone"])
     selection = select_variant(table, settings.selection, lines)
+    if ref_name:
+        selection = Selection(selection.variant, selection.rule,
+                              selection.reasoning + _reference_reasoning(table, indicators, ref_name))
     table["selected"] = table["variant"] == selection.variant
-    indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "theory", "mean", "bias_pct", "cv_pct",
-                                                 "sigma", "zone"])
-    return table, indicators, selection
+    return Screening(table, indicators, selection, lines, ref_name)
 
 
-def _names(df: pd.DataFrame) -> str:
-    return ", ".join(df["variant"].astype(str)) or "none"
-
-
-def _pick(candidates: pd.DataFrame, keys: Sequence[str]) -> pd.Series:
-    return candidates.sort_values(list(keys), kind="stable").iloc[0]
-
-
-def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines) -> Selection:
-    """Apply a selection rule to a screening table (columns: variant, status, zone_rank, time_s,
-    distance_pct) and explain the choice.
-
-    - ``fastest_in_best_zone``: among the variants in the best zone reached, the fastest; ties
-      (equal time) by distance from the origin. This is the study's reasoning (section 2.2: of
-      models 4, 6, 7 in the excellent zone, model 4 is the cheapest).
-    - ``closest_to_origin``: the smallest relative error distance; ties by time.
-    - ``fastest_acceptable``: the fastest variant that is not non-conforming; ties by distance.
-    """
-    ok = table[table["status"] == "ok"]
-    failed = table[table["status"] != "ok"]
-    notes = f" Not screened (failed): {_names(failed)}." if len(failed) else ""
-    tea = f"TEa = {lines.tea_pct:g} %"
-    if ok.empty:
-        return Selection(None, rule, "No variant finished, nothing to select." + notes)
-    if rule == "closest_to_origin":
-        best = _pick(ok, ("distance_pct", "time_s"))
-        why = (f"Rule closest_to_origin: {best['variant']} has the smallest relative error distance "
-               f"({best['distance_pct']:.4g} %, zone {best['zone']}, {tea}).")
-    elif rule == "fastest_acceptable":
-        acceptable = ok[ok["zone_rank"] >= 1]
-        if acceptable.empty:
-            return Selection(None, rule, f"Rule fastest_acceptable: no variant meets Bias + 2 CV <= {tea}; "
-                                         "none is selected." + notes)
-        best = _pick(acceptable, ("time_s", "distance_pct"))
-        why = (f"Rule fastest_acceptable: variants meeting Bias + 2 CV <= {tea}: {_names(acceptable)}; "
-               f"the fastest is {best['variant']} ({best['time_s']:.4g} s, zone {best['zone']}).")
-    elif rule == "fastest_in_best_zone":
-        top = int(ok["zone_rank"].max())
-        zone = lines.zone_names[top]
-        in_zone = ok[ok["zone_rank"] == top]
-        best = _pick(in_zone, ("time_s", "distance_pct"))
-        why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {_names(in_zone)}; "
-               f"the fastest of them is {best['variant']} ({best['time_s']:.4g} s, distance "
-               f"{best['distance_pct']:.4g} %).")
-        if len(in_zone) > 1:
-            slower = in_zone[in_zone["variant"] != best["variant"]]
-            why += " It is as accurate as zone '" + zone + "' asks while " + ", ".join(
-                f"{r.variant} takes {r.time_s / best['time_s']:.3g}x as long" for r in slower.itertuples()) + "."
-        if top == 0:
-            why += (f" WARNING: no variant meets even Bias + {lines.multipliers[0]} CV <= {tea}: "
-                    "the selection is not an acceptable model.")
-    else:
-        raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
-                         "fastest_acceptable")
-    return Selection(str(best["variant"]), rule, why + notes)
+def screening_tables(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None
+                     ) -> tuple[pd.DataFrame, pd.DataFrame, Selection]:
+    """(table, indicators, selection) of :func:`screen`."""
+    s = screen(results, settings, reference)
+    return s.table, s.indicators, s.selection

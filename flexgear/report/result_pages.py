@@ -1,0 +1,359 @@
+"""Report pages of the results: run times, Westgard diagrams, screening tables, overlaid signals,
+spectra, Tables 6-7, sweeps. Each page lays out objects that draw themselves (``plot(ax)``)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pandas as pd
+from matplotlib.figure import Figure
+
+from flexgear.report.data import ReportData
+from flexgear.report.figures import draw_table, fmt, run_time_chart
+from flexgear.report.layout import Page, colours, components_text, text_block
+from flexgear.results import SIGNAL_TYPES, RunResult
+from flexgear.study.compare import TABLE7_HARMONICS, BearingSpectrum, compare_results, mark_harmonics
+from flexgear.study.indicators import ALL_INDICATORS
+from flexgear.study.reference import ADAMS_SIMULATED_S, ADAMS_TIME_S, STUDY_TABLE6, STUDY_TABLE7
+from flexgear.study.screening import Screening
+
+__all__ = ["run_time_page", "diagram_pages", "screening_pages", "overlay_pages", "spectrum_pages",
+           "tables_6_7_pages", "sweep_pages", "shown_runs"]
+
+STUDY_RAMP_S, STUDY_END_S = 0.5, 0.6    # Table 5 and section 3.1: the study's load case
+
+
+def shown_runs(d: ReportData) -> dict[str, RunResult]:
+    """Finished runs to draw: the variants, then the lumped model."""
+    out = {n: r for n, r in d.runs.items() if r.ok}
+    if d.lumped is not None and d.lumped.ok:
+        out["lumped"] = d.lumped
+    return out
+
+
+def run_time_page(d: ReportData) -> Page:
+    rows = []
+    for name, r in d.runs.items():
+        num = name[5:] if name.startswith("model") and name[5:].isdigit() else None
+        adams = ADAMS_TIME_S.get(int(num), np.nan) if num else np.nan
+        t_end = r.meta.get("t_end_s", np.nan)
+        wall = r.meta.get("wall_time_s", np.nan) if r.ok else np.nan
+        rows.append({"variant": name, "components": components_text(r.meta), "status": r.meta.get("status"),
+                     "t_end_s": t_end, "wall_time_s": wall,
+                     "cpu_time_s": r.meta.get("cpu_time_s", np.nan) if r.ok else np.nan,
+                     "per_s": wall / t_end if t_end else np.nan,
+                     "cpu_per_s": r.meta.get("cpu_time_s", np.nan) / t_end if r.ok and t_end else np.nan,
+                     "adams_per_s": adams / ADAMS_SIMULATED_S})
+    runs = pd.DataFrame(rows)
+
+    def draw(fig: Figure) -> None:
+        run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs)
+        shown = runs.assign(speedup=runs["adams_per_s"] / runs["per_s"]).rename(columns={
+            "t_end_s": "simulated [s]", "wall_time_s": "wall [s]", "cpu_time_s": "CPU [s]",
+            "per_s": "wall per simulated s", "cpu_per_s": "CPU per simulated s",
+            "adams_per_s": "study ADAMS per simulated s",
+            "speedup": "ADAMS / flexgear"})
+        draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34}, fontsize=7.5)
+        fig.text(0.04, 0.37, "Both per simulated second: the study's Table 4 times are for 0.6 s simulated (its own "
+                 "computer); ours for the simulated time shown (model build + simulation). Wall time includes waiting "
+                 "for a shared CPU; CPU time does not.", fontsize=7.5)
+    return ("Run time per simulated second against the study's ADAMS times (Table 4)", draw)
+
+
+def _diagram_page(s: Screening, title: str, note: str) -> Page:
+    ok = s.table[s.table["status"] == "ok"]
+    tea = s.lines.tea_pct
+    far = len(ok) and (float(ok["bias_pct"].max()) > 4 * tea or float(ok["cv_pct"].max()) > 2 * tea)
+
+    def draw(fig: Figure) -> None:
+        if far:
+            s.plot(fig.add_axes([0.06, 0.2, 0.3, 0.68]), title="all variants")
+            legend = s.plot(fig.add_axes([0.41, 0.2, 0.3, 0.68]), 1.3 * tea, 0.65 * tea, title="zones at TEa scale")
+        else:
+            xmax = max(1.3 * tea, 1.1 * float(ok["bias_pct"].max()) if len(ok) else 0.0)
+            ymax = max(0.65 * tea, 1.15 * float(ok["cv_pct"].max()) if len(ok) else 0.0)
+            legend = s.plot(fig.add_axes([0.07, 0.2, 0.6, 0.68]), xmax, ymax)
+        text_block(fig.add_axes([0.72, 0.2, 0.27, 0.68]), f"Markers: variant: Bias, CV [{s.lines.unit}], zone\n"
+                   + "\n".join(legend) + f"\n\nSelected: {s.selection.variant or 'none'}. {s.selection.reasoning}",
+                   width=56, fontsize=7.2)
+        text_block(fig.add_axes([0.07, 0.04, 0.9, 0.1]), note + " Axes as in the study (Bias on x, CV on y). "
+                   "Lines Bias + m·CV = TEa; a point on a line belongs to the better zone. Markers closer than a "
+                   "few points share one label.", width=175, fontsize=8)
+    return (title, draw)
+
+
+def diagram_pages(d: ReportData) -> list[Page]:
+    pages = [_diagram_page(d.study, "Westgard decision diagram, the study's mode: Bias against theory (section "
+                           "2.2, Fig. 2)", f"The study's five indicators, 20 % each, TEa = "
+                           f"{d.study.lines.tea_pct:g} %. They are fixed by kinematics and torque balance and barely "
+                           "depend on flexibility.")]
+    if d.reference is not None:
+        name = d.reference.reference
+        pages.append(_diagram_page(d.reference, f"Westgard decision diagram against the reference {name}: "
+                                   "dynamic indicators", "Each indicator's Bias and CV in % of its own TEa "
+                                   "([screening.reference_indicators]), weighted; the reference sits on the CV axis."))
+    return pages
+
+
+def screening_pages(d: ReportData) -> list[Page]:
+    pages = []
+    for s, mode in ((d.study, "against theory"), (d.reference, "against the reference")):
+        if s is None:
+            continue
+        t = s.table
+        comp = t[["variant", "status", "bias_pct", "cv_pct", "distance_pct", "zone", "time_s", "window_start_s",
+                  "window_end_s", "steady_window", "selected"]].rename(columns={
+                      "bias_pct": f"Bias [{s.lines.unit}]", "cv_pct": f"CV [{s.lines.unit}]",
+                      "distance_pct": f"distance [{s.lines.unit}]", "time_s": "wall [s]",
+                      "window_start_s": "window from [s]", "window_end_s": "to [s]", "steady_window": "settled"})
+        ind = s.indicators
+        order = [k for k in ALL_INDICATORS if k in set(ind["indicator"])]
+        means = ind.pivot(index="indicator", columns="variant", values="mean").reindex(order)
+        bias = ind.pivot(index="indicator", columns="variant", values="bias_pct").reindex(order)
+        first = ind.drop_duplicates("indicator").set_index("indicator").reindex(order)
+        head = pd.DataFrame({"indicator": order, "TEa [%]": first["tea_pct"].to_numpy(),
+                             "weight": first["weight"].to_numpy()})
+        mean_tab = pd.concat([head, means.reset_index(drop=True)], axis=1)
+        bias_tab = pd.concat([head, bias.reset_index(drop=True)], axis=1)
+
+        def draw(fig: Figure, s: Screening = s, comp=comp, mean_tab=mean_tab, bias_tab=bias_tab) -> None:
+            ax = fig.add_axes([0.04, 0.06, 0.92, 0.85])
+            ax.text(0, 1.0, "Composite point per variant", fontsize=9, weight="bold", transform=ax.transAxes)
+            y = draw_table(ax, comp, top=0.975, fontsize=6.5, max_height=0.22)
+            ax.text(0, y - 0.02, "Indicator means over each run's window (definitions and units: "
+                    "flexgear.study.indicators)", fontsize=8.5, weight="bold", transform=ax.transAxes)
+            y = draw_table(ax, mean_tab, top=y - 0.035, fontsize=6.5, wrap=30)
+            ax.text(0, y - 0.02, f"Bias [%] of each indicator against {'theory' if not s.reference else s.reference} "
+                    "(not yet scaled by its TEa)", fontsize=8.5, weight="bold", transform=ax.transAxes)
+            draw_table(ax, bias_tab, top=y - 0.035, fontsize=6.5, wrap=30)
+        pages.append((f"Screening {mode}: composite points, indicators and selection", draw))
+    return pages
+
+
+def _window_span(d: ReportData, runs: dict[str, RunResult]) -> tuple[float, float]:
+    windows = [d.window(r) for n, r in runs.items() if n != "lumped"]
+    return (max(w.start_s for w in windows), min(w.end_s for w in windows)) if windows else (0.0, 0.0)
+
+
+def _run_window(d: ReportData, name: str, r: RunResult, runs: dict[str, RunResult]) -> tuple[float, float]:
+    """A variant's own settled window; the lumped run: the variants' common window if it lies inside
+    the lumped run, else its own."""
+    if name != "lumped":
+        w = d.window(r)
+        return (w.start_s, w.end_s)
+    span = _window_span(d, runs)
+    t_end = float(r.signals["time_s"].iloc[-1])
+    if span[1] > span[0] and span[1] <= t_end + 1e-9:
+        return span
+    w = d.window(r)
+    return (w.start_s, w.end_s)
+
+
+def overlay_pages(d: ReportData) -> list[Page]:
+    """One page per signal type: every run overlaid on common axes, full length and the last mesh cycles."""
+    runs = shown_runs(d)
+    col = colours(list(runs))
+    th = next((r.meta["theory"] for r in runs.values() if "theory" in r.meta), {})
+    span = _window_span(d, runs)
+    cycles = 5.0 / th.get("mesh_frequency_hz", 5000.0)
+    pages = []
+    targets = {"input_speed": th.get("input_speed_deg_per_s"), "output_speed": th.get("output_speed_deg_per_s"),
+               "outer_mesh_force": th.get("mesh_force_n"), "inner_mesh_force": th.get("mesh_force_n")}
+    for kind, (title, ylabel) in SIGNAL_TYPES.items():
+        having = {n: r for n, r in runs.items() if r.has(kind)}
+        if not having or kind == "input_speed":
+            continue
+
+        def draw(fig: Figure, kind=kind, having=having, ylabel=ylabel) -> None:
+            top = fig.add_axes([0.1, 0.53, 0.87, 0.36])
+            zoom = fig.add_axes([0.1, 0.1, 0.38, 0.34])
+            last = fig.add_axes([0.59, 0.1, 0.38, 0.34])
+            for n, r in having.items():
+                style = {"color": "k", "ls": "--", "lw": 1.0} if n == "lumped" else {"color": col[n]}
+                r.plot(top, kind, **style)
+                r.plot(zoom, kind, zoom=span, **style)
+                t_end = float(r.signals["time_s"].iloc[-1])
+                r.plot(last, kind, zoom=(t_end - cycles, t_end), **style)
+            for ax, name in ((top, "whole run"), (zoom, f"common settled window {span[0]:.3g}–{span[1]:.3g} s"),
+                             (last, "last 5 mesh cycles of each run")):
+                if targets.get(kind) is not None:
+                    ax.axhline(targets[kind], color="#d62728", lw=0.9, ls=":", label="theory")
+                ax.set_title(name, fontsize=9)
+                ax.set_xlabel("time [s]")
+                ax.set_ylabel(ylabel)
+                ax.grid(alpha=0.3)
+                if "accel" in kind:      # the lumped model's level can be ten times the variants': log scale
+                    ax.set_yscale("log")
+                else:
+                    ax.ticklabel_format(axis="y", useOffset=False)
+            if span[1] > span[0]:
+                top.axvspan(*span, color="#2ca02c", alpha=0.1, label="common settled window")
+            top.legend(fontsize=7, ncol=min(6, len(having) + 2), loc="best", framealpha=0.85)
+        pages.append((f"All variants overlaid: {title}", draw))
+    return pages
+
+
+def spectrum_pages(d: ReportData) -> list[Page]:
+    runs = shown_runs(d)
+    col = colours(list(runs))
+
+    def draw(fig: Figure) -> None:
+        for i, side in enumerate(("input", "output")):
+            ax = fig.add_axes([0.07, 0.56 - 0.46 * i, 0.9, 0.33])
+            spectra = [BearingSpectrum.of(r, side, _run_window(d, n, r, runs), n) for n, r in runs.items()]
+            present: set[int] = set()
+            for sp in spectra:
+                sp.plot(ax, color="k" if sp.name == "lumped" else col[sp.name],
+                        **({"ls": "--"} if sp.name == "lumped" else {}))
+                present |= set(sp.present())
+            f = spectra[0].mesh_frequency_hz
+            ax.set_xlim(0, 10.5 * f / 1e3)
+            mark_harmonics(ax, f, sorted(present))
+            ax.set_xlabel(f"frequency [kHz] (mesh frequency {f:g} Hz)")
+            ax.set_ylabel("amplitude of a_x [m/s²]")
+            ax.set_title(f"{side}-shaft bearing, x acceleration, each run's settled window", fontsize=9, pad=14)
+            ax.legend(fontsize=7, ncol=min(8, len(spectra)), loc="lower left", framealpha=0.85)
+            ax.grid(alpha=0.3, which="major")
+        text_block(fig.add_axes([0.07, 0.03, 0.9, 0.04]), "Hann-windowed amplitude spectrum "
+                   "(flexgear.study.compare). Markers at every harmonic of the mesh frequency that stands 20 dB above "
+                   "its neighbourhood in any run (grey), the study's 1, 2, 4, 6, 9× (Table 7) in red.", width=190,
+                   fontsize=7.5)
+    return [("Bearing acceleration spectra, all variants overlaid", draw)]
+
+
+def _load_case_note(d: ReportData) -> str:
+    cases = {(r.meta.get("ramp_time_s"), r.meta.get("t_end_s")) for r in shown_runs(d).values()}
+    differ = [c for c in cases if c != (STUDY_RAMP_S, STUDY_END_S)]
+    if not differ:
+        return ""
+    text = ", ".join(f"ramps {fmt(a)} s / {fmt(b)} s simulated" for a, b in sorted(differ, key=str))
+    return (f"CAUTION: these runs used a load case other than the study's (ramps over {STUDY_RAMP_S:g} s, "
+            f"{STUDY_END_S:g} s simulated): {text}. The study's values are its own model's under its load case and "
+            "its unknown face width (see the eps_beta sensitivity): compare trends, not digits.")
+
+
+def tables_6_7_pages(d: ReportData) -> list[Page]:
+    """Tables 6 and 7 for every finished run and the lumped model beside the study's (marked as the study's)."""
+    runs = shown_runs(d)
+    t6 = {}
+    t7 = []
+    for n, r in runs.items():
+        a, b = compare_results(r, r, window=_run_window(d, n, r, runs))
+        t6.setdefault("theory", a["theory"])
+        t6[n] = a.iloc[:, 1]
+        row = {"run": n}
+        for side in ("input", "output"):
+            for k, v in zip(TABLE7_HARMONICS, b.iloc[:, 0 if side == "input" else 1], strict=True):
+                row[f"{side} {k}×"] = v
+        t7.append(row)
+    table6 = pd.DataFrame(t6).reindex(list(STUDY_TABLE6))
+    for j, col in enumerate(("study: theory", "study: ADAMS (model 4)", "study: lumped")):
+        table6[col] = [STUDY_TABLE6[k][j] for k in table6.index]
+    labels = {"input_speed_deg_per_s": "input speed [°/s]", "output_speed_deg_per_s": "output speed [°/s]",
+              "outer_mesh_force_n": "outer mesh force, mean [N]", "inner_mesh_force_n": "inner mesh force, mean [N]",
+              "input_bearing_peak_accel_m_per_s2": "input bearing peak accel. [m/s²]",
+              "output_bearing_peak_accel_m_per_s2": "output bearing peak accel. [m/s²]"}
+    table6 = table6.rename(index=labels).reset_index(names="Table 6")
+    for j, name in ((0, "study: ADAMS"), (2, "study: lumped")):
+        row = {"run": name}
+        for side, off in (("input", 0), ("output", 1)):
+            row.update({f"{side} {k}×": STUDY_TABLE7[k][j + off] for k in TABLE7_HARMONICS})
+        t7.append(row)
+    table7 = pd.DataFrame(t7)
+    note = _load_case_note(d)
+
+    def draw(fig: Figure) -> None:
+        ax = fig.add_axes([0.03, 0.06, 0.94, 0.85])
+        ax.text(0, 1.0, "Table 6: time-domain indicators over each run's settled window; the study's columns are "
+                "the study's published values", fontsize=9, weight="bold", transform=ax.transAxes)
+        shown = table6.astype(object)
+        for i, name in enumerate(shown.iloc[:, 0]):
+            shown.iloc[i, 1:] = [fmt(v, 4 if "accel" in name else 9) for v in shown.iloc[i, 1:]]
+        y = draw_table(ax, shown, top=0.97, fontsize=7, wrap=14)
+        ax.text(0, y - 0.04, "Table 7: amplitude of the bearing x acceleration at multiples of the mesh frequency "
+                "[m/s²] (windowed DTFT); 'study:' rows are the study's", fontsize=9, weight="bold",
+                transform=ax.transAxes)
+        y = draw_table(ax, table7.astype(object).map(lambda v: fmt(v, 3)), top=y - 0.07, fontsize=7, wrap=14)
+        text_block(ax, note, width=190, fontsize=8, top=y - 0.03)
+    return [("Tables 6 and 7: every variant and the lumped model, beside the study's", draw)]
+
+
+def _peak(d: ReportData, folder, name: str, side: str) -> float:
+    """Largest radial bearing acceleration of a sweep run in its settled window (as Table 6)."""
+    from flexgear.results import load_result
+
+    r = d.runs.get(name)
+    if r is None and folder is not None and (folder / name / "run.json").exists():
+        r = load_result(folder / name)
+    if r is None or not r.ok:
+        return np.nan
+    w = d.window(r)
+    t = r.signals["time_s"].to_numpy()
+    y = r.signal(f"{side}_bearing_accel")
+    return float(y[(t >= w.start_s) & (t <= w.end_s)].max())
+
+
+def sweep_pages(d: ReportData) -> list[Page]:
+    if d.sweep is None:
+        return []
+    sw = d.sweep
+    table = sw.table.copy()
+    if sw.folder is not None:   # indicator means again from the runs, with the report's screening settings
+        from flexgear.study.sweep import indicator_means
+
+        fresh = pd.DataFrame([indicator_means(sw.folder / n, d.settings) for n in table["variant"]],
+                             index=table.index)
+        table[list(fresh.columns)] = fresh
+    table["input_bearing_peak"] = [_peak(d, sw.folder, n, "input") for n in table["variant"]]
+    table["output_bearing_peak"] = [_peak(d, sw.folder, n, "output") for n in table["variant"]]
+    params = sw.parameters
+    keep = ["variant", *params, "eps_beta", "status", "wall_time_s", "input_bearing_peak", "output_bearing_peak",
+            "input_bearing_rms", "outer_mesh_ripple", "dynamic_factor", "transmission_error"]
+    names = {"wall_time_s": "wall [s]", "input_bearing_peak": "input bearing peak [m/s²]",
+             "output_bearing_peak": "output bearing peak [m/s²]", "input_bearing_rms": "input bearing RMS [m/s²]",
+             "outer_mesh_ripple": "outer ripple [%]", "dynamic_factor": "K_v",
+             "transmission_error": "loaded TE [m]"}
+    shown = table[[c for c in keep if c in table.columns]].rename(columns=lambda c: names.get(c, c.split(".")[-1]))
+    from flexgear.study.sweep import SweepResult
+
+    plotted = SweepResult(sw.meta, table, sw.folder)
+
+    def draw_table_page(fig: Figure) -> None:
+        ax = fig.add_axes([0.03, 0.07, 0.94, 0.83])
+        text_block(ax, f"Sweep '{sw.meta['name']}' ({sw.meta['grid']} grid): " + "; ".join(
+            f"{k} = {', '.join(map(str, v))}" for k, v in sw.meta["parameters"].items()), width=180, fontsize=8.5)
+        draw_table(ax, shown, top=0.92, fontsize=7, wrap=26)
+
+    def draw_figures(fig: Figure) -> None:
+        x = "eps_beta" if width else numeric[0]
+        panels = (("input_bearing_peak", "input bearing, peak radial accel. [m/s²]"),
+                  ("output_bearing_peak", "output bearing, peak radial accel. [m/s²]"),
+                  ("input_bearing_rms", "input bearing accel. RMS [m/s²]"),
+                  ("outer_mesh_ripple", "outer mesh-force ripple [%]"))
+        for i, (y, label) in enumerate(panels):
+            ax = fig.add_axes([0.07 + 0.48 * (i % 2), 0.55 - 0.42 * (i // 2), 0.4, 0.32])
+            plotted.plot(ax, y, x)
+            if x == "eps_beta":
+                ax.axvline(1.0, color="#d62728", ls="--", lw=0.8, label="ε_β = 1")
+                if "peak" in y:
+                    study = STUDY_TABLE6[f"{y.split('_')[0]}_bearing_peak_accel_m_per_s2"][1]
+                    ax.axhline(study, color="#555555", ls=":", lw=0.9, label=f"study ADAMS {study:g} (face width "
+                               "not given)")
+            ax.set_yscale("log" if "peak" in y or "rms" in y else "linear")
+            ax.set_xlabel("overlap ratio ε_β of one helix half" if x == "eps_beta" else x)
+            ax.set_ylabel(label, fontsize=8)
+            ax.grid(alpha=0.3, which="both")
+            ax.legend(fontsize=6.5, loc="best")
+        text_block(fig.add_axes([0.07, 0.02, 0.9, 0.05]), "ε_β = (b/2) sin β / (π m_n) of one helix half (b: total "
+                   "face width, double-helical). Near integer ε_β the contact-line length, and so the mesh stiffness, "
+                   "hardly varies with mesh position: the mesh excitation and the bearing accelerations drop by orders "
+                   "of magnitude. The study does not give b, so its bearing accelerations cannot be a target by "
+                   "themselves. Peak: largest radial acceleration in the settled window (as Table 6).", width=190,
+                   fontsize=7.5)
+    width = any(p.endswith("face_width_mm") for p in params)
+    numeric = [p for p in params if len(sw.meta["parameters"][p]) > 1
+               and all(isinstance(v, (int, float)) for v in sw.meta["parameters"][p])]
+    pages = [(f"Sweep table: {sw.meta['name']}", draw_table_page)]
+    if numeric:     # a sensitivity figure needs a swept number
+        what = "the face width (ε_β)" if width else ", ".join(numeric)
+        pages.append((f"Sweep: sensitivity to {what}", draw_figures))
+    return pages

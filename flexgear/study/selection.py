@@ -1,0 +1,81 @@
+"""Selection of a model from a screening table (section 2.2): the rules and their reasoning in words."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import pandas as pd
+
+if TYPE_CHECKING:
+    from flexgear.study.screening import DecisionLines
+
+__all__ = ["Selection", "select_variant"]
+
+
+@dataclass(frozen=True)
+class Selection:
+    """The selected variant (None if the rule selects none) and the reasoning, in words."""
+
+    variant: str | None
+    rule: str
+    reasoning: str
+
+
+def _names(df: pd.DataFrame) -> str:
+    return ", ".join(df["variant"].astype(str)) or "none"
+
+
+def _pick(candidates: pd.DataFrame, keys: Sequence[str]) -> pd.Series:
+    return candidates.sort_values(list(keys), kind="stable").iloc[0]
+
+
+def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines) -> Selection:
+    """Apply a selection rule to a screening table (columns: variant, status, zone_rank, time_s,
+    distance_pct) and explain the choice.
+
+    - ``fastest_in_best_zone``: among the variants in the best zone reached, the fastest; ties
+      (equal time) by distance from the origin. This is the study's reasoning (section 2.2: of
+      models 4, 6, 7 in the excellent zone, model 4 is the cheapest).
+    - ``closest_to_origin``: the smallest relative error distance; ties by time.
+    - ``fastest_acceptable``: the fastest variant that is not non-conforming; ties by distance.
+    """
+    ok = table[table["status"] == "ok"]
+    failed = table[table["status"] != "ok"]
+    notes = f" Not screened (failed): {_names(failed)}." if len(failed) else ""
+    tea = (f"TEa = {lines.tea_pct:g} %" if not lines.normalised
+           else "each indicator scaled by its own TEa, composite TEa = 100 %")
+    if ok.empty:
+        return Selection(None, rule, "No variant finished, nothing to select." + notes)
+    if rule == "closest_to_origin":
+        best = _pick(ok, ("distance_pct", "time_s"))
+        why = (f"Rule closest_to_origin: {best['variant']} has the smallest relative error distance "
+               f"({best['distance_pct']:.4g} %, zone {best['zone']}, {tea}).")
+    elif rule == "fastest_acceptable":
+        acceptable = ok[ok["zone_rank"] >= 1]
+        if acceptable.empty:
+            return Selection(None, rule, f"Rule fastest_acceptable: no variant meets Bias + 2 CV <= {tea}; "
+                                         "none is selected." + notes)
+        best = _pick(acceptable, ("time_s", "distance_pct"))
+        why = (f"Rule fastest_acceptable: variants meeting Bias + 2 CV <= {tea}: {_names(acceptable)}; "
+               f"the fastest is {best['variant']} ({best['time_s']:.4g} s, zone {best['zone']}).")
+    elif rule == "fastest_in_best_zone":
+        top = int(ok["zone_rank"].max())
+        zone = lines.zone_names[top]
+        in_zone = ok[ok["zone_rank"] == top]
+        best = _pick(in_zone, ("time_s", "distance_pct"))
+        why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {_names(in_zone)}; "
+               f"the fastest of them is {best['variant']} ({best['time_s']:.4g} s, distance "
+               f"{best['distance_pct']:.4g} %).")
+        if len(in_zone) > 1:
+            slower = in_zone[in_zone["variant"] != best["variant"]]
+            why += " It is as accurate as zone '" + zone + "' asks while " + ", ".join(
+                f"{r.variant} takes {r.time_s / best['time_s']:.3g}x as long" for r in slower.itertuples()) + "."
+        if top == 0:
+            why += (f" WARNING: no variant meets even Bias + {lines.multipliers[0]} CV <= {tea}: "
+                    "the selection is not an acceptable model.")
+    else:
+        raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
+                         "fastest_acceptable")
+    return Selection(str(best["variant"]), rule, why + notes)
