@@ -84,3 +84,23 @@ def ramp_state(t: float, T: float) -> tuple[float, float, float, float]:
         return t - 0.5 * T, 1.0, 0.0, 0.0
     d = t / T
     return T * (d**3 - 0.5 * d**4), d * d * (3.0 - 2.0 * d), 6.0 * d * (1.0 - d) / T, (6.0 - 12.0 * d) / T**2
+
+
+@njit(cache=True)
+def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi, spin):  # pragma: no cover
+    """Write each column set's coefficients at spin angle ``theta`` [rad] into ``matrix`` (in place).
+
+    Compiled twin of flexgear.mbs.contact_kinematics.ContactKinematics.reference_matrix_at: set j's
+    coefficients c(alpha) at alpha = psi_j - spin_j theta, linearly interpolated on the periodic grid
+    ``tables[j]`` (n_grid, width), times signs_j, go to row rows_j, columns first_j .. first_j + n_modes_j.
+    """
+    n_grid = tables.shape[1]
+    two_pi = 2.0 * math.pi
+    for j in range(rows.shape[0]):
+        a = ((psi[j] - spin[j] * theta) % two_pi) * (n_grid / two_pi)
+        fl = math.floor(a)
+        w = a - fl
+        i0 = int(fl) % n_grid
+        i1 = (i0 + 1) % n_grid
+        for m in range(n_modes[j]):
+            matrix[rows[j], first[j] + m] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])

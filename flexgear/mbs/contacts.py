@@ -160,9 +160,17 @@ class MeshConstraint:
                 offset=matrix[rows] @ q_ref))
             self.blocks.append((block, rows, np.ix_(rows, cols)))
 
-    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
-        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
-        for block, rows, sub in self.blocks:
+    def blocks_with_rows(self, rows: np.ndarray) -> list[int]:
+        """Indices of the blocks (gear pairs) that hold any of ``rows``."""
+        return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
+
+    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None,
+            blocks: list[int] | None = None) -> None:
+        """Write G (and the offset, if given) into the constraints (a pre-step hot path); with
+        ``blocks`` (:meth:`blocks_with_rows`), only into those."""
+        for i, (block, rows, sub) in enumerate(self.blocks):
+            if blocks is not None and i not in blocks:
+                continue
             mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
             if offset is not None:
                 mbs.SetObjectParameter(block, "offset", offset[rows])
@@ -265,9 +273,9 @@ class StiffnessSchedule:
 
     def fast_values(self, t: float) -> np.ndarray:
         """Same as :meth:`values`, compiled (flexgear.laws.compiled.periodic_values)."""
-        from flexgear.laws.compiled import periodic_values
+        from flexgear.laws.compiled import periodic_values, ramp_state
 
-        phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        phase = self.rate * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0]) - self.offsets
         return periodic_values(phase, self._means, self._cos, self._sin)
 
     def __call__(self, mbs, t: float) -> bool:
@@ -332,9 +340,9 @@ class MeshFriction:
 
     def fast_forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
         """Same as :meth:`forces`, compiled (flexgear.laws.compiled.mesh_friction_forces)."""
-        from flexgear.laws.compiled import mesh_friction_forces
+        from flexgear.laws.compiled import mesh_friction_forces, ramp_state
 
-        phase = self.phase_rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        phase = self.phase_rate * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0]) - self.offsets
         law = self.law
         return mesh_friction_forces(
             phase, delta, delta_t, q_t, law.stiffness, law.exponent, law.damping_max, law.penetration_depth,
