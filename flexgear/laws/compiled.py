@@ -43,11 +43,10 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
     (series index 0: stiffness factor, 1: sliding direction kappa, 2: lever lambda [m]) and
     laws.contact.friction_forces (f = mu F tanh(Omega lambda_mean / v_reg) (kappa, lambda)).
     """
-    n_c, n_h = cos_c.shape[1], cos_c.shape[2]
-    spin_rate = spin_rows @ q_t
-    q = np.zeros(sliding_rows.shape[1])
-    for i in range(n_c):
-        val = np.empty(3)
+    n_c, n_h, n_q = cos_c.shape[1], cos_c.shape[2], sliding_rows.shape[1]
+    q = np.zeros(n_q)
+    val = np.empty(3)
+    for i in range(n_c):  # explicit loops: no temporary arrays per contact (a per-step hot path)
         for k in range(3):
             v = means[k, i]
             for h in range(n_h):
@@ -56,8 +55,12 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
             val[k] = v
         normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
                                      depth[i])
-        f = mu[i] * normal * math.tanh(spin_rate[i] * means[2, i] / reg[i])
-        q -= sliding_rows[i] * (f * val[1]) + spin_rows[i] * (f * val[2])
+        spin_rate = 0.0
+        for j in range(n_q):
+            spin_rate += spin_rows[i, j] * q_t[j]
+        f = mu[i] * normal * math.tanh(spin_rate * means[2, i] / reg[i])
+        for j in range(n_q):
+            q[j] -= sliding_rows[i, j] * (f * val[1]) + spin_rows[i, j] * (f * val[2])
     return q
 
 
