@@ -14,6 +14,7 @@ from standins import annulus_source
 from flexgear.lumped.run import build_lumped_model, lumped_rhs, run_lumped
 from flexgear.mbs.contact_kinematics import ContactKinematics, ModalColumn
 from flexgear.mbs.contacts import MeshFriction, StiffnessSchedule
+from flexgear.mbs.mesh_updates import MeshUpdates
 from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 from flexgear.study.agreement import signal_agreement
@@ -54,6 +55,7 @@ def test_compiled_updates_keep_every_signal_of_the_reference_formulation(short_m
     monkeypatch.setattr(ContactKinematics, "matrix_at", ContactKinematics.reference_matrix_at)
     monkeypatch.setattr(StiffnessSchedule, "fast_values", StiffnessSchedule.values)
     monkeypatch.setattr(MeshFriction, "fast_forces", MeshFriction.forces)
+    monkeypatch.setattr(MeshUpdates, "values_and_forces", MeshUpdates.reference)
     ref = run_variant(short_model7, reduced_source=annulus_source)
     assert ref.ok, ref.meta.get("reason")
     lc = short_model7.gearbox.load_case
@@ -98,3 +100,31 @@ def test_plain_python_rhs_equals_the_compiled_one(gearbox):
     for t in (0.0, 0.2, 0.55):
         a, b = compiled(t, y), plain(t, y)
         assert np.max(np.abs(a - b)) <= 1e-10 * np.max(np.abs(a))
+
+
+def test_fused_mesh_updates_equal_their_parts(model1):
+    """One compiled call per step (MeshUpdates) gives the schedule's factors and the friction forces."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+
+    mbs = exu.SystemContainer().AddSystem()
+    model = build_star_gearbox(mbs, model1)
+    mbs.Assemble()
+    pre_step = mbs.GetPreStepUserFunction()["function"]
+    fused = [f for f in getattr(pre_step, "functions", [pre_step]) if isinstance(f, MeshUpdates)]
+    assert len(fused) == 1
+    updates = fused[0]
+    updates.bind(mbs)
+    rng = np.random.default_rng(11)
+    n = mbs.systemData.ODE2Size()
+    aux = updates._index[0]
+    for t in (0.01, 0.3, 0.55):
+        q, q_t = rng.normal(0, 1e-3, n), rng.normal(0, 300, n)
+        q[aux] = rng.uniform(-1e-4, 5e-4, aux.size)
+        q_t[aux] = rng.normal(0, 1e-3, aux.size)
+        factors, forces = (x.copy() for x in updates.values_and_forces(t, q, q_t))
+        ref_factors, ref_forces = updates.reference(t, q, q_t)
+        assert len(factors) == len(model.contacts) // 2  # helix halves share their factor
+        assert np.max(np.abs(factors - ref_factors)) < 1e-12
+        assert np.max(np.abs(forces - ref_forces)) < 1e-9 * np.max(np.abs(ref_forces))

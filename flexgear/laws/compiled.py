@@ -11,7 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["impact_normal_force", "backlash_linear_force", "mesh_friction_forces", "periodic_values", "ramp_state"]
+__all__ = ["impact_normal_force", "backlash_linear_force", "mesh_friction_forces", "periodic_values", "ramp_state",
+           "interpolated_columns", "mesh_step"]
 
 
 @njit(cache=True)
@@ -47,12 +48,15 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
     q = np.zeros(n_q)
     val = np.empty(3)
     for i in range(n_c):  # explicit loops: no temporary arrays per contact (a per-step hot path)
+        x = 2.0 * math.pi * phase[i]
+        c1, s1 = math.cos(x), math.sin(x)
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
         for k in range(3):
-            v = means[k, i]
-            for h in range(n_h):
-                x = 2.0 * math.pi * (h + 1) * phase[i]
-                v += cos_c[k, i, h] * math.cos(x) + sin_c[k, i, h] * math.sin(x)
-            val[k] = v
+            val[k] = means[k, i]
+        for h in range(n_h):
+            for k in range(3):
+                val[k] += cos_c[k, i, h] * ch + sin_c[k, i, h] * sh
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
         normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
                                      depth[i])
         spin_rate = 0.0
@@ -69,9 +73,12 @@ def periodic_values(phase, means, cos_c, sin_c):  # pragma: no cover - compiled
     """Fourier series values per contact, as laws.contact.periodic_value: cos_c, sin_c (n_contacts, n_harmonics)."""
     out = means.copy()
     for i in range(phase.shape[0]):
+        x = 2.0 * math.pi * phase[i]
+        c1, s1 = math.cos(x), math.sin(x)
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence
         for h in range(cos_c.shape[1]):
-            x = 2.0 * math.pi * (h + 1) * phase[i]
-            out[i] += cos_c[i, h] * math.cos(x) + sin_c[i, h] * math.sin(x)
+            out[i] += cos_c[i, h] * ch + sin_c[i, h] * sh
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
     return out
 
 
@@ -107,3 +114,26 @@ def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi
         i1 = (i0 + 1) % n_grid
         for m in range(n_modes[j]):
             matrix[rows[j], first[j] + m] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])
+
+
+@njit(cache=True)
+def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law, means, cos_c, sin_c,  # noqa: PLR0913
+              sliding_rows, spin_rows, factor_rows, force):  # pragma: no cover - compiled
+    """One step's mesh updates in one call: stiffness factors s(phi) of the contacts ``factor_rows``
+    (returned) and the friction forces on the frame coordinates (written into ``force[:frames.size]``).
+
+    phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
+    (:func:`ramp_state`); ``q``, ``q_t``: all ODE2 coordinates and rates, ``aux``: the contacts'
+    deflection coordinates, ``frames``: the bodies' frame coordinates; ``law`` rows: stiffness,
+    exponent, damping_max, penetration depth, mu, v_reg. Same numbers as :func:`periodic_values` plus
+    :func:`mesh_friction_forces`.
+    """
+    theta = drive_speed * ramp_state(t, ramp_time)[0]
+    phase = rate * theta - offset
+    q_frames = np.empty(frames.size)
+    for j in range(frames.size):
+        q_frames[j] = q_t[frames[j]]
+    friction = mesh_friction_forces(phase, q[aux], q_t[aux], q_frames, law[0], law[1], law[2], law[3], means,
+                                    cos_c, sin_c, law[4], law[5], sliding_rows, spin_rows)
+    force[:frames.size] = friction
+    return periodic_values(phase[factor_rows], means[0][factor_rows], cos_c[0][factor_rows], sin_c[0][factor_rows])
