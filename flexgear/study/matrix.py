@@ -1,7 +1,8 @@
 """Variant matrix runner: run variants in parallel, time them, resume, then screen (section 2.2).
 
 ``run_matrix`` runs every variant file in a worker process (a local process pool, or a Dask
-distributed cluster given by its scheduler address), writes each run with
+distributed cluster given by its scheduler address), the runs with the most flexible bodies first
+(the longest start first, so that the last ones overlap), writes each run with
 :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with copies of
 its input files (``inputs/``), and then writes
 
@@ -214,6 +215,12 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     return table
 
 
+def _flexible_bodies(variant: Variant) -> int:
+    """Flexible bodies of a variant (planets count each): the measure of its run time used to order the runs."""
+    planets = variant.gearbox.gears.planet_count
+    return sum((planets if c == "planets" else 1) for c, form in variant.components.items() if form == "flexible")
+
+
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
                runner: Runner | None = None) -> pd.DataFrame:
@@ -230,6 +237,7 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     metas: dict[str, dict] = {}
     resumed: set[str] = set()
     tasks: list[_Task] = []
+    cost: dict[str, int] = {}
     settings: ScreeningSettings | None = None
     for path in map(Path, variant_paths):
         try:
@@ -259,6 +267,8 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
                 _say(progress, f"{name}: unchanged (hash {h}), skipped")
                 continue
         tasks.append(_Task(name, str(path), str(run_dir), h))
+        cost[name] = _flexible_bodies(variant)
+    tasks.sort(key=lambda t: -cost[t.name])  # longest first: the last runs overlap (stable for ties)
     metas.update(_execute(tasks, t_end_s, workers, scheduler, runner, progress))
     table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])
     write_table(table, out_dir / "matrix_results")
