@@ -41,14 +41,9 @@ class MeshUpdates:
 
     def values_and_forces(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Stiffness factors of the schedule's variables and friction forces on the frames (compiled)."""
-        from flexgear.laws.compiled import mesh_step
-
-        aux, frames = self._index
-        f = self.friction
-        factors = mesh_step(float(t), f.ramp_time, f.drive_speed, f.phase_rate, f.offsets, q, q_t, aux, frames,
-                            self.law, f._means, f._cos, f._sin, f.sliding_rows, f.spin_rows, self.factor_rows,
-                            self._force)
-        return factors, self._force[:frames.size]
+        head, tail = self._args
+        factors = self._kernel(float(t), *head, q, q_t, *tail)
+        return factors, self._force[:self._index[1].size]
 
     def reference(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Same as :meth:`values_and_forces` with the two parts' numpy reference implementations."""
@@ -65,12 +60,19 @@ class MeshUpdates:
                        np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
                                        for b in f.bodies]).astype(np.int64))
         self._force = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")))
+        from flexgear.laws.compiled import mesh_step
+
+        # the kernel and its arguments, looked up once (this runs every step)
+        self._kernel = mesh_step
+        self._args = ((f.ramp_time, f.drive_speed, f.phase_rate, f.offsets),
+                      (*self._index, self.law, f._means, f._cos, f._sin, f.sliding_rows, f.spin_rows,
+                       self.factor_rows, self._force))
 
     def __call__(self, mbs, t: float) -> bool:
         if self._index is None:
             self.bind(mbs)
-        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
-        factors, _ = self.values_and_forces(t, q, q_t)
+        data = mbs.systemData
+        factors, _ = self.values_and_forces(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
         for var, value in zip(self.schedule.variables, factors.tolist(), strict=True):
             var.SetValue(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
