@@ -11,8 +11,8 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force",
-           "mesh_friction_forces", "periodic_values", "ramp_state"]
+__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces",
+           "periodic_values", "ramp_state", "interpolated_columns", "mesh_step"]
 
 
 @njit(cache=True)
@@ -53,24 +53,30 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
     (series index 0: stiffness factor, 1: sliding direction kappa, 2: lever lambda [m]) and
     laws.contact.friction_forces (f = mu F tanh(Omega lambda_mean / v_reg) (kappa, lambda)).
     """
-    n_c, n_h = cos_c.shape[1], cos_c.shape[2]
-    spin_rate = spin_rows @ q_t
-    q = np.zeros(sliding_rows.shape[1])
-    for i in range(n_c):
-        val = np.empty(3)
+    n_c, n_h, n_q = cos_c.shape[1], cos_c.shape[2], sliding_rows.shape[1]
+    q = np.zeros(n_q)
+    val = np.empty(3)
+    for i in range(n_c):  # explicit loops: no temporary arrays per contact (a per-step hot path)
+        x = 2.0 * math.pi * phase[i]
+        c1, s1 = math.cos(x), math.sin(x)
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
         for k in range(3):
-            v = means[k, i]
-            for h in range(n_h):
-                x = 2.0 * math.pi * (h + 1) * phase[i]
-                v += cos_c[k, i, h] * math.cos(x) + sin_c[k, i, h] * math.sin(x)
-            val[k] = v
+            val[k] = means[k, i]
+        for h in range(n_h):
+            for k in range(3):
+                val[k] += cos_c[k, i, h] * ch + sin_c[k, i, h] * sh
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
         if linear:
             normal = linear_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], damping_max[i])
         else:
             normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
                                          depth[i])
-        f = mu[i] * normal * math.tanh(spin_rate[i] * means[2, i] / reg[i])
-        q -= sliding_rows[i] * (f * val[1]) + spin_rows[i] * (f * val[2])
+        spin_rate = 0.0
+        for j in range(n_q):
+            spin_rate += spin_rows[i, j] * q_t[j]
+        f = mu[i] * normal * math.tanh(spin_rate * means[2, i] / reg[i])
+        for j in range(n_q):
+            q[j] -= sliding_rows[i, j] * (f * val[1]) + spin_rows[i, j] * (f * val[2])
     return q
 
 
@@ -79,9 +85,12 @@ def periodic_values(phase, means, cos_c, sin_c):  # pragma: no cover - compiled
     """Fourier series values per contact, as laws.contact.periodic_value: cos_c, sin_c (n_contacts, n_harmonics)."""
     out = means.copy()
     for i in range(phase.shape[0]):
+        x = 2.0 * math.pi * phase[i]
+        c1, s1 = math.cos(x), math.sin(x)
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence
         for h in range(cos_c.shape[1]):
-            x = 2.0 * math.pi * (h + 1) * phase[i]
-            out[i] += cos_c[i, h] * math.cos(x) + sin_c[i, h] * math.sin(x)
+            out[i] += cos_c[i, h] * ch + sin_c[i, h] * sh
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
     return out
 
 
@@ -97,3 +106,46 @@ def ramp_state(t: float, T: float) -> tuple[float, float, float, float]:
         return t - 0.5 * T, 1.0, 0.0, 0.0
     d = t / T
     return T * (d**3 - 0.5 * d**4), d * d * (3.0 - 2.0 * d), 6.0 * d * (1.0 - d) / T, (6.0 - 12.0 * d) / T**2
+
+
+@njit(cache=True)
+def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi, spin):  # pragma: no cover
+    """Write each column set's coefficients at spin angle ``theta`` [rad] into ``matrix`` (in place).
+
+    Compiled twin of flexgear.mbs.contact_kinematics.ContactKinematics.reference_matrix_at: set j's
+    coefficients c(alpha) at alpha = psi_j - spin_j theta, linearly interpolated on the periodic grid
+    ``tables[j]`` (n_grid, width), times signs_j, go to row rows_j, columns first_j .. first_j + n_modes_j.
+    """
+    n_grid = tables.shape[1]
+    two_pi = 2.0 * math.pi
+    for j in range(rows.shape[0]):
+        a = ((psi[j] - spin[j] * theta) % two_pi) * (n_grid / two_pi)
+        fl = math.floor(a)
+        w = a - fl
+        i0 = int(fl) % n_grid
+        i1 = (i0 + 1) % n_grid
+        for m in range(n_modes[j]):
+            matrix[rows[j], first[j] + m] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])
+
+
+@njit(cache=True)
+def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law, means, cos_c, sin_c,  # noqa: PLR0913
+              sliding_rows, spin_rows, factor_rows, force, linear=False):  # pragma: no cover - compiled
+    """One step's mesh updates in one call: stiffness factors s(phi) of the contacts ``factor_rows``
+    (returned) and the friction forces on the frame coordinates (written into ``force[:frames.size]``).
+
+    phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
+    (:func:`ramp_state`); ``q``, ``q_t``: all ODE2 coordinates and rates, ``aux``: the contacts'
+    deflection coordinates, ``frames``: the bodies' frame coordinates; ``law`` rows: stiffness,
+    exponent, damping_max, penetration depth, mu, v_reg. Same numbers as :func:`periodic_values` plus
+    :func:`mesh_friction_forces`.
+    """
+    theta = drive_speed * ramp_state(t, ramp_time)[0]
+    phase = rate * theta - offset
+    q_frames = np.empty(frames.size)
+    for j in range(frames.size):
+        q_frames[j] = q_t[frames[j]]
+    friction = mesh_friction_forces(phase, q[aux], q_t[aux], q_frames, law[0], law[1], law[2], law[3], means,
+                                    cos_c, sin_c, law[4], law[5], sliding_rows, spin_rows, linear)
+    force[:frames.size] = friction
+    return periodic_values(phase[factor_rows], means[0][factor_rows], cos_c[0][factor_rows], sin_c[0][factor_rows])

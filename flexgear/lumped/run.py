@@ -30,6 +30,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numba
@@ -44,7 +45,7 @@ from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import GearboxSpec, spec_hash
 from flexgear.theory import theory
 
-__all__ = ["LumpedModel", "build_lumped_model", "run_lumped", "static_mesh_forces"]
+__all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces"]
 
 # layout of the float parameter vector handed to the compiled kernel
 _MU, _W_IN, _T_RAMP, _R_C, _T_LOAD, _LOAD_SIGN, _NFP = range(7)
@@ -357,3 +358,38 @@ def static_mesh_forces(spec: GearboxSpec) -> tuple[np.ndarray, np.ndarray]:
     forces = s.mesh_stiffness * (s.mesh_G @ q)
     n = s.params.planet_count
     return forces[:n], forces[n:]
+
+
+class LumpedRHS:
+    """The compiled right-hand side dy/dt = f(t, y) of :func:`_integrate`, callable from Python.
+
+    ``y`` = (free coordinates, their rates), as in the kernel. For other integrators
+    (``scipy.integrate.solve_ivp``) driving the same compiled equations; ``record(t, y)`` gives the
+    row the kernel records (input/output speed [rad/s], drive torque [N m], mesh forces [N], bearing
+    accelerations [m/s^2]).
+    """
+
+    def __init__(self, model: LumpedModel, kernel: Callable | None = None):
+        self.model, self.args = model, _kernel_args(model)
+        self.kernel = _evaluate if kernel is None else kernel
+        n, nm = model.system.mass.size, model.system.mesh_stiffness.size
+        self.nf = model.free.size
+        self._work = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(nm), np.zeros(7))
+
+    def _eval(self, t: float, y: np.ndarray) -> None:
+        self.kernel(float(t), np.ascontiguousarray(y, dtype=float), *self.args, *self._work)
+
+    def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
+        self._eval(t, y)
+        return np.concatenate([y[self.nf:], self._work[2][self.model.free]])
+
+    def record(self, t: float, y: np.ndarray) -> np.ndarray:
+        self._eval(t, y)
+        forces, out = self._work[4], self._work[5]
+        return np.concatenate([out[:3], forces, out[3:7]])
+
+
+def lumped_rhs(model: LumpedModel, compiled: bool = True) -> LumpedRHS:
+    """f(t, y) of the lumped model on its compiled kernel (``compiled=False``: the same kernel
+    interpreted by Python, numba's ``py_func``: a plain-Python/numpy baseline)."""
+    return LumpedRHS(model, None if compiled else _evaluate.py_func)

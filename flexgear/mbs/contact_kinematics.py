@@ -92,9 +92,20 @@ class ContactKinematics:
         self.first = np.array([column_offsets[c.body] for c in columns])
         self.bodies = [c.body for c in columns]
         self.matrix = base.copy()
+        self._blocks = constraint.blocks_with_rows(self.rows)  # only these change with the spin
 
     def matrix_at(self, t: float) -> np.ndarray:
-        """The constraint's scaling matrix (frame + modal columns) at time t."""
+        """The constraint's scaling matrix (frame + modal columns) at time t (compiled; the returned
+        array is overwritten by the next call)."""
+        from flexgear.laws.compiled import interpolated_columns, ramp_state
+
+        theta = self.drive_speed * ramp_state(float(t), self.ramp_time)[0]
+        interpolated_columns(self.matrix, theta, self.tables, self.rows, self.first, self.n_modes, self.signs,
+                             self.psi, self.spin)
+        return self.matrix
+
+    def reference_matrix_at(self, t: float) -> np.ndarray:
+        """Same as :meth:`matrix_at` in numpy (the reference implementation); a new array."""
         theta = float(drive_angle(t, self.ramp_time, self.drive_speed))
         alpha = np.mod(self.psi - self.spin * theta, 2 * np.pi) * (self.n_grid / (2 * np.pi))
         i0 = np.floor(alpha).astype(int) % self.n_grid
@@ -102,14 +113,14 @@ class ContactKinematics:
         i1 = (i0 + 1) % self.n_grid
         k = np.arange(len(alpha))
         values = (1 - w) * self.tables[k, i0] + w * self.tables[k, i1]
-        out = self.matrix
+        out = self.matrix.copy()
         for j in range(len(alpha)):
             out[self.rows[j], self.first[j]:self.first[j] + self.n_modes[j]] = (
                 self.signs[j] * values[j, :self.n_modes[j]])
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        self.constraint.set(mbs, self.matrix_at(t))
+        self.constraint.set(mbs, self.matrix_at(t), blocks=self._blocks)
         return True
 
 

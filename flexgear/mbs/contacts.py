@@ -160,9 +160,17 @@ class MeshConstraint:
                 offset=matrix[rows] @ q_ref))
             self.blocks.append((block, rows, np.ix_(rows, cols)))
 
-    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
-        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
-        for block, rows, sub in self.blocks:
+    def blocks_with_rows(self, rows: np.ndarray) -> list[int]:
+        """Indices of the blocks (gear pairs) that hold any of ``rows``."""
+        return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
+
+    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None,
+            blocks: list[int] | None = None) -> None:
+        """Write G (and the offset, if given) into the constraints (a pre-step hot path); with
+        ``blocks`` (:meth:`blocks_with_rows`), only into those."""
+        for i, (block, rows, sub) in enumerate(self.blocks):
+            if blocks is not None and i not in blocks:
+                continue
             mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
             if offset is not None:
                 mbs.SetObjectParameter(block, "offset", offset[rows])
@@ -201,20 +209,30 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
                                       initialCoordinates_t=[0.0] * n_c))
     constraint = MeshConstraint(mbs, bodies, contacts, aux, gradient, q_ref, modal_offsets or {})
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
-    springs, laws, factors = [], [], []
+    springs, laws = [], []
+    shared: dict[tuple, tuple[Any, GearContact]] = {}  # one factor per distinct s(phi(t)): helix halves share it
     varying = any(np.any(c.stiffness.cos_coeffs) or np.any(c.stiffness.sin_coeffs) for c in contacts)
     for i, c in enumerate(contacts):
         spring = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=c.name, markerNumbers=[m_ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
-        if varying:
-            factors.append(esym.Real(f"mesh_stiffness_factor_{id(mbs)}_{spring}", 1.0))
-        law = _normal_law_function(c, factors[-1] if varying else 1.0, esym)
+        key = _schedule_key(c)
+        if varying and key not in shared:
+            shared[key] = (esym.Real(f"mesh_stiffness_factor_{id(mbs)}_{spring}", 1.0), c)
+        law = _normal_law_function(c, shared[key][0] if varying else 1.0, esym)
         laws.append(CreateSymbolicUserFunction(mbs, law, "springForceUserFunction", spring))
         mbs.SetObjectParameter(spring, "springForceUserFunction", laws[-1])
         springs.append(spring)
+    factors = [v for v, _ in shared.values()]
     _keep_alive(mbs, laws + factors)
-    schedule = StiffnessSchedule(contacts, ramp_time, drive_speed, factors) if varying else None
+    schedule = (StiffnessSchedule([c for _, c in shared.values()], ramp_time, drive_speed, factors)
+                if varying else None)
     return springs, aux, constraint, gradient, schedule
+
+
+def _schedule_key(c: GearContact) -> tuple:
+    """What the stiffness factor s(phi(t)) of a contact depends on (equal keys: equal factors at all t)."""
+    return (float(c.stiffness.mean), tuple(np.ravel(c.stiffness.cos_coeffs)), tuple(np.ravel(c.stiffness.sin_coeffs)),
+            float(c.phase_offset), float(c.phase_per_drive_angle))
 
 
 def _assemble_rows(bodies: list[Body], contacts: list[GearContact], row: int) -> np.ndarray:
@@ -245,7 +263,9 @@ class StiffnessSchedule:
 
     The factor is a function of time only (the mesh phase follows the prescribed drive angle), so
     setting it for the step's end time before the step is exact; evaluating it once per step in numpy
-    instead of inside every compiled law call halves the cost of a run.
+    instead of inside every compiled law call halves the cost of a run. ``contacts[i]`` gives the
+    factor of ``variables[i]``; contacts with equal series and phase (the helix halves of one mesh)
+    share one variable (:func:`add_gear_contacts`).
     """
 
     def __init__(self, contacts: list[GearContact], ramp_time: float, drive_speed: float, variables: list):
@@ -265,9 +285,9 @@ class StiffnessSchedule:
 
     def fast_values(self, t: float) -> np.ndarray:
         """Same as :meth:`values`, compiled (flexgear.laws.compiled.periodic_values)."""
-        from flexgear.laws.compiled import periodic_values
+        from flexgear.laws.compiled import periodic_values, ramp_state
 
-        phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        phase = self.rate * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0]) - self.offsets
         return periodic_values(phase, self._means, self._cos, self._sin)
 
     def __call__(self, mbs, t: float) -> bool:
@@ -335,9 +355,9 @@ class MeshFriction:
 
     def fast_forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
         """Same as :meth:`forces`, compiled (flexgear.laws.compiled.mesh_friction_forces)."""
-        from flexgear.laws.compiled import mesh_friction_forces
+        from flexgear.laws.compiled import mesh_friction_forces, ramp_state
 
-        phase = self.phase_rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
+        phase = self.phase_rate * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0]) - self.offsets
         law = self.law
         return mesh_friction_forces(
             phase, delta, delta_t, q_t, law.stiffness, law.exponent, law.damping_max, law.penetration_depth,

@@ -197,12 +197,16 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
     "failed" and the reason (see :class:`RunGuard`).
     """
     import exudyn as exu
+    from threadpoolctl import threadpool_limits
 
     t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
     meta = _meta(variant, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     extra: dict[str, pd.DataFrame] = {}
+    # small BLAS calls only (mode-shape fits, post-processing): threads contend on a shared machine
+    # (model 7's build: 6-7 s CPU with 2 OpenBLAS threads, 0.5-1.4 s with one; benchmarks/profile_mbs.py)
+    blas = threadpool_limits(limits=1, user_api="blas")
     try:
         if not (t_end > 0 and math.isfinite(t_end)):
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
@@ -232,5 +236,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         signals = None
         meta.update(status="failed", reason=f"{type(exc).__name__}: {exc}",
                     traceback=traceback.format_exc(limit=5))
+    finally:
+        blas.restore_original_limits()
     meta.update(wall_time_s=time.perf_counter() - wall0, cpu_time_s=time.process_time() - cpu0)
     return RunResult(meta, signals, extra)

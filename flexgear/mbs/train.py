@@ -120,7 +120,12 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         g, offset = train.carrier.matrix_and_offset(0.0)
         constraint.set(mbs, g, offset)
         pre_steps.append(train.carrier)  # before friction: friction uses the turned sliding rows
-    if train.friction is not None:
+    if train.friction is not None and schedule is not None and carrier is None:
+        from flexgear.mbs.mesh_updates import MeshUpdates
+
+        pre_steps.remove(schedule)  # both in one compiled call per step
+        pre_steps.append(MeshUpdates(schedule, train.friction))
+    elif train.friction is not None:
         pre_steps.append(train.friction)
     if pre_steps:
         from flexgear.mbs.contact_kinematics import PreStepChain

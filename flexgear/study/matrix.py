@@ -6,7 +6,8 @@ gearbox file, not their paths: a worker needs no access to the caller's files. T
 variant from that content, builds (or finds in its own cache, ``FLEXGEAR_CACHE_DIR``, keyed by hash) the
 meshes and reduced bodies, runs it and sends the :class:`~flexgear.results.RunResult` back; the caller
 writes it with :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with
-copies of its input files (``inputs/``), as each run finishes. Then it writes
+copies of its input files (``inputs/``), as each run finishes (the runs with the most flexible bodies first: the longest start first, so that
+the last ones overlap). Then it writes
 
 - ``matrix_results.csv`` / ``.parquet``: one row per variant: status and reason, components,
   simulated time, the runner's wall and CPU time of the run (model build + simulation), the
@@ -241,6 +242,12 @@ def _check_reference(reference: str, names: Sequence[str]) -> None:
                          f"({', '.join(names)}); allowed: one of them, or '' for the study's mode")
 
 
+def _flexible_bodies(variant: Variant) -> int:
+    """Flexible bodies of a variant (planets count each): the measure of its run time used to order the runs."""
+    planets = variant.gearbox.gears.planet_count
+    return sum((planets if c == "planets" else 1) for c, form in variant.components.items() if form == "flexible")
+
+
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
                runner: Runner | None = None, time_budget_s: float | None = None,
@@ -262,6 +269,7 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     metas: dict[str, dict] = {}
     resumed: set[str] = set()
     tasks: list[RunTask] = []
+    cost: dict[str, int] = {}
     settings: ScreeningSettings | None = None
     for path in map(Path, variant_paths):
         try:
@@ -290,6 +298,8 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
                 _say(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
                 continue
         tasks.append(task)
+        cost[name] = _flexible_bodies(variant)
+    tasks.sort(key=lambda t: -cost[t.name])  # longest first: the last runs overlap (stable for ties)
     _check_reference(reference if reference is not None else (settings.reference if settings else ""), names)
     metas.update(_execute(tasks, workers, scheduler, runner, out_dir, progress))
     table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])

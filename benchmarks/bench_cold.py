@@ -1,0 +1,91 @@
+"""Benchmark (issue 16): cold coarse meshes and reductions, and the peak memory of the quick ``make``.
+
+Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold make] [--make-target quick]
+
+- cold: ``python -m flexgear.cli meshes --level coarse`` (OCC solids, Netgen meshes and reduced bodies
+  of every component) in a fresh, empty temporary ``FLEXGEAR_CACHE_DIR``: wall time (goal <= 90 s on
+  the 2-core machine) and the peak memory of the process tree;
+- make: ``make <target> PY=<this python> RESULTS=<temporary folder>`` in the project folder, again with
+  an empty cache folder (what a first ``make`` does): wall time and peak memory (goal <= 2 GB).
+
+Peak memory is the largest maximum resident set size among the command's processes and their
+descendants (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process that runs only that command).
+Each round uses its own empty folders, removed afterwards.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from speed_common import figure_line, load_average
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def _child(cmd: list[str]) -> None:
+    """Wrapper mode: run ``cmd``, print JSON with its wall time, exit code and peak RSS [bytes]."""
+    t0 = time.perf_counter()
+    code = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    wall = time.perf_counter() - t0
+    rss_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss  # Linux: KiB
+    tail = code.stderr.strip().splitlines()[-3:] if code.returncode else []
+    print(json.dumps({"wall_s": wall, "returncode": code.returncode, "max_rss_bytes": rss_kib * 1024,
+                      "stderr_tail": tail}))
+
+
+def measure(cmd: list[str], cache_dir: Path) -> dict:
+    """Run ``cmd`` through the wrapper with an empty ``FLEXGEAR_CACHE_DIR``; its wall time and peak RSS."""
+    env = dict(os.environ, FLEXGEAR_CACHE_DIR=str(cache_dir))
+    out = subprocess.run([sys.executable, __file__, "--child", *cmd], env=env, capture_output=True, text=True,
+                         check=True)
+    res = json.loads(out.stdout.strip().splitlines()[-1])
+    if res["returncode"] != 0:
+        sys.exit(f"{' '.join(cmd)} failed ({res['returncode']}): {res['stderr_tail']}")
+    return res
+
+
+def main() -> None:
+    if len(sys.argv) > 1 and sys.argv[1] == "--child":
+        _child(sys.argv[2:])
+        return
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--sections", nargs="+", default=["cold", "make"], choices=["cold", "make"])
+    ap.add_argument("--make-target", default="quick")
+    a = ap.parse_args()
+    print(f"bench_cold: {a.repeat} rounds of {a.sections}; {load_average()}", flush=True)
+    commands = {"cold": [sys.executable, "-m", "flexgear.cli", "meshes", "--level", "coarse"]}
+    walls: dict[str, list[float]] = {s: [] for s in a.sections}
+    rss: dict[str, list[float]] = {s: [] for s in a.sections}
+    for i in range(a.repeat):
+        for section in a.sections:
+            folder = Path(tempfile.mkdtemp(prefix=f"flexgear-bench-{section}-"))
+            try:
+                cmd = commands.get(section) or ["make", a.make_target, f"PY={sys.executable}",
+                                                f"RESULTS={folder / 'results'}"]
+                res = measure(cmd, folder / "cache")
+            finally:
+                shutil.rmtree(folder, ignore_errors=True)
+            walls[section].append(res["wall_s"])
+            rss[section].append(res["max_rss_bytes"] / 1e9)
+            print(f"round {i + 1} {section}: wall {res['wall_s']:.1f} s, peak RSS {rss[section][-1]:.2f} GB; "
+                  f"{load_average()}", flush=True)
+    print()
+    goals = {"cold": ("<= 90 s", ""), "make": ("", "<= 2 GB")}
+    for section in a.sections:
+        print(figure_line(f"{section} wall [s]", walls[section]) + f"   goal {goals[section][0] or '-'}")
+        print(figure_line(f"{section} peak RSS [GB]", rss[section], "GB") + f"   goal {goals[section][1] or '-'}")
+    print(f"after: {load_average()}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,130 @@
+"""Profile one multibody run: Exudyn's CPU-time statistics per solver part, Newton counts, and cProfile.
+
+Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
+
+Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
+stiffness and no friction, benchmarks/speed_common.floor_variant), warmed with a 1e-4 s run, then
+solved with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
+case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
+step (the ``Python`` timer is the pre-step user functions), Newton iterations and Jacobians per step;
+with ``--cprofile`` the top Python functions. ``--blas-threads 2`` shows what BLAS threads cost the build.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import cProfile
+import io
+import pstats
+import re
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from speed_common import floor_variant, load_average
+
+from flexgear.mbs.gearbox import build_star_gearbox
+from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
+from flexgear.spec import load_variant
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def solve(variant, t_end: float, timers: bool, profile: bool) -> tuple[str, float, float]:
+    """Build and solve; returns Exudyn's printed statistics, wall and CPU time of the solve."""
+    import exudyn as exu
+
+    mbs = exu.SystemContainer().AddSystem()
+    b0, bc0 = time.perf_counter(), time.process_time()
+    model = build_star_gearbox(mbs, variant)
+    add_gearbox_sensors(mbs, model)
+    mbs.Assemble()
+    if timers:
+        print(f"  build: wall {time.perf_counter() - b0:.2f} s, cpu {time.process_time() - bc0:.2f} s")
+    settings = simulation_settings(variant, t_end, False)
+    if timers:
+        settings.timeIntegration.verboseMode = 1
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", DeprecationWarning)
+            settings.displayComputationTime = True
+            settings.displayStatistics = True
+    prof = cProfile.Profile() if profile else None
+    w0, c0 = time.perf_counter(), time.process_time()
+    with _captured_stdout() as out:
+        if prof:
+            prof.enable()
+        mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha)
+        if prof:
+            prof.disable()
+    wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+    text = out.getvalue()
+    if prof:
+        s = io.StringIO()
+        pstats.Stats(prof, stream=s).sort_stats("tottime").print_stats(12)
+        text += s.getvalue()
+    return text, wall, cpu
+
+
+@contextlib.contextmanager
+def _captured_stdout():
+    """Exudyn prints from C++ through Python's sys.stdout: collect it."""
+    buf, old = io.StringIO(), sys.stdout
+    sys.stdout = buf
+    try:
+        yield buf
+    finally:
+        sys.stdout = old
+
+
+def summary(text: str, steps: int, cpu: float) -> list[str]:
+    """The timer lines as CPU seconds and microseconds per step, Newton counts per step.
+
+    Exudyn's timers measure wall time; on a shared machine that includes waiting for a core, so
+    each timer's share of the measured time is applied to the process's CPU time of the solve.
+    """
+    total = re.search(r"total time\s*=\s*([\d.eE+-]+)", text)
+    lines = []
+    if total:
+        t = cpu
+        for name, pct in re.findall(r"^\s*(\w+)\s*=\s*([\d.eE+-]+)%", text, flags=re.M):
+            sec = t * float(pct) / 100
+            if sec > 1e-3 * t:
+                lines.append(f"  {name:<20s} {sec:8.3f} s  {1e6 * sec / steps:8.1f} us/step  {float(pct):5.1f} %")
+    for label, key in (("Newton iterations", "Newton iterations"), ("Jacobians", "Newton Jacobians")):
+        m = re.search(rf"{key}:\s*(\d+)", text)
+        if m:
+            lines.append(f"  {label:<20s} {int(m.group(1)):8d}    {int(m.group(1)) / steps:8.3f} per step")
+    return lines
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("cases", nargs="+", help="variant names in model_variants/ (model1, model7, ...) or 'floor'")
+    ap.add_argument("--t-end", type=float, default=0.02)
+    ap.add_argument("--cprofile", action="store_true")
+    ap.add_argument("--variants-dir", default=str(ROOT / "model_variants"))
+    ap.add_argument("--blas-threads", type=int, default=1,
+                    help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
+    a = ap.parse_args()
+    from threadpoolctl import threadpool_limits
+
+    threadpool_limits(limits=a.blas_threads, user_api="blas")
+    folder = Path(a.variants_dir)
+    print(f"profile_mbs: t_end {a.t_end} s; {load_average()}", flush=True)
+    for case in a.cases:
+        variant = floor_variant(load_variant(folder / "model1.toml")) if case == "floor" else \
+            load_variant(folder / f"{case}.toml")
+        solve(variant, 1e-4, False, False)
+        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile)
+        steps = round(a.t_end / variant.gearbox.load_case.step_size_s)
+        print(f"{case}: solve wall {wall:.2f} s, cpu {cpu:.2f} s ({1e6 * cpu / steps:.1f} us/step cpu); "
+              f"{load_average()}")
+        print("\n".join(summary(text, steps, cpu)))
+        if a.cprofile:
+            print(text[text.find("Ordered by"):])
+
+
+if __name__ == "__main__":
+    main()

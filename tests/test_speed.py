@@ -1,0 +1,139 @@
+"""The speed levers of issue 16 change no result: compiled per-step updates against the numpy reference
+formulation, the lumped right-hand side for other integrators against the project's own RK4.
+
+No timings here (benchmarks/bench_speed.py, benchmarks/bench_lumped_scipy.py measure them).
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import VARIANTS
+from standins import annulus_source
+
+from flexgear.lumped.run import build_lumped_model, lumped_rhs, run_lumped
+from flexgear.mbs.contact_kinematics import ContactKinematics, ModalColumn
+from flexgear.mbs.contacts import MeshFriction, StiffnessSchedule
+from flexgear.mbs.mesh_updates import MeshUpdates
+from flexgear.mbs.run import run_variant
+from flexgear.spec import load_variant
+from flexgear.study.agreement import signal_agreement
+
+
+class _Blocks:
+    """Stand-in for flexgear.mbs.contacts.MeshConstraint: only what ContactKinematics asks at construction."""
+
+    def blocks_with_rows(self, rows):
+        return [0]
+
+
+def test_compiled_modal_columns_match_the_numpy_reference():
+    rng = np.random.default_rng(3)
+    columns = [ModalColumn(row, body, sign, psi, spin, rng.normal(size=(720, m)))
+               for row, body, sign, psi, spin, m in ((0, "sun", 1.0, 0.3, 1.0, 5), (1, "ring", -1.0, 2.1, -0.3, 7),
+                                                     (1, "sun", 1.0, -1.2, 1.0, 5))]
+    kin = ContactKinematics(_Blocks(), rng.normal(size=(2, 30)), columns, {"sun": 12, "ring": 18}, 0.5, 628.3)
+    for t in (0.0, 1e-5, 0.1234, 0.49999, 0.5, 0.61):
+        ref = kin.reference_matrix_at(t)
+        # same formula; the drive angle (~160 rad) is summed in another order: round-off ~1e-14 rad x grid slope
+        assert np.max(np.abs(kin.matrix_at(t) - ref)) < 1e-9 * np.max(np.abs(ref))
+
+
+@pytest.fixture(scope="module")
+def short_model7():
+    """Model 7 (every component flexible, stand-in annulus bodies) on a shortened load case."""
+    v = load_variant(VARIANTS / "model7.toml")
+    g = v.gearbox
+    g = g.with_changes(load_case=dataclasses.replace(g.load_case, ramp_time_s=0.006, end_time_s=0.012))
+    return dataclasses.replace(v, gearbox=g)
+
+
+def test_compiled_updates_keep_every_signal_of_the_reference_formulation(short_model7, monkeypatch):
+    """Issue 16's rule: means within 0.1 %, 1x mesh amplitudes within 2 % (flexgear.study.agreement)."""
+    fast = run_variant(short_model7, reduced_source=annulus_source)
+    assert fast.ok, fast.meta.get("reason")
+    monkeypatch.setattr(ContactKinematics, "matrix_at", ContactKinematics.reference_matrix_at)
+    monkeypatch.setattr(StiffnessSchedule, "fast_values", StiffnessSchedule.values)
+    monkeypatch.setattr(MeshFriction, "fast_forces", MeshFriction.forces)
+    monkeypatch.setattr(MeshUpdates, "values_and_forces", MeshUpdates.reference)
+    ref = run_variant(short_model7, reduced_source=annulus_source)
+    assert ref.ok, ref.meta.get("reason")
+    lc = short_model7.gearbox.load_case
+    agreement = signal_agreement(ref, fast, (lc.ramp_time_s, lc.end_time_s), ref.meta["theory"]["mesh_frequency_hz"])
+    assert agreement.ok(), agreement.table
+    # the rule has teeth: the mesh forces carry a resolved 1x amplitude
+    assert agreement.table.loc["outer_mesh_force_1_n", "ref_amp_1x"] > 1e-3 * agreement.table.loc[
+        "outer_mesh_force_1_n", "ref_mean"]
+
+
+def test_lumped_rhs_is_the_kernel_that_run_lumped_integrates(gearbox):
+    """Classical RK4 in Python on lumped_rhs, with the configured substeps, reproduces run_lumped."""
+    h_out, n_out = gearbox.load_case.step_size_s, 40
+    substeps = gearbox.lumped_assumed.integration_substeps
+    own = run_lumped(gearbox, t_end_s=n_out * h_out).signals
+    model = build_lumped_model(gearbox)
+    f = lumped_rhs(model)
+    y, h = np.zeros(2 * model.free.size), h_out / substeps
+    rows = []
+    for step in range(n_out + 1):
+        rows.append(f.record(step * h_out, y))
+        for sub in range(substeps):
+            t = step * h_out + sub * h
+            k1 = f(t, y)
+            k2 = f(t + h / 2, y + h / 2 * k1)
+            k3 = f(t + h / 2, y + h / 2 * k2)
+            k4 = f(t + h, y + h * k3)
+            y = y + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+    rec = np.array(rows)
+    n = gearbox.gears.planet_count
+    forces = own.filter(regex=r"mesh_force").to_numpy()
+    assert forces[-1].min() > 0.1  # the teeth carry load by the end of the span (ramps just begun)
+    np.testing.assert_allclose(rec[:, 3:3 + 2 * n], forces, rtol=1e-9, atol=1e-9 * np.abs(forces).max())
+    np.testing.assert_allclose(np.degrees(rec[:, 1]), own["output_speed_deg_per_s"], rtol=1e-9, atol=1e-9)
+
+
+def test_plain_python_rhs_equals_the_compiled_one(gearbox):
+    model = build_lumped_model(gearbox)
+    rng = np.random.default_rng(7)
+    y = np.r_[rng.normal(scale=1e-6, size=model.free.size), rng.normal(scale=1e-2, size=model.free.size)]
+    compiled, plain = lumped_rhs(model), lumped_rhs(model, compiled=False)
+    for t in (0.0, 0.2, 0.55):
+        a, b = compiled(t, y), plain(t, y)
+        assert np.max(np.abs(a - b)) <= 1e-10 * np.max(np.abs(a))
+
+
+def test_fused_mesh_updates_equal_their_parts(model1):
+    """One compiled call per step (MeshUpdates) gives the schedule's factors and the friction forces."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+
+    mbs = exu.SystemContainer().AddSystem()
+    model = build_star_gearbox(mbs, model1)
+    mbs.Assemble()
+    pre_step = mbs.GetPreStepUserFunction()["function"]
+    fused = [f for f in getattr(pre_step, "functions", [pre_step]) if isinstance(f, MeshUpdates)]
+    assert len(fused) == 1
+    updates = fused[0]
+    updates.bind(mbs)
+    rng = np.random.default_rng(11)
+    n = mbs.systemData.ODE2Size()
+    aux = updates._index[0]
+    for t in (0.01, 0.3, 0.55):
+        q, q_t = rng.normal(0, 1e-3, n), rng.normal(0, 300, n)
+        q[aux] = rng.uniform(-1e-4, 5e-4, aux.size)
+        q_t[aux] = rng.normal(0, 1e-3, aux.size)
+        factors, forces = (x.copy() for x in updates.values_and_forces(t, q, q_t))
+        ref_factors, ref_forces = updates.reference(t, q, q_t)
+        assert len(factors) == len(model.contacts) // 2  # helix halves share their factor
+        assert np.max(np.abs(factors - ref_factors)) < 1e-12
+        assert np.max(np.abs(forces - ref_forces)) < 1e-9 * np.max(np.abs(ref_forces))
+
+
+def test_matrix_orders_runs_by_flexible_bodies():
+    """The matrix starts the runs with the most flexible bodies first (Table 3: model 7 has all nine)."""
+    from flexgear.study.matrix import _flexible_bodies
+
+    counts = {p.stem: _flexible_bodies(load_variant(p)) for p in sorted(VARIANTS.glob("model*.toml"))}
+    assert counts["model1"] == 0 and counts["model7"] == 9  # 2 shafts, sun, ring, 5 planets
+    assert counts["model2"] == 5 and counts["model3"] == 2
