@@ -6,8 +6,8 @@ gearbox file, not their paths: a worker needs no access to the caller's files. T
 variant from that content, builds (or finds in its own cache, ``FLEXGEAR_CACHE_DIR``, keyed by hash) the
 meshes and reduced bodies, runs it and sends the :class:`~flexgear.results.RunResult` back; the caller
 writes it with :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with
-copies of its input files (``inputs/``), as each run finishes (the runs with the most flexible bodies first: the longest start first, so that
-the last ones overlap). Then it writes
+copies of its input files (``inputs/``), as each run finishes. The runs with the most flexible bodies
+start first (the longest first, so that the last ones overlap). Then it writes
 
 - ``matrix_results.csv`` / ``.parquet``: one row per variant: status and reason, components,
   simulated time, the runner's wall and CPU time of the run (model build + simulation), the
