@@ -8,8 +8,10 @@ Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold mak
 - make: ``make <target> PY=<this python> RESULTS=<temporary folder>`` in the project folder, again with
   an empty cache folder (what a first ``make`` does): wall time and peak memory (goal <= 2 GB).
 
-Peak memory is the largest maximum resident set size among the command's processes and their
-descendants (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process that runs only that command).
+CPU time is the sum over the command's processes (user + system; on a busy machine the steadier figure,
+but parallel work counts once per core). Peak memory is the largest maximum resident set size among the
+command's processes and their descendants (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process that runs
+only that command).
 Each round uses its own empty folders, removed afterwards.
 """
 
@@ -36,10 +38,10 @@ def _child(cmd: list[str]) -> None:
     t0 = time.perf_counter()
     code = subprocess.run(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     wall = time.perf_counter() - t0
-    rss_kib = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss  # Linux: KiB
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
     tail = code.stderr.strip().splitlines()[-3:] if code.returncode else []
-    print(json.dumps({"wall_s": wall, "returncode": code.returncode, "max_rss_bytes": rss_kib * 1024,
-                      "stderr_tail": tail}))
+    print(json.dumps({"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "returncode": code.returncode,
+                      "max_rss_bytes": usage.ru_maxrss * 1024, "stderr_tail": tail}))  # ru_maxrss: KiB (Linux)
 
 
 def measure(cmd: list[str], cache_dir: Path) -> dict:
@@ -65,6 +67,7 @@ def main() -> None:
     print(f"bench_cold: {a.repeat} rounds of {a.sections}; {load_average()}", flush=True)
     commands = {"cold": [sys.executable, "-m", "flexgear.cli", "meshes", "--level", "coarse"]}
     walls: dict[str, list[float]] = {s: [] for s in a.sections}
+    cpus: dict[str, list[float]] = {s: [] for s in a.sections}
     rss: dict[str, list[float]] = {s: [] for s in a.sections}
     for i in range(a.repeat):
         for section in a.sections:
@@ -76,13 +79,15 @@ def main() -> None:
             finally:
                 shutil.rmtree(folder, ignore_errors=True)
             walls[section].append(res["wall_s"])
+            cpus[section].append(res["cpu_s"])
             rss[section].append(res["max_rss_bytes"] / 1e9)
-            print(f"round {i + 1} {section}: wall {res['wall_s']:.1f} s, peak RSS {rss[section][-1]:.2f} GB; "
-                  f"{load_average()}", flush=True)
+            print(f"round {i + 1} {section}: wall {res['wall_s']:.1f} s, CPU {res['cpu_s']:.1f} s, "
+                  f"peak RSS {rss[section][-1]:.2f} GB; {load_average()}", flush=True)
     print()
     goals = {"cold": ("<= 90 s", ""), "make": ("", "<= 2 GB")}
     for section in a.sections:
         print(figure_line(f"{section} wall [s]", walls[section]) + f"   goal {goals[section][0] or '-'}")
+        print(figure_line(f"{section} CPU, all processes [s]", cpus[section]))
         print(figure_line(f"{section} peak RSS [GB]", rss[section], "GB") + f"   goal {goals[section][1] or '-'}")
     print(f"after: {load_average()}")
 

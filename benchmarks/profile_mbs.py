@@ -15,6 +15,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import cProfile
+import dataclasses
 import io
 import pstats
 import re
@@ -105,6 +106,8 @@ def main() -> None:
     ap.add_argument("--t-end", type=float, default=0.02)
     ap.add_argument("--cprofile", action="store_true")
     ap.add_argument("--variants-dir", default=str(ROOT / "model_variants"))
+    ap.add_argument("--ramp", type=float, default=None,
+                    help="shorten the ramps to this [s] (profile at full speed: 0.005 with --t-end 0.02)")
     ap.add_argument("--blas-threads", type=int, default=1,
                     help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
     a = ap.parse_args()
@@ -116,6 +119,10 @@ def main() -> None:
     for case in a.cases:
         variant = floor_variant(load_variant(folder / "model1.toml")) if case == "floor" else \
             load_variant(folder / f"{case}.toml")
+        if a.ramp is not None:
+            gb = variant.gearbox
+            lc = dataclasses.replace(gb.load_case, ramp_time_s=a.ramp, end_time_s=max(a.t_end, a.ramp))
+            variant = dataclasses.replace(variant, gearbox=gb.with_changes(load_case=lc))
         solve(variant, 1e-4, False, False)
         text, wall, cpu = solve(variant, a.t_end, True, a.cprofile)
         steps = round(a.t_end / variant.gearbox.load_case.step_size_s)

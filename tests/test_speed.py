@@ -21,10 +21,18 @@ from flexgear.study.agreement import signal_agreement
 
 
 class _Blocks:
-    """Stand-in for flexgear.mbs.contacts.MeshConstraint: only what ContactKinematics asks at construction."""
+    """Stand-in for flexgear.mbs.contacts.MeshConstraint (two gear pairs, rows 0 and 1) and an Exudyn system."""
+
+    def __init__(self):
+        self.blocks = [(7, np.array([0]), np.ix_([0], np.arange(0, 24))),
+                       (9, np.array([1]), np.ix_([1], np.r_[0:6, 12:30]))]
+        self.written = {}
 
     def blocks_with_rows(self, rows):
-        return [0]
+        return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
+
+    def SetObjectParameter(self, obj, name, value):  # noqa: N802 - Exudyn's name
+        self.written[obj] = np.array(value)
 
 
 def test_compiled_modal_columns_match_the_numpy_reference():
@@ -32,11 +40,15 @@ def test_compiled_modal_columns_match_the_numpy_reference():
     columns = [ModalColumn(row, body, sign, psi, spin, rng.normal(size=(720, m)))
                for row, body, sign, psi, spin, m in ((0, "sun", 1.0, 0.3, 1.0, 5), (1, "ring", -1.0, 2.1, -0.3, 7),
                                                      (1, "sun", 1.0, -1.2, 1.0, 5))]
-    kin = ContactKinematics(_Blocks(), rng.normal(size=(2, 30)), columns, {"sun": 12, "ring": 18}, 0.5, 628.3)
+    system = _Blocks()
+    kin = ContactKinematics(system, rng.normal(size=(2, 30)), columns, {"sun": 12, "ring": 18}, 0.5, 628.3)
     for t in (0.0, 1e-5, 0.1234, 0.49999, 0.5, 0.61):
         ref = kin.reference_matrix_at(t)
         # same formula; the drive angle (~160 rad) is summed in another order: round-off ~1e-14 rad x grid slope
         assert np.max(np.abs(kin.matrix_at(t) - ref)) < 1e-9 * np.max(np.abs(ref))
+        kin(system, t)  # the pre-step writes each pair's block of the matrix
+        for obj, _, sub in system.blocks:
+            np.testing.assert_allclose(system.written[obj], ref[sub], rtol=0, atol=1e-9 * np.max(np.abs(ref)))
 
 
 @pytest.fixture(scope="module")

@@ -92,7 +92,15 @@ class ContactKinematics:
         self.first = np.array([column_offsets[c.body] for c in columns])
         self.bodies = [c.body for c in columns]
         self.matrix = base.copy()
-        self._blocks = constraint.blocks_with_rows(self.rows)  # only these change with the spin
+        # only the blocks (gear pairs) with modal columns change with the spin: their entries are gathered
+        # from the matrix into one buffer in one call, each block's scaling matrix a view of it
+        blocks = [constraint.blocks[i] for i in constraint.blocks_with_rows(self.rows)]
+        flat = [(sub[0] * base.shape[1] + sub[1]).ravel() for _, _, sub in blocks]
+        self._gather = np.concatenate(flat) if flat else np.zeros(0, dtype=np.int64)
+        self._buffer = np.empty(self._gather.size)
+        starts = np.cumsum([0] + [f.size for f in flat])
+        self._views = [(obj, self._buffer[a:b].reshape(len(sub[0]), -1))
+                       for (obj, _, sub), a, b in zip(blocks, starts[:-1], starts[1:], strict=True)]
 
     def matrix_at(self, t: float) -> np.ndarray:
         """The constraint's scaling matrix (frame + modal columns) at time t (compiled; the returned
@@ -120,7 +128,9 @@ class ContactKinematics:
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        self.constraint.set(mbs, self.matrix_at(t), blocks=self._blocks)
+        np.take(self.matrix_at(t).ravel(), self._gather, out=self._buffer)
+        for obj, scaling in self._views:
+            mbs.SetObjectParameter(obj, "scalingMarker1", scaling)
         return True
 
 

@@ -164,13 +164,9 @@ class MeshConstraint:
         """Indices of the blocks (gear pairs) that hold any of ``rows``."""
         return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
 
-    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None,
-            blocks: list[int] | None = None) -> None:
-        """Write G (and the offset, if given) into the constraints (a pre-step hot path); with
-        ``blocks`` (:meth:`blocks_with_rows`), only into those."""
-        for i, (block, rows, sub) in enumerate(self.blocks):
-            if blocks is not None and i not in blocks:
-                continue
+    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
+        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
+        for block, rows, sub in self.blocks:
             mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
             if offset is not None:
                 mbs.SetObjectParameter(block, "offset", offset[rows])
