@@ -16,7 +16,7 @@ VARIANTS := $(sort $(wildcard model_variants/model*.toml))
 QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 RESULTS ?= results
 
-.PHONY: quick install venv test lint meshes matrix report lpm bench clean distclean
+.PHONY: quick install venv test test-heavy lint meshes matrix report lpm bench clean distclean
 
 quick: install
 	$(PY) -m flexgear.cli meshes --level coarse
@@ -41,6 +41,9 @@ lint: install
 
 test: lint
 	$(PY) -m pytest -q
+
+test-heavy: install
+	$(PY) -m pytest -q -m heavy
 
 meshes: install
 	$(PY) -m flexgear.cli meshes --level coarse
