@@ -7,6 +7,7 @@ import xml.etree.ElementTree as ET
 
 import numpy as np
 import pytest
+from conftest import VARIANTS
 
 from flexgear.fe.reduced import component_reduced_body
 from flexgear.mbs.run import run_variant
@@ -20,7 +21,7 @@ meshio = pytest.importorskip("meshio")
 @pytest.fixture(scope="module")
 def run_dir(tmp_path_factory):
     """Model 4 (sun and ring flexible), quick variant, first 2 ms with states every 50 steps (5 states)."""
-    variant = load_variant("model_variants/quick/model4.toml")
+    variant = load_variant(VARIANTS / "quick" / "model4.toml")
     result = run_variant(variant, t_end_s=0.002, record_states_every=50)
     assert result.ok, result.meta.get("reason")
     return save_result(result, tmp_path_factory.mktemp("anim") / "model4")
@@ -37,7 +38,7 @@ def test_vtk_series_steps_points_and_node_positions(run_dir, tmp_path):
     entries = ET.parse(pvd).getroot().find("Collection").findall("DataSet")
     assert [float(e.get("timestep")) for e in entries] == pytest.approx(list(states["time_s"]))
     # points: the boundary nodes of every body's component meshes, counted from the reduced bodies
-    variant = load_variant("model_variants/quick/model4.toml")
+    variant = load_variant(VARIANTS / "quick" / "model4.toml")
     expected = 0
     for info in result.meta["state_bodies"].values():
         for geometry in info["geometries"]:

@@ -4,12 +4,13 @@ import dataclasses
 import math
 
 import pytest
+from conftest import VARIANTS
 
 from flexgear.laws.contact import ContactLaw, linear_force, mesh_laws, normal_force
 from flexgear.laws.iso6336 import tooth_stiffness
 from flexgear.spec import SpecError, load_gearbox, load_variant
 
-GEARBOX = "model_variants/gearbox.toml"
+GEARBOX = str(VARIANTS / "gearbox.toml")
 
 
 def test_single_and_mesh_stiffness_hand_calculation():

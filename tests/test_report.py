@@ -8,6 +8,7 @@ import shutil
 from pathlib import Path
 
 import pytest
+from conftest import VARIANTS
 from pypdf import PdfReader
 from synthetic import GEARBOX, fake_runner
 
@@ -36,7 +37,7 @@ def results(tmp_path_factory) -> Path:
     from flexgear.lumped.run import run_lumped
     from flexgear.mbs.run import run_variant
 
-    rigid = dataclasses.replace(load_variant("model_variants/model1.toml"), rigid_mass_properties="exact")
+    rigid = dataclasses.replace(load_variant(VARIANTS / "model1.toml"), rigid_mass_properties="exact")
     model1 = run_variant(rigid, t_end_s=0.02)
     assert model1.ok, model1.meta.get("reason")
     save_result(model1, out / "model1")
