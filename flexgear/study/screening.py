@@ -52,7 +52,7 @@ import pandas as pd
 from flexgear.results import RunResult
 from flexgear.spec import ScreeningSettings
 from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, segment_slices, settled_start
-from flexgear.study.selection import Selection, select_variant
+from flexgear.study.selection import DecisionLines, Selection, select_variant
 
 __all__ = [
     "INDICATORS",
@@ -85,51 +85,6 @@ _THEORY_KEYS = {
     "inner_mesh_force": "mesh_force_n",
 }
 
-_ZONE_NAMES = {
-    (2, 3, 4): ("non-conforming", "critical", "good", "excellent"),
-    (2, 3, 4, 5, 6): ("non-conforming", "poor", "marginal", "good", "excellent", "world-class"),
-}
-_LINE_SETS = {"westgard": (2, 3, 4), "six_sigma": (2, 3, 4, 5, 6)}
-_ON_LINE_RTOL = 1e-12
-
-
-# --------------------------------------------------------------------------- decision lines
-@dataclass(frozen=True)
-class DecisionLines:
-    """Lines Bias + m·CV = TEa (all in %) and the zones between them, worst zone first."""
-
-    tea_pct: float
-    multipliers: tuple[int, ...] = (2, 3, 4)
-    normalised: bool = False   # reference mode: Bias and CV in % of each indicator's own TEa, TEa = 100
-
-    @classmethod
-    def from_settings(cls, settings: ScreeningSettings, reference: str | None = None) -> DecisionLines:
-        if reference if reference is not None else settings.reference:
-            return cls(100.0, _LINE_SETS[settings.lines], True)
-        return cls(settings.allowable_total_error_pct, _LINE_SETS[settings.lines])
-
-    @property
-    def unit(self) -> str:
-        return "% of TEa" if self.normalised else "%"
-
-    @property
-    def zone_names(self) -> tuple[str, ...]:
-        names = _ZONE_NAMES.get(tuple(self.multipliers))
-        if names is None:
-            names = ("non-conforming", *(f"sigma >= {m}" for m in self.multipliers))
-        return names
-
-    def rank(self, bias: float, cv: float) -> int:
-        """Zone index: the number of lines whose criterion Bias + m·CV <= TEa is met (0 = worst)."""
-        limit = self.tea_pct * (1.0 + _ON_LINE_RTOL)
-        return sum(1 for m in self.multipliers if bias + m * cv <= limit)
-
-    def zone(self, bias: float, cv: float) -> str:
-        return self.zone_names[self.rank(bias, cv)]
-
-    def cv_on_line(self, m: float, bias: np.ndarray | float) -> np.ndarray | float:
-        """CV of line m at a given Bias (the study's axes: Bias on x, CV on y): (TEa - Bias)/m."""
-        return (self.tea_pct - np.asarray(bias, dtype=float)) / m
 
 
 def sigma_metric(bias: float, cv: float, tea: float) -> float:
