@@ -275,6 +275,10 @@ class ReductionSettings:
     # 0: keep every mode of the (attachment-corrected) basis; n > 0: only the n lowest (loses the
     # static correction: for speed experiments only).
     simulation_modes: int = _num(0, 400, integer=True, default=0)
+    # Gears only (bodies with gear contacts): modes above this multiple of the nominal mesh frequency
+    # leave the time integration and return as the static residual compliance of the contacts
+    # (flexgear.mbs.residual); 0 keeps every mode dynamic.
+    dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
 
 
 @dataclass(frozen=True)

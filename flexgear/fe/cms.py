@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import io
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 import scipy.linalg as la
@@ -241,6 +241,26 @@ class ReducedBody:
         rows = rbe3_weights(self.nodes, itf)
         shapes = self.modes.reshape(len(self.nodes), 3, -1)[itf.nodes]  # (k, 3, m)
         return np.einsum("idc,icm->dm", rows, shapes)
+
+    def truncated(self, n: int) -> ReducedBody:
+        """The same body on its ``n`` lowest modes (exact: each floating-frame invariant is a per-mode block,
+        so the kept blocks equal :func:`ffrf_invariants` of the kept modes)."""
+        if not 0 <= n <= self.n_modes:
+            raise ValueError(f"truncated: n must be in 0..{self.n_modes}, got {n}")
+        inv = dict(self.invariants)
+        k3 = 3 * n
+        inv["mPsiTildePsi"] = self.invariants["mPsiTildePsi"][:k3, :n]
+        inv["mPsiTildePsiTilde"] = self.invariants["mPsiTildePsiTilde"][:k3, :k3]
+        for key in ("mPhitTPsi", "mXRefTildePsi"):
+            inv[key] = self.invariants[key][:, :n]
+        for key in ("mPhitTPsiTilde", "mXRefTildePsiTilde"):
+            inv[key] = self.invariants[key][:, :k3]
+        return replace(self, modes=self.modes[:, :n], stiffness=self.stiffness[:n],
+                       frequencies_hz=self.frequencies_hz[:n], invariants=inv)
+
+    def modes_below(self, cutoff_hz: float) -> int:
+        """Number of modes whose frequency is below ``cutoff_hz`` [Hz] (modes are sorted by frequency)."""
+        return int(np.count_nonzero(self.frequencies_hz < cutoff_hz))
 
     def save(self) -> bytes:
         """The body as ``.npz`` bytes (write them with flexgear.results.atomic_write_bytes)."""

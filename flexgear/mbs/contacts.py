@@ -46,22 +46,6 @@ __all__ = [
 ]
 
 
-# --------------------------------------------------------------------------- linear elements
-
-
-
-
-# --------------------------------------------------------------------------- contact laws
-
-
-
-
-
-
-
-
-
-
 # --------------------------------------------------------------------------- gear contact
 @dataclass(frozen=True)
 class GearContact:
@@ -173,14 +157,16 @@ class MeshConstraint:
 
 
 def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp_time: float, drive_speed: float,
-                      modal_offsets: dict[str, int] | None = None, n_coordinates: int | None = None
+                      modal_offsets: dict[str, int] | None = None, n_coordinates: int | None = None,
+                      residual_markers: dict[int, int] | None = None
                       ) -> tuple[list[int], int, MeshConstraint, np.ndarray, StiffnessSchedule | None]:
     """Add the contacts: one auxiliary deflection coordinate each, their linear kinematics
     (:class:`MeshConstraint`), one compiled normal-force law each.
 
     ``modal_offsets``, ``n_coordinates``: first global column of each flexible body's modal
     coordinates and the total number of columns (frame coordinates first; the modal columns start
-    at zero and are filled by flexgear.mbs.contact_kinematics).
+    at zero and are filled by flexgear.mbs.contact_kinematics). ``residual_markers``: {contact row: marker of its
+    residual deflection coordinate} (flexgear.mbs.residual): the law then acts on delta - e, not on delta.
     Returns the spring-damper of every contact (its ``Force`` output is the normal force), the
     auxiliary node holding the deflections, the constraint, its (frame) gradient matrix and the
     :class:`StiffnessSchedule` (a pre-step function; None for constant stiffness).
@@ -210,7 +196,8 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     varying = any(np.any(c.stiffness.cos_coeffs) or np.any(c.stiffness.sin_coeffs) for c in contacts)
     for i, c in enumerate(contacts):
         spring = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
-            name=c.name, markerNumbers=[m_ground, mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
+            name=c.name, markerNumbers=[(residual_markers or {}).get(i, m_ground),
+                                        mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
         key = _schedule_key(c)
         if varying and key not in shared:
             shared[key] = (esym.Real(f"mesh_stiffness_factor_{id(mbs)}_{spring}", 1.0), c)
@@ -314,8 +301,9 @@ class MeshFriction:
     """
 
     def __init__(self, mbs, bodies: list[Body], container: int, aux_node: int, contacts: list[GearContact],
-                 ramp_time: float, drive_speed: float):
+                 ramp_time: float, drive_speed: float, residual: tuple[int, np.ndarray] | None = None):
         self.mbs, self.container, self.contacts = mbs, container, contacts
+        self.residual = residual  # (node, contact rows) of the residual deflections e: the law acts on delta - e
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
         self.sliding_rows = _assemble_rows(bodies, contacts, row=1)
         self.spin_rows = _assemble_rows(bodies, contacts, row=2)
@@ -360,6 +348,18 @@ class MeshFriction:
             self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows,
             law.kind == "iso6336")
 
+    def tooth_state(self, mbs) -> tuple[np.ndarray, np.ndarray]:
+        """The system's coordinates and velocities (copies) with each contact's deflection coordinate
+        reduced by its residual deflection e (flexgear.mbs.residual): the tooth deflection the law sees."""
+        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        if self.residual is not None:
+            node, rows = self.residual
+            first, aux = mbs.GetNodeODE2Index(node), mbs.GetNodeODE2Index(self.aux_node)
+            e = np.arange(first, first + len(rows))
+            q[aux + rows] -= q[e]
+            q_t[aux + rows] -= q_t[e]
+        return q, q_t
+
     def __call__(self, mbs, t: float) -> bool:
         """Pre-step user function: friction from the state at the start of the step."""
         if self._index is None:
@@ -371,7 +371,7 @@ class MeshFriction:
         aux, frames = self._index
         if self._force is None:
             self._force = np.zeros(len(mbs.GetObjectParameter(self.container, "forceVector")))
-        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        q, q_t = self.tooth_state(mbs)
         self._force[:len(frames)] = self.fast_forces(t, q[aux], q_t[aux], q_t[frames])
         mbs.SetObjectParameter(self.container, "forceVector", self._force)
         return True

@@ -54,11 +54,15 @@ def _body_geometry(name: str) -> str:
     return COMPONENT_GEOMETRY.get(name.rstrip("0123456789"), name.rstrip("0123456789"))
 
 
-def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarray]) -> dict[str, np.ndarray]:
+def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarray],
+                            residual: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Columns ``{outer,inner}_deflection_{load,centrifugal}_{i}_m`` of the flexible gears (module docstring).
 
     ``modal``: {body name: (n_times, n_modes) modal coordinates}. Gear spin angles are the nominal ones
-    (spin per drive angle x prescribed angle), as the contact kinematics uses them.
+    (spin per drive angle x prescribed angle), as the contact kinematics uses them. ``residual``: (n_times,
+    n) residual deflections e of the contacts ``model.residual.rows`` (flexgear.mbs.residual: the static,
+    seat-relative answer of the modes above the dynamic cut-off to the mesh forces and the spin); they add
+    to the load and centrifugal parts.
     """
     kin = model.kinematics
     lc = model.spec.load_case
@@ -95,6 +99,10 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             total[:, j] += sign * np.einsum("tm,tm->t", coeff, q)
             q_c = (spin * rate)[:, None] ** 2 * q_c_unit[None, :]
             centrifugal[:, j] += sign * np.einsum("tm,tm->t", coeff, q_c)
+    if residual is not None:  # e > 0 is a yield: it reduces the penetration; its centrifugal part y(t) likewise
+        rows = model.residual.rows
+        total[:, rows] -= residual
+        centrifugal[:, rows] -= (rate ** 2)[:, None] * model.residual.yield_per_drive_speed2[rows][None, :]
     out = {}
     for kind in ("outer", "inner"):
         groups: dict[int, list[int]] = {}

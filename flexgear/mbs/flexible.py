@@ -33,6 +33,9 @@ class FlexibleBody(Body):
     interface_markers: dict[str, int] = field(default_factory=dict)
     reduced: ReducedBody | None = None
     point_markers: dict[str, list[int]] = field(default_factory=dict)  # interface -> position markers
+    # modes of the converged basis left out of the time integration (flexgear.mbs.residual.DroppedModes);
+    # their static compliance returns at the contacts
+    dropped: object | None = None
 
 
 def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):

@@ -61,6 +61,8 @@ class GearboxModel:
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
     joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
+    residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
+    residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -123,23 +125,40 @@ def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
     return lambda spec, component: reduced(spec, component, variant.mesh_level).props
 
 
+GEARS = ("sun", "planet", "ring")
+"""Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
+
+
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
-                   joint: tuple[str, np.ndarray] | None = None, support: Support | None = None) -> Body:
+                   joint: tuple[str, np.ndarray] | None = None, support: Support | None = None,
+                   cutoff_hz: float = 0.0) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point;
-    ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support).
+    ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support);
+    ``cutoff_hz`` > 0: a gear keeps its modes below it as coordinates, the others as ``dropped`` modes whose
+    static compliance the contacts carry (flexgear.mbs.residual).
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
+    from dataclasses import replace
+
     from flexgear.mbs.flexible import add_flexible_body
 
     points = {support.interface: support_points(support)} if support is not None else None
-    return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
+    full = reduced(spec, geometry, level)
+    # at least one dynamic mode: the floating-frame object needs one
+    keep = max(1, full.modes_below(cutoff_hz)) if cutoff_hz > 0 and geometry in GEARS else full.n_modes
+    body = add_flexible_body(mbs, name, full.truncated(keep) if keep < full.n_modes else full, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers={joint[0]: joint[1]} if joint else [], point_markers=points,
                              show=False)
+    if keep == full.n_modes:
+        return body
+    from flexgear.mbs.residual import dropped_modes
+
+    return replace(body, dropped=dropped_modes(full, keep, geometry))
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -179,6 +198,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     geo = gear_set_geometry(spec)
     level = variant.mesh_level
     seats = spec.supports_assumed.placement == "bearing_seats"
+    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     supports = gearbox_supports(spec)
     bodies: list[Body] = []
     pairs = []
@@ -191,7 +211,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         else:
             point = joint_point(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  (JOINT_INTERFACES[gear], point))
+                                  (JOINT_INTERFACES[gear], point), cutoff_hz=cutoff)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
                                    (JOINT_INTERFACES[shaft], point), supports[shaft] if seats else None)
             bodies += [lead, other]
@@ -200,7 +220,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
-                                     props, reduced, support=supports["planet"] if seats else None))
+                                     props, reduced, support=supports["planet"] if seats else None,
+                                     cutoff_hz=cutoff))
     by_body = {bd.name: bd for bd in bodies}
     joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
     b = spec.bearings
@@ -231,4 +252,5 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:])
+                        train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
+                        train.residual)

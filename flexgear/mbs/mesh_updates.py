@@ -71,8 +71,7 @@ class MeshUpdates:
     def __call__(self, mbs, t: float) -> bool:
         if self._index is None:
             self.bind(mbs)
-        data = mbs.systemData
-        factors, _ = self.values_and_forces(t, data.GetODE2Coordinates(), data.GetODE2Coordinates_t())
+        factors, _ = self.values_and_forces(t, *self.friction.tooth_state(mbs))
         for var, value in zip(self.schedule.variables, factors.tolist(), strict=True):
             var.SetValue(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)

@@ -164,6 +164,9 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
     if model.kinematics is not None:
         sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
                                                           outputVariableType=ovt.Coordinates, storeInternal=True))
+        if model.residual is not None:
+            sensors["residual"] = mbs.AddSensor(SensorNode(nodeNumber=model.residual_node,
+                                                           outputVariableType=ovt.Coordinates, storeInternal=True))
         for name, body in model.bodies.items():
             if body.flexible:
                 sensors[f"modes_{name}"] = mbs.AddSensor(SensorNode(

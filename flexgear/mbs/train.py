@@ -43,6 +43,8 @@ class GearTrain:
     kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics (flexible gears)
     carrier: CarrierKinematics | None = None
     friction: MeshFriction | None = None
+    residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the gears' dropped modes
+    residual_node: int = -1  # node of the residual deflections e (one per contact in residual.rows)
 
     def springs_named(self, prefix: str) -> list[int]:
         """Spring-dampers of the contacts whose name starts with ``prefix`` (e.g. all helix halves of a mesh)."""
@@ -98,13 +100,28 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     for b in flexible:
         offsets[b.name] = n_total
         n_total += b.reduced.n_modes
-    frame_elements, coords = add_linear_elements(mbs, bodies, elements)
-    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
-                                                                 offsets, n_total)
-    train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords)
-    pre_steps = [schedule] if schedule is not None else []
     if flexible and radial_band is None:
         raise ValueError(f"flexible bodies {[b.name for b in flexible]} need radial_band [m] (about one normal module)")
+    frame_elements, coords = add_linear_elements(mbs, bodies, elements)
+    dropped = {b.name: b.dropped for b in flexible if getattr(b, "dropped", None) is not None}
+    residual, residual_node, markers = None, -1, None
+    if dropped:
+        from flexgear.mbs.residual import add_residual_coordinates, residual_compliance
+
+        residual = residual_compliance(contacts, by_name, dropped, contact_fourier_order, radial_band)
+        if residual.rows.size:
+            residual_node, residual_obj, markers = add_residual_coordinates(mbs, residual)
+        else:
+            residual = None
+    springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
+                                                                 offsets, n_total, markers)
+    train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords,
+                      residual=residual, residual_node=residual_node)
+    pre_steps = [schedule] if schedule is not None else []
+    if markers:
+        from flexgear.mbs.residual import CentrifugalYield
+
+        pre_steps.append(CentrifugalYield(residual, residual_obj, ramp_time, drive_speed))
     columns = modal_columns(contacts, by_name, contact_fourier_order, radial_band) if flexible else []
     if columns:
         from flexgear.mbs.contact_kinematics import ContactKinematics
@@ -113,7 +130,8 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         constraint.set(mbs, train.kinematics.matrix_at(0.0))
         pre_steps.append(train.kinematics)
     if friction and any(c.friction_coefficient > 0.0 for c in contacts):
-        train.friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, ramp_time, drive_speed)
+        train.friction = MeshFriction(mbs, bodies, frame_elements, aux, contacts, ramp_time, drive_speed,
+                                      (residual_node, residual.rows) if markers else None)
     if carrier is not None:
         extra = [train.friction.sliding_rows] if train.friction is not None else []
         train.carrier = CarrierKinematics(constraint, base, bodies, carrier, ramp_time, drive_speed, extra)

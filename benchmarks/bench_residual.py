@@ -1,0 +1,81 @@
+"""Dynamic cut-off of the flexible gears against the whole basis: cost and agreement (issues 13 and 16).
+
+Run: nice -n 5 python benchmarks/bench_residual.py [--case model4] [--cuts 0 4 8] [--law impact]
+     [--ramp 0.006] [--t-end 0.024] [--window 0.012] [--step 1e-5]
+
+Each cut-off (gearbox.toml [reduction_assumed] dynamic_cutoff_mesh_orders; 0 = every mode of the converged
+basis dynamic, the reference) runs the variant on a shortened load case; printed: the dynamic modes per gear,
+the solve's CPU time, and against the reference the worst relative difference of the means and of the 1x
+mesh amplitudes of every signal over the window (flexgear.study.agreement, issue 16's rule: 0.1 % and 2 %),
+with the worst signals named.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import time
+from pathlib import Path
+
+from speed_common import load_average
+
+from flexgear.fe.reduced import component_reduced_body
+from flexgear.mbs.run import run_variant
+from flexgear.spec import load_variant
+from flexgear.study.agreement import signal_agreement
+from flexgear.theory import theory
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--case", default="model4")
+    ap.add_argument("--cuts", type=float, nargs="+", default=[0.0, 4.0, 8.0])
+    ap.add_argument("--law", default="impact", choices=["impact", "iso6336"])
+    ap.add_argument("--ramp", type=float, default=0.006, help="ramp time [s] of the shortened load case")
+    ap.add_argument("--t-end", type=float, default=0.024, help="simulated time [s]")
+    ap.add_argument("--window", type=float, default=0.012, help="start [s] of the compared window")
+    ap.add_argument("--step", type=float, default=None, help="time step [s] (default: Table 5's)")
+    a = ap.parse_args()
+    v = load_variant(ROOT / "model_variants" / f"{a.case}.toml")
+    g = v.gearbox
+    lc = dataclasses.replace(g.load_case, ramp_time_s=a.ramp, end_time_s=a.t_end,
+                             step_size_s=a.step or g.load_case.step_size_s)
+    f_mesh = theory(g).mesh_frequency
+    print(f"bench_residual: {a.case}, law {a.law}, ramp {a.ramp} s, {a.t_end} s simulated, step {lc.step_size_s} s, "
+          f"window from {a.window} s, mesh frequency {f_mesh:.0f} Hz; {load_average()}", flush=True)
+    runs = {}
+    for cut in a.cuts:
+        red = dataclasses.replace(g.reduction_assumed, dynamic_cutoff_mesh_orders=cut)
+        spec = g.with_changes(load_case=lc, reduction_assumed=red, contact=dataclasses.replace(g.contact, law=a.law))
+        c0 = time.process_time()
+        run = run_variant(dataclasses.replace(v, gearbox=spec))
+        cpu = time.process_time() - c0
+        runs[cut] = run
+        label = "every mode" if cut == 0 else f"below {cut:g} x f_mesh = {cut * f_mesh / 1e3:.1f} kHz"
+        bodies = {gear: component_reduced_body(g, gear, v.mesh_level) for gear in ("sun", "planet", "ring")}
+        label += ": " + ", ".join(f"{gear} {b.modes_below(cut * f_mesh) if cut else b.n_modes}/{b.n_modes}"
+                                  for gear, b in bodies.items())
+        print(f"  cut-off {cut:4g} ({label}): {'ok' if run.ok else 'FAILED ' + str(run.meta.get('reason'))}, "
+              f"cpu {cpu:7.1f} s", flush=True)
+    ref = runs[a.cuts[0]]
+    for cut in a.cuts[1:]:
+        if not (ref.ok and runs[cut].ok):
+            continue
+        agr = signal_agreement(ref, runs[cut], (a.window, a.t_end), f_mesh)
+        t = agr.table
+        worst_amp = t["amp_diff"].abs().sort_values(ascending=False).head(3)
+        worst_mean = t["mean_diff"].abs().sort_values(ascending=False).head(3)
+        print(f"  cut-off {cut:g} vs {a.cuts[0]:g}: worst mean {agr.worst_mean:.2e} "
+              f"({', '.join(f'{k} {x:.1e}' for k, x in worst_mean.items())}); worst 1x amplitude "
+              f"{agr.worst_amplitude:.2e} ({', '.join(f'{k} {x:.1e}' for k, x in worst_amp.items())}); "
+              f"issue 16 rule {'met' if agr.ok() else 'not met'}", flush=True)
+        for kind in ("outer", "inner"):
+            row = t.loc[f"{kind}_mesh_force_1_n"]
+            print(f"    {kind} mesh force 1: mean {row.ref_mean:.2f} -> {row.new_mean:.2f} N, 1x "
+                  f"{row.ref_amp_1x:.3f} -> {row.new_amp_1x:.3f} N ({100 * row.amp_diff:+.1f} %)")
+
+
+if __name__ == "__main__":
+    main()

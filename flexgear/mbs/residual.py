@@ -1,0 +1,175 @@
+"""Static residual compliance of the modes a flexible gear leaves out of the time integration.
+
+A gear's converged basis (flexgear.fe.reduced: fixed-interface modes plus the attachment modes of its
+contact bands) has modes far above the mesh frequency: a 44-tooth sun has 4 modes below 17.6 kHz and 59
+above. Those high modes answer a mesh force quasi-statically, so they can leave the dynamic
+coordinates and return as a static compliance in series with the contact law (the mode-acceleration
+method). The gear's seat (bore, bolt circle: flexgear.mbs.deflection.GEAR_SEATS) carries the reaction, so
+the load set of a unit contact force is the force plus its rigid reaction at the seat, self-equilibrated;
+with mass-normalised free-free modes psi_j (omega_j^2 = lambda_j) its modal load and the contact's
+seat-relative deflection share the row
+
+    a_ij(alpha) = s_i (c_ij(alpha) - g_i(alpha) . Psi_seat,j)
+
+(s_i = +1 for gear 1 of the contact, -1 for gear 2; c_i(alpha) the contact's Fourier-kernel coefficients,
+flexgear.mbs.contact_kinematics; g_i = (n, (x - p_seat) x n) the contact's rigid lever to the seat,
+Psi_seat the seat's RBE3 motion), and the dropped modes add the compliance and the centrifugal yield
+
+    C_ik = sum_{j dropped} a_ij a_kj / lambda_j,   y_i = -(spin Omega)^2 sum_{j dropped} a_ij Q_c,j / lambda_j
+
+(Q_c: flexgear.mbs.deflection.centrifugal_modal_load). Summed over all modes, C is the full basis' static
+compliance of the contacts relative to the seat. C and y depend on the gear's spin through alpha = psi -
+phi; they are averaged over phi (a gear blank is nearly axisymmetric; ``spread`` says how far). The
+contacts' residuals of all gears add up to one symmetric C over the contacts; its inverse is the constant
+stiffness of a massless coordinate vector e (one entry per contact that has one), in series with each
+contact law: the law acts on the tooth deflection delta - e, and K e = F + K y(t). The dynamic seat
+reaction is taken as the quasi-static one (the gear's own inertia does not share it).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from flexgear.laws.compiled import ramp_state
+from flexgear.mbs.contact_kinematics import modal_contact_coefficients
+from flexgear.mbs.deflection import GEAR_SEATS, centrifugal_modal_load
+
+__all__ = ["DroppedModes", "dropped_modes", "ResidualCompliance", "residual_compliance", "add_residual_coordinates",
+           "CentrifugalYield"]
+
+
+@dataclass(frozen=True)
+class DroppedModes:
+    """The modes of a gear's basis above its dynamic cut-off, with what the residual needs of them."""
+
+    modes: np.ndarray  # (3n, m_d) body frame
+    stiffness: np.ndarray  # lambda_j = omega_j^2 [1/s^2]
+    seat_motion: np.ndarray  # (6, m_d) RBE3 translation [m] and rotation [rad] of the seat per mode
+    seat_point: np.ndarray  # (3,) [m] body frame
+    centrifugal_load: np.ndarray  # Q_c (m_d,) [N per (rad/s)^2 per modal unit]
+
+
+def dropped_modes(full, keep: int, geometry: str) -> DroppedModes:
+    """Modes ``keep:`` of the reduced body ``full`` (flexgear.fe.cms.ReducedBody) of gear ``geometry``."""
+    seat = GEAR_SEATS[geometry]
+    return DroppedModes(full.modes[:, keep:], full.stiffness[keep:], full.interface_motion(seat)[:, keep:],
+                        np.asarray(full.interface(seat).point, float), centrifugal_modal_load(full)[keep:])
+
+
+@dataclass(frozen=True)
+class ResidualCompliance:
+    """The contacts' residual compliance [m/N], ``matrix`` (n_contacts, n_contacts), spin-averaged, and their
+    centrifugal yield per (rad/s)^2 of the drive, ``yield_per_drive_speed2`` (n_contacts,) [m s^2].
+
+    ``spread``: max |C(phi) - C| over the sampled spin angles phi, relative to max diag(C) (0 for an
+    axisymmetric gear); ``rows``: contacts with a residual (the coordinate vector e spans them).
+    """
+
+    matrix: np.ndarray
+    yield_per_drive_speed2: np.ndarray
+    spread: float
+    mass_moment: np.ndarray | None = None  # sum_j a_ij a_kj / lambda_j^2 [m/N s^2... m s^2/N]: the residual mass
+
+    @property
+    def rows(self) -> np.ndarray:
+        return np.flatnonzero(np.diag(self.matrix) > 0.0)
+
+
+def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes], order: int,
+                        radial_band: float, n_angles: int = 72) -> ResidualCompliance:
+    """Residual compliance and centrifugal yield of the contacts (module docstring) from the gears' dropped modes.
+
+    ``contacts``: flexgear.mbs.contacts.GearContact list (rows of the contact constraint); ``bodies``: {name:
+    Body}; ``dropped``: {body name: :class:`DroppedModes`}; ``order`` and ``radial_band`` [m]: the contact
+    kernel's Fourier order and band (as the dynamic modal columns). ``n_angles`` spin angles over one
+    revolution are averaged.
+    """
+    n_c = len(contacts)
+    total, cent, second = np.zeros((n_c, n_c)), np.zeros(n_c), np.zeros((n_c, n_c))
+    spread = 0.0
+    for name, d in dropped.items():
+        body = bodies[name]
+        rows, parts = [], []
+        for i, c in enumerate(contacts):
+            for body_name, sign, spin in ((c.body1, 1.0, c.spin_per_drive_angle[0]),
+                                          (c.body2, -1.0, c.spin_per_drive_angle[1])):
+                if body_name != name:
+                    continue
+                rel = np.asarray(c.point) - body.position
+                table = modal_contact_coefficients(body.reduced.nodes, d.modes, rel, c.normal,
+                                                   0.5 * c.half_width, radial_band, order)
+                rows.append(i)
+                parts.append((table, sign, spin, rel, np.asarray(c.normal, float)))
+        if not rows:
+            continue
+        samples = [_rows_at(p, parts, d) for p in 2 * np.pi * np.arange(n_angles) / n_angles]
+        comp = np.stack([(a / d.stiffness) @ a.T for a in samples])
+        mean = comp.mean(axis=0)
+        spread = max(spread, float(np.abs(comp - mean).max() / np.abs(np.diag(mean)).max()))
+        total[np.ix_(rows, rows)] += mean
+        second[np.ix_(rows, rows)] += np.mean([(a / d.stiffness**2) @ a.T for a in samples], axis=0)
+        spins2 = np.array([p[2] ** 2 for p in parts])
+        cent[rows] -= spins2 * np.mean([a @ (d.centrifugal_load / d.stiffness) for a in samples], axis=0)
+    return ResidualCompliance(0.5 * (total + total.T), cent, spread, 0.5 * (second + second.T))
+
+
+def _rows_at(phi: float, parts: list, d: DroppedModes) -> np.ndarray:
+    """Rows a_i(phi) (module docstring) of one gear's contacts at its spin angle phi [rad]."""
+    c, s = np.cos(phi), np.sin(phi)
+    rot = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # ground -> body frame at spin phi
+    out = []
+    for table, sign, _, rel, normal in parts:
+        n_grid = table.shape[0]
+        x = np.mod(np.arctan2(rel[1], rel[0]) - phi, 2 * np.pi) * n_grid / (2 * np.pi)
+        i0 = int(np.floor(x)) % n_grid
+        w = x - np.floor(x)
+        kernel = (1 - w) * table[i0] + w * table[(i0 + 1) % n_grid]
+        x_b, n_b = rot @ rel, rot @ normal
+        lever = np.concatenate([n_b, np.cross(x_b - d.seat_point, n_b)])
+        out.append(sign * (kernel - lever @ d.seat_motion))
+    return np.array(out)
+
+
+def add_residual_coordinates(mbs, residual: ResidualCompliance) -> tuple[int, int, dict[int, int]]:
+    """A massless coordinate per contact with a residual, held by the constant stiffness K = C^-1 (one
+    ``ObjectGenericODE2``). Returns the node, the object (its ``forceVector`` K y(t) carries the
+    centrifugal yield: :class:`CentrifugalYield`) and {contact row: marker of its coordinate}: the contact
+    law's spring acts between that marker and the contact's deflection coordinate."""
+    from exudyn.itemInterface import MarkerNodeCoordinate, NodeGenericODE2, ObjectGenericODE2
+
+    rows = residual.rows
+    n = len(rows)
+    stiffness = np.linalg.inv(residual.matrix[np.ix_(rows, rows)])
+    stiffness = 0.5 * (stiffness + stiffness.T)
+    mass = np.zeros((n, n))
+    if residual.mass_moment is not None:  # Ritz mass of the static residual shapes: K (sum a a / lambda^2) K
+        mass = stiffness @ residual.mass_moment[np.ix_(rows, rows)] @ stiffness
+        mass = 0.5 * (mass + mass.T)
+    node = mbs.AddNode(NodeGenericODE2(name="mesh_residual_deflections", numberOfODE2Coordinates=n,
+                                       referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
+                                       initialCoordinates_t=[0.0] * n))
+    obj = mbs.AddObject(ObjectGenericODE2(name="mesh_residual_compliance", nodeNumbers=[node],
+                                          massMatrix=mass, stiffnessMatrix=stiffness,
+                                          forceVector=np.zeros(n)))
+    markers = {int(r): mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k)) for k, r in enumerate(rows)}
+    return node, obj, markers
+
+
+class CentrifugalYield:
+    """Pre-step function: the residual coordinates' force vector K y(t), y = Omega_drive(t)^2 y_1 (module
+    docstring), Omega_drive the prescribed STEP speed ramp [rad/s] at the step's end time."""
+
+    def __init__(self, residual: ResidualCompliance, obj: int, ramp_time: float, drive_speed: float):
+        rows = residual.rows
+        self.obj, self.ramp_time, self.drive_speed = obj, ramp_time, drive_speed
+        self.unit = np.linalg.solve(residual.matrix[np.ix_(rows, rows)], residual.yield_per_drive_speed2[rows])
+
+    def force(self, t: float) -> np.ndarray:
+        """K y(t) [N]."""
+        return (self.drive_speed * ramp_state(float(t), self.ramp_time)[1]) ** 2 * self.unit
+
+    def __call__(self, mbs, t: float) -> bool:
+        mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        return True
