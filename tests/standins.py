@@ -2,7 +2,8 @@
 
 Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm. Coarse first-order
 meshes (a few hundred nodes, about a second each) with the bore (ring: outer surface) as the RBE3
-interface, named as the gearbox's joints expect (flexgear.fe.reduced.JOINT_INTERFACES).
+interface, named as the gearbox's joints expect (flexgear.fe.reduced.gear_shaft_joints; with bolt patches
+the ring's and output shaft's interface surface is split into one angular sector per bolt).
 They exercise the flexible-gear machinery; the real components come from
 flexgear.fe.reduced.component_reduced_body.
 """
@@ -15,7 +16,8 @@ from flexgear.geometry.involute import gear_set_geometry
 
 
 @cache
-def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int, name: str):
+def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int,
+             names: tuple[str, ...]):
     import ngsolve as ngs
     from netgen.occ import Cylinder, OCCGeometry, Pnt, Z
 
@@ -26,15 +28,19 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     fe = fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), material, 1)
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
     sel = np.flatnonzero(np.abs(r - (r_out if interface_outer else r_in)) < 1e-6)
-    return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes or None)
+    sector = np.round(np.arctan2(fe.nodes[sel, 1], fe.nodes[sel, 0]) / (2 * np.pi) * len(names)) % len(names)
+    itfs = [interface(fe, sel[sector == k], name) for k, name in enumerate(names)]
+    return reduce(fe, itfs, 20, n_compare=0, keep_modes=modes or None)
 
 
 def annulus_source(spec, component: str, level: str):
     """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox."""
-    from flexgear.fe.reduced import JOINT_INTERFACES
+    from flexgear.fe.reduced import gear_shaft_joints
 
     geo = gear_set_geometry(spec)
-    name = JOINT_INTERFACES.get(component, "bore")
+    side = {"sun": 0, "input_shaft": 1, "ring": 0, "output_shaft": 1}
+    pair = "sun" if component in ("sun", "input_shaft") else "ring"
+    name = tuple(j[side[component]] for j in gear_shaft_joints(spec, pair)) if component in side else ("bore",)
     width = spec.gears_assumed.face_width_m + spec.gears_assumed.half_gap_m
     modes = spec.reduction_assumed.simulation_modes
     if component == "ring":

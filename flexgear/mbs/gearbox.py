@@ -59,7 +59,8 @@ class GearboxModel:
     aux_node: int = -1  # node of the contacts' deflection coordinates
     input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
-    joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
+    # gear -> its fixed joints to its shaft (separate bodies): (joint, joint point [m] in the gear's frame)
+    joints: dict[str, list[tuple[int, np.ndarray]]] = field(default_factory=dict)
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
 
 
@@ -125,10 +126,10 @@ def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
-                   joint: tuple[str, np.ndarray] | None = None, support: Support | None = None) -> Body:
+                   joints: dict[str, np.ndarray] | None = None, support: Support | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
-    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point;
+    ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
     ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support).
     """
     if form == "rigid":
@@ -138,7 +139,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     points = {support.interface: support_points(support)} if support is not None else None
     return add_flexible_body(mbs, name, reduced(spec, geometry, level), position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
-                             interface_markers={joint[0]: joint[1]} if joint else [], point_markers=points,
+                             interface_markers=joints or [], point_markers=points,
                              show=False)
 
 
@@ -148,9 +149,10 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
     ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
-    exact); otherwise they are two bodies joined by a fixed joint at their interfaces
-    (flexgear.fe.reduced.JOINT_INTERFACES, at flexgear.fe.reduced.joint_point): a flexible body
-    through its interface node set's RBE3 motion, a rigid one at the point. The input bearing and the
+    exact); otherwise they are two bodies joined by fixed joints at their interfaces
+    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring per bolt or at the bolt circle as
+    ``[joints_assumed]`` says): a flexible body through its interface node set's RBE3 (or rigid patch)
+    motion, a rigid one at the joint's point. The input bearing and the
     drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
     body when shaft and gear are one): with ``[supports_assumed] placement = "bearing_seats"`` at the
     shafts' bearing seats and the planets' bores (flexgear.geometry.supports, flexgear.mbs.elements.add_support,
@@ -160,7 +162,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
     "exact", the exact geometry's; ``mass_source`` overrides both.
     """
-    from flexgear.fe.reduced import JOINT_INTERFACES, joint_point
+    from flexgear.fe.reduced import gear_shaft_joints
 
     spec = variant.gearbox
     if spec.gears.arrangement != "star":
@@ -189,20 +191,24 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
             ends[gear] = gear
         else:
-            point = joint_point(spec, gear)
+            joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  (JOINT_INTERFACES[gear], point))
+                                  {a: p for a, _, p in joints})
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   (JOINT_INTERFACES[shaft], point), supports[shaft] if seats else None)
+                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None)
             bodies += [lead, other]
-            pairs.append((lead, other, (JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft]), point))
+            pairs.append((lead, other, joints))
             ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"] if seats else None))
     by_body = {bd.name: bd for bd in bodies}
-    joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
+    joints = {}
+    for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
+        label = f"joint_{lead.name}_{other.name}"
+        joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
+                             for k, (a, b, p) in enumerate(found)]
     b = spec.bearings
     bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]

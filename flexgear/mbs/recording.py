@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from flexgear.mbs.gearbox import GearboxModel
     from flexgear.spec import Variant
 
-__all__ = ["Recorder", "solver_settings", "solve", "simulation_settings", "add_gearbox_sensors"]
+__all__ = ["Recorder", "solver_settings", "solve", "simulation_settings", "add_gearbox_sensors", "joint_axis_torque"]
 
 
 @dataclass
@@ -158,9 +158,13 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
     }
     sensors["output_spin"] = mbs.AddSensor(SensorNode(nodeNumber=model.output_spin[0],
                                                       outputVariableType=ovt.Coordinates, storeInternal=True))
-    for gear, joint in model.joints.items():
-        sensors[f"joint_{gear}"] = mbs.AddSensor(SensorObject(objectNumber=joint, outputVariableType=ovt.TorqueLocal,
-                                                              storeInternal=True))
+    for gear, joints in model.joints.items():
+        for k, (joint, point) in enumerate(joints):
+            sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
+                objectNumber=joint, outputVariableType=ovt.TorqueLocal, storeInternal=True))
+            if np.hypot(point[0], point[1]) > 0.0:  # off the axis: its force has a moment about the axis
+                sensors[f"joint_{gear}_{k}_force"] = mbs.AddSensor(SensorObject(
+                    objectNumber=joint, outputVariableType=ovt.ForceLocal, storeInternal=True))
     if model.kinematics is not None:
         sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
                                                           outputVariableType=ovt.Coordinates, storeInternal=True))
@@ -174,3 +178,20 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                 sensors[f"{kind}_{i + 1}_{h}"] = mbs.AddSensor(SensorObject(
                     objectNumber=obj, outputVariableType=ovt.Force, storeInternal=True))
     return sensors
+
+
+def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: str) -> tuple[np.ndarray, np.ndarray]:
+    """Time [s] and the torque [N·m] about the axis that ``gear``'s joints to its shaft transmit together.
+
+    T_z = sum_k (M_z,k + x_k F_y,k - y_k F_x,k) over its joints at points (x_k, y_k, z_k) of the gear's frame,
+    with each joint's local torque M and force F (about the axis z, which the local frames share).
+    """
+    total = None
+    for k, (_, point) in enumerate(model.joints[gear]):
+        data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
+        torque = data[:, 3].copy()
+        if f"joint_{gear}_{k}_force" in sensors:
+            force = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}_force"]))
+            torque += point[0] * force[:, 2] - point[1] * force[:, 1]
+        total = torque if total is None else total + torque
+    return data[:, 0], total
