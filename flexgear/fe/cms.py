@@ -232,13 +232,14 @@ class ReducedBody:
                 return itf
         raise KeyError(f"no interface {name!r}; have {[i.name for i in self.interfaces]}")
 
-    def interface_motion(self, name: str) -> np.ndarray:
-        """(6, m): RBE3 translation [m] and rotation [rad] of interface ``name`` per modal coordinate.
+    def interface_motion(self, name: str | Interface) -> np.ndarray:
+        """(6, m): RBE3 translation [m] and rotation [rad] of interface ``name`` (or of an Interface of the
+        body's nodes) per modal coordinate.
 
         The interface's six motions in the body frame are ``interface_motion(name) @ q`` (eq. of
         :func:`rbe3_weights` applied to the mode shapes); exact for the RBE3 Craig-Bampton basis.
         """
-        itf = self.interface(name)
+        itf = name if isinstance(name, Interface) else self.interface(name)
         rows = rbe3_weights(self.nodes, itf)
         shapes = self.modes.reshape(len(self.nodes), 3, -1)[itf.nodes]  # (k, 3, m)
         return np.einsum("idc,icm->dm", rows, shapes)

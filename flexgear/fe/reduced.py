@@ -37,7 +37,7 @@ from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints"]
+           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints", "gear_seat"]
 
 """Variant component name -> geometry component name."""
 
@@ -176,6 +176,21 @@ def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.n
         centres, _, z_j = bolt_axes(spec)
         return [(f"bolt_{k}", f"bolt_{k}", np.array([x, y, z_j])) for k, (x, y) in enumerate(centres)]
     return [(JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft], joint_point(spec, gear))]
+
+
+def gear_seat(spec: GearboxSpec, body: ReducedBody, gear: str) -> Interface:
+    """The interface of a gear's reduced body that its deflections are measured from (and held at).
+
+    Sun, planet: the bore. Ring: its side of the joint to the output shaft (:func:`gear_shaft_joints`), as one
+    RBE3 interface "seat" over the union of its joint interfaces' nodes, each interface weighted equally (the
+    bolt circle itself, or the 12 bolt patches together).
+    """
+    if gear != "ring":
+        return body.interface("bore")
+    parts = [body.interface(a) for a, _, _ in gear_shaft_joints(spec, "ring")]
+    nodes = np.concatenate([i.nodes for i in parts])
+    weights = np.concatenate([i.weights for i in parts]) / len(parts)
+    return Interface("seat", nodes, weights, weights @ body.nodes[nodes])
 
 
 def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",

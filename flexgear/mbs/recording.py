@@ -183,8 +183,12 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
 def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: str) -> tuple[np.ndarray, np.ndarray]:
     """Time [s] and the torque [N·m] about the axis that ``gear``'s joints to its shaft transmit together.
 
-    T_z = sum_k (M_z,k + x_k F_y,k - y_k F_x,k) over its joints at points (x_k, y_k, z_k) of the gear's frame,
-    with each joint's local torque M and force F (about the axis z, which the local frames share).
+    T_z = sum_k (M_z,k - (x_k F_y,k - y_k F_x,k)) over its joints at points (x_k, y_k, z_k) of the gear's frame,
+    with each joint's local torque M and force F (``TorqueLocal``, ``ForceLocal``; the local frames share the
+    axis z). The minus: Exudyn's generic joint constrains p_m1 - p_m0 (force +lambda_t on marker 1's body) but
+    the z rotation through t_x0 . t_y1 = 0 (moment -lambda_5 on it), so its force and torque outputs act on
+    different bodies; T_z has the sign of the single joint's M_z. Checked: model 4's twelve bolt joints then
+    carry the load torque within 0.2 % (with a plus, 12 % off).
     """
     total = None
     for k, (_, point) in enumerate(model.joints[gear]):
@@ -192,6 +196,6 @@ def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: s
         torque = data[:, 3].copy()
         if f"joint_{gear}_{k}_force" in sensors:
             force = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}_force"]))
-            torque += point[0] * force[:, 2] - point[1] * force[:, 1]
+            torque -= point[0] * force[:, 2] - point[1] * force[:, 1]
         total = torque if total is None else total + torque
     return data[:, 0], total
