@@ -37,7 +37,7 @@ from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints", "gear_seat"]
+           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints", "gear_seat", "bolt_patches"]
 
 """Variant component name -> geometry component name."""
 
@@ -86,7 +86,7 @@ def _ring_joint_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interf
     "rbe3", one interface "bolt_circle" over the walls of all bolt holes (of the ring's flange, the shaft's
     web); "bolt_patches", one interface "bolt_<k>" per bolt over its clamped disc on the mating face
     (flexgear.fe.bolted.clamped_patches)."""
-    if spec.joints_assumed.ring_output_shaft == "bolt_patches":
+    if bolt_patches(spec):
         return [interface(fe, nodes, f"bolt_{k}") for k, nodes in enumerate(clamped_patches(fe, spec))]
     holed = [p for p in component_layout(spec, component).prisms if p.section.holes][0]
     return [interface(fe, _bolt_hole_nodes(fe, holed.section, (holed.z0, holed.z1)), "bolt_circle")]
@@ -164,6 +164,14 @@ JOINT_INTERFACES = {"sun": "bore", "input_shaft": "sun_seat", "ring": "bolt_circ
 ring-output shaft with ``[joints_assumed] ring_output_shaft = "rbe3"``)."""
 
 
+def bolt_patches(spec: GearboxSpec) -> bool:
+    """Whether the ring and the output shaft are joined by bolt patches: ``[joints_assumed] ring_output_shaft``,
+    except with a truncated basis (``[reduction_assumed] simulation_modes`` > 0, speed experiments and the quick
+    variants), which cannot carry twelve 6-DOF joints (12 modes against 72 constraints: the joints would be
+    redundant and the solver fails): that uses the single RBE3 joint at the bolt circle."""
+    return spec.joints_assumed.ring_output_shaft == "bolt_patches" and spec.reduction_assumed.simulation_modes == 0
+
+
 def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.ndarray]]:
     """The fixed joints of ``gear`` ("sun" or "ring") and its shaft: (gear interface, shaft interface, point [m]).
 
@@ -172,7 +180,7 @@ def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.n
     the flange-web plane ("bolt_patches", ``[joints_assumed] ring_output_shaft``).
     """
     shaft = {"sun": "input_shaft", "ring": "output_shaft"}[gear]
-    if gear == "ring" and spec.joints_assumed.ring_output_shaft == "bolt_patches":
+    if gear == "ring" and bolt_patches(spec):
         centres, _, z_j = bolt_axes(spec)
         return [(f"bolt_{k}", f"bolt_{k}", np.array([x, y, z_j])) for k, (x, y) in enumerate(centres)]
     return [(JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft], joint_point(spec, gear))]
@@ -203,7 +211,7 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
     red = spec.reduction_assumed
     circles = component_load_circles(spec, name, red.attachment_order)
     joint = spec.joints_assumed
-    patches = name in ("ring", "output_shaft") and joint.ring_output_shaft == "bolt_patches"
+    patches = name in ("ring", "output_shaft") and bolt_patches(spec)
     # the bolt patches are interfaces: they enter the key (the RBE3 bodies keep their former keys)
     extra = [("bolt_patches", joint.bolt_patch, joint.bolt_clamp_diameter_mm)] if patches else []
     key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
