@@ -22,6 +22,7 @@ as the gear's joint (RBE3, flexgear.fe.compliance):
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import time
 
 import numpy as np
@@ -70,7 +71,10 @@ def study(spec, component: str, level: str, orders: list[int], modes: list[int],
 
     t0 = time.perf_counter()
     fe = _fe(spec, component, level)
-    itfs = component_interfaces(fe, spec, component)
+    # one RBE3 interface per joint (the ring and output shaft at their bolt circle, not per bolt patch): the
+    # study holds the body at its first interface and reduces with RBE3 interfaces throughout
+    one_joint = dataclasses.replace(spec.joints_assumed, ring_output_shaft="rbe3")
+    itfs = component_interfaces(fe, spec.with_changes(joints_assumed=one_joint), component)
     solver = free_body_solver(fe)
     gear = component in ("sun", "planet", "ring")
     max_order = max(orders) if gear else 0

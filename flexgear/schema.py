@@ -20,6 +20,7 @@ __all__ = [
     "GearSetAssumed",
     "Material",
     "ComponentsAssumed",
+    "JointsAssumed",
     "Bearing",
     "Bearings",
     "Contact",
@@ -385,6 +386,21 @@ class SupportsAssumed:
 
 
 @dataclass(frozen=True)
+class JointsAssumed:
+    """How the ring and the output shaft are joined when either is flexible (flexgear.fe.bolted, flexgear.fe.reduced).
+
+    ``ring_output_shaft`` "bolt_patches": per bolt a patch over its clamped disc on each mating face, joined
+    pairwise; "rbe3": one RBE3 interface over all bolt-hole walls of each body, one fixed joint at the bolt
+    circle. ``bolt_patch`` "rbe2" (rigid disc) or "rbe3"; ``bolt_clamp_diameter_mm`` the disc's diameter.
+    """
+
+    ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),
+                                                                      "doc": "ring-output shaft joint model"})
+    bolt_patch: str = field(default="rbe2", metadata={"choices": ("rbe2", "rbe3"), "doc": "bolt patch kind"})
+    bolt_clamp_diameter_mm: float = field(default=21.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
+
+
+@dataclass(frozen=True)
 class GearboxSpec:
     """The whole gearbox: the study's tables plus documented assumptions."""
 
@@ -404,6 +420,7 @@ class GearboxSpec:
     screening: ScreeningSettings
     lumped_assumed: LumpedAssumed
     supports_assumed: SupportsAssumed = field(default_factory=SupportsAssumed)
+    joints_assumed: JointsAssumed = field(default_factory=JointsAssumed)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""

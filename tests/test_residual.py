@@ -41,12 +41,13 @@ def test_truncated_body_keeps_the_invariants_of_its_lowest_modes(gearbox):
     assert kept.n_modes == 3 and body.modes_below(body.frequencies_hz[5] * (1 + 1e-9)) == 6
 
 
-@pytest.mark.parametrize("gear,seat", [("sun", "bore"), ("planet", "bore"), ("ring", "bolt_circle")])
-def test_seat_relative_rows_give_the_held_seat_compliance(gearbox, gear, seat):
+@pytest.mark.parametrize("gear", ["sun", "planet", "ring"])
+def test_seat_relative_rows_give_the_held_seat_compliance(gearbox, gear):
     """All modes 'dropped': C = sum_j a a^T / lambda_j must be the gear's compliance with its seat held."""
-    from flexgear.fe.reduced import component_load_circles, component_reduced_body
+    from flexgear.fe.reduced import component_load_circles, component_reduced_body, gear_seat
 
     body = component_reduced_body(gearbox, gear, "coarse")
+    seat = gear_seat(gearbox, body, gear)  # bore; the ring's joint interfaces as one RBE3 seat
     contacts = mesh_contacts(gearbox)
     geo = gear_set_geometry(gearbox)
     name = "planet1" if gear == "planet" else gear
@@ -55,7 +56,7 @@ def test_seat_relative_rows_give_the_held_seat_compliance(gearbox, gear, seat):
     stand_in = {name: types.SimpleNamespace(position=centre, reduced=body)}
     order = gearbox.reduction_assumed.contact_fourier_order
     # one spin angle (phi = 0): the held-seat solve below sees the gear at rest
-    res = residual_compliance(contacts, stand_in, {name: dropped_modes(body, 0, gear)}, order,
+    res = residual_compliance(contacts, stand_in, {name: dropped_modes(gearbox, body, 0, gear)}, order,
                               gearbox.gears.normal_module_m, n_angles=1)
     rows = res.rows
     points = np.array([np.asarray(contacts[i].point) - centre for i in rows])
@@ -79,8 +80,8 @@ def test_dropped_modes_carry_most_of_a_small_gears_compliance(gearbox):
     stand_in = {"sun": types.SimpleNamespace(position=np.zeros(3), reduced=body)}
     args = (mesh_contacts(gearbox), stand_in)
     order, band = gearbox.reduction_assumed.contact_fourier_order, gearbox.gears.normal_module_m
-    whole = residual_compliance(*args, {"sun": dropped_modes(body, 0, "sun")}, order, band)
-    rest = residual_compliance(*args, {"sun": dropped_modes(body, keep, "sun")}, order, band)
+    whole = residual_compliance(*args, {"sun": dropped_modes(gearbox, body, 0, "sun")}, order, band)
+    rest = residual_compliance(*args, {"sun": dropped_modes(gearbox, body, keep, "sun")}, order, band)
     share = np.diag(rest.matrix)[rest.rows] / np.diag(whole.matrix)[whole.rows]
     assert keep < 10 and np.all(share > 0.5) and np.all(share < 1.0)
     # the sun is nearly axisymmetric: its residual barely depends on the spin angle

@@ -14,6 +14,7 @@ is T = [Psi_s, Phi_f]:
   made rings and gears 10-78 % too stiff in the prototype).
 - ``kind="rbe2"`` (rigid interface): the interface nodes move as a rigid patch, u_b = R_b q; static
   modes [R_b; -K_ii^-1 K_ib R_b], fixed-interface modes from (K_ii, M_ii): classical Craig-Bampton.
+  Mixed (``rigid=`` names): those interfaces rigid, the others RBE3 rows on the interior (bolt patches).
 
 Both are solved with one sparse factorisation. The free body's K is singular, so the rigid-body
 motion is split off exactly: u = R a + u_f with u_f zero on six determinate support coordinates
@@ -231,13 +232,14 @@ class ReducedBody:
                 return itf
         raise KeyError(f"no interface {name!r}; have {[i.name for i in self.interfaces]}")
 
-    def interface_motion(self, name: str) -> np.ndarray:
-        """(6, m): RBE3 translation [m] and rotation [rad] of interface ``name`` per modal coordinate.
+    def interface_motion(self, name: str | Interface) -> np.ndarray:
+        """(6, m): RBE3 translation [m] and rotation [rad] of interface ``name`` (or of an Interface of the
+        body's nodes) per modal coordinate.
 
         The interface's six motions in the body frame are ``interface_motion(name) @ q`` (eq. of
         :func:`rbe3_weights` applied to the mode shapes); exact for the RBE3 Craig-Bampton basis.
         """
-        itf = self.interface(name)
+        itf = name if isinstance(name, Interface) else self.interface(name)
         rows = rbe3_weights(self.nodes, itf)
         shapes = self.modes.reshape(len(self.nodes), 3, -1)[itf.nodes]  # (k, 3, m)
         return np.einsum("idc,icm->dm", rows, shapes)
@@ -329,38 +331,56 @@ def ffrf_invariants(mass_scalar: sp.spmatrix, nodes: np.ndarray, modes: np.ndarr
             "mXRefTildePsi": xref_tilde_psi, "mXRefTildePsiTilde": xref_tilde_psi_tilde}
 
 
-def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int,
-                patterns: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
-    """Classical Craig-Bampton basis with rigid interface patches, plus the static responses to the load
-    ``patterns`` (3n, p) with the interface nodes clamped."""
-    bnodes = np.unique(np.concatenate([i.nodes for i in interfaces]))
+def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str], n_modes: int,
+                       patterns: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Craig-Bampton basis with the interfaces named in ``rigid`` as rigid patches (RBE2: their nodes move as
+    one, u_b = R_b q) and the others distributing (RBE3 rows C u = q, nodes free to deform).
+
+    With the rigid patches' nodes b clamped, K_ii is regular; a constrained solve of the interior
+    min 1/2 u^T K_ii u - g^T u subject to C u = e is u = K_ii^-1 (g - C^T lam), (C K_ii^-1 C^T) lam =
+    C K_ii^-1 g - e. Static modes: each rigid patch's six rigid motions (g = -K_ib R_b e_k, e = 0) and each
+    distributing interface's six motions (g = 0, e = e_k); fixed-interface modes of (K_ii, M_ii) on C u = 0;
+    attachment modes the responses to the load ``patterns`` (3n, p) with all interfaces held.
+    """
+    bnodes = np.unique(np.concatenate([i.nodes for i in interfaces if i.name in rigid]))
     bdofs = (3 * bnodes[:, None] + np.arange(3)).ravel()
     mask = np.ones(fe.n_dof, bool)
     mask[bdofs] = False
     idofs = np.flatnonzero(mask)
     k_ii = fe.K[idofs][:, idofs].tocsc()
     lu = sla.splu(k_ii, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
-    k_ib = fe.K[idofs][:, bdofs]
-    ub = np.zeros((len(bdofs), 6 * len(interfaces)))
-    for j, itf in enumerate(interfaces):
-        rig = rigid_body_modes(fe.nodes[itf.nodes], centre=itf.point)
+    soft = [i for i in interfaces if i.name not in rigid]
+    c = sp.vstack([_rbe3_rows(fe, i) for i in soft]).tocsc()[:, idofs] if soft else sp.csc_matrix((0, len(idofs)))
+    z = lu.solve(np.ascontiguousarray(c.T.toarray())) if soft else np.zeros((len(idofs), 0))
+    schur = la.lu_factor(c @ z) if soft else None
+
+    def solve(g: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
+        y = lu.solve(np.ascontiguousarray(g))
+        if soft:
+            lam = la.lu_solve(schur, c @ y - (0.0 if e is None else e))
+            y = y - z @ lam
+        return y
+
+    ub = np.zeros((len(bdofs), 6 * (len(interfaces) - len(soft))))
+    for j, itf in enumerate(i for i in interfaces if i.name in rigid):
         pos = np.searchsorted(bnodes, itf.nodes)
-        rows = (3 * pos[:, None] + np.arange(3)).ravel()
-        ub[rows, 6 * j:6 * j + 6] = rig
-    static = np.zeros((fe.n_dof, ub.shape[1]))
-    static[bdofs] = ub
-    static[idofs] = -lu.solve(np.asarray(k_ib @ ub))
-    m = fe.M
-    m_ii = m[idofs][:, idofs]
-    op = sla.LinearOperator(k_ii.shape, matvec=lu.solve, dtype=float)
-    fixed = np.zeros((fe.n_dof, 0))
+        ub[(3 * pos[:, None] + np.arange(3)).ravel(), 6 * j:6 * j + 6] = rigid_body_modes(fe.nodes[itf.nodes],
+                                                                                          centre=itf.point)
+    static = np.zeros((fe.n_dof, ub.shape[1] + 6 * len(soft)))
+    static[bdofs, :ub.shape[1]] = ub
+    static[idofs, :ub.shape[1]] = solve(-np.asarray(fe.K[idofs][:, bdofs] @ ub))
+    if soft:
+        static[idofs, ub.shape[1]:] = solve(np.zeros((len(idofs), c.shape[0])), np.eye(c.shape[0]))
+    fixed = np.zeros((fe.n_dof, n_modes))
     if n_modes:
-        _, vec = sla.eigsh(k_ii, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", tol=1e-10)
-        fixed = np.zeros((fe.n_dof, n_modes))
-        fixed[idofs] = vec
+        op = sla.LinearOperator(k_ii.shape, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
+        m_ii = fe.M[idofs][:, idofs]
+        v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
+        lam, vec = sla.eigsh(k_ii, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
+        fixed[idofs] = vec[:, np.argsort(lam)]
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
-        attached[idofs] = lu.solve(np.ascontiguousarray(patterns[idofs]))
+        attached[idofs] = solve(patterns[idofs])
     return static, fixed, attached, lu.L.nnz + lu.U.nnz
 
 
@@ -380,14 +400,15 @@ class BasisParts:
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str = "rbe3",
                     load_circles: list[LoadCircle] | None = None,
-                    solver: _FreeBodySolver | None = None) -> BasisParts:
+                    solver: _FreeBodySolver | None = None, rigid: tuple[str, ...] = ()) -> BasisParts:
     """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation
     (``solver``: the free body's, if already made)."""
     circles = list(load_circles or [])
     patterns = (np.hstack([load_patterns(fe.nodes, c) for c in circles]) if circles
                 else np.zeros((fe.n_dof, 0)))
-    if kind != "rbe3":
-        return BasisParts(*_rbe2_basis(fe, itfs, n_modes, patterns))
+    rigid_set = {i.name for i in itfs} if kind == "rbe2" else set(rigid)
+    if rigid_set:
+        return BasisParts(*_rigid_patch_basis(fe, itfs, rigid_set, n_modes, patterns))
     solver = solver or _FreeBodySolver(fe)
     con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
@@ -399,10 +420,11 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
 def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: str = "rbe3",
            n_compare: int = 12, keep_modes: int | None = None,
-           load_circles: list[LoadCircle] | None = None) -> ReducedBody:
+           load_circles: list[LoadCircle] | None = None, rigid: tuple[str, ...] = ()) -> ReducedBody:
     """Craig-Bampton reduction of ``fe`` with ``interfaces`` and ``n_modes`` fixed-interface modes.
 
-    ``kind``: "rbe3" (distributing interfaces, default) or "rbe2" (rigid patches). ``load_circles``
+    ``kind``: "rbe3" (distributing interfaces, default; those named in ``rigid`` are rigid patches all the
+    same) or "rbe2" (all rigid patches). ``load_circles``
     (flexgear.fe.attachment.LoadCircle): their Fourier load patterns' static responses with the
     interfaces held join the basis as attachment modes (exact compliance under the contact kernel's
     loads). The basis is mass-orthonormalised (dependent directions dropped) and its free-free modes
@@ -412,11 +434,14 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
     """
     if kind not in ("rbe3", "rbe2"):
         raise ValueError(f"reduce: kind must be 'rbe3' or 'rbe2', got {kind!r}")
+    names = [i if isinstance(i, str) else i.name for i in interfaces]
+    if set(rigid) - set(names):
+        raise ValueError(f"reduce: rigid interfaces {sorted(set(rigid) - set(names))} are not among {names}")
     if not interfaces:
         raise ValueError("reduce: at least one interface is needed (it fixes the static modes' rigid part)")
     itfs = [interface(fe, i) if isinstance(i, str) else i for i in interfaces]
     t0 = time.perf_counter()
-    parts = reduction_basis(fe, itfs, n_modes, kind, load_circles)
+    parts = reduction_basis(fe, itfs, n_modes, kind, load_circles, rigid=tuple(rigid))
     modes, lam, dropped = modal_basis(np.hstack([parts.static, parts.fixed, parts.attached]), fe.K, fe.M)
     if keep_modes is not None:
         modes, lam = modes[:, :keep_modes], lam[:keep_modes]

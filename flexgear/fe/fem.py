@@ -29,7 +29,7 @@ import scipy.sparse as sp
 from flexgear.geometry.massprops import MassProperties
 from flexgear.spec import Material
 
-__all__ = ["FEModel", "fe_model", "rigid_body_modes", "lame_parameters"]
+__all__ = ["FEModel", "fe_model", "rigid_body_modes", "lame_parameters", "surface_faces"]
 
 
 def lame_parameters(material: Material) -> tuple[float, float]:
@@ -182,3 +182,16 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
     else:
         tri = tri[:, :3]
     return FEModel(nodes, k_inter, mass_scalar, order, material, region_nodes, region_weights, tri)
+
+
+def surface_faces(fe: FEModel) -> np.ndarray:
+    """Boundary faces of ``fe`` as element faces: (t, 3) corners, or for order 2 (t, 6) corners then the
+    mid-nodes of edges 01, 12, 20, rebuilt from the flat split of :func:`fe_model` (four blocks of t:
+    [c0, m01, m02], [m01, c1, m12], [m01, m12, m02], [m02, m12, c2])."""
+    tri = fe.surface_triangles
+    if fe.order != 2:
+        return tri
+    t = len(tri) // 4
+    c0, m01, m02 = tri[:t, 0], tri[:t, 1], tri[:t, 2]
+    c1, m12, c2 = tri[t:2 * t, 1], tri[t:2 * t, 2], tri[3 * t:, 2]
+    return np.column_stack([c0, c1, c2, m01, m12, m02])

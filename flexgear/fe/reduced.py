@@ -2,9 +2,11 @@
 
 Interfaces (where a component is connected; RBE3, distributing, by default):
 - sun, planet: the bore (shaft-sun joint, planet bearing seat);
-- ring: "bolt_circle", the walls of the flange's 12 bolt holes (ring-output shaft joint, section 2.1);
+- ring: its side of the ring-output shaft joint (section 2.1: 12 bolts), as ``[joints_assumed]
+  ring_output_shaft`` says: "bolt_<k>", per bolt its clamped disc on the flange face (rigid with
+  ``bolt_patch = "rbe2"``, flexgear.fe.bolted), or "bolt_circle", the walls of all 12 bolt holes;
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
-- output shaft: "bolt_circle", the bolt-hole walls of its web, and "bearing_seat" (``bearing_seat_width_mm``
+- output shaft: the same joint interfaces on its web, and "bearing_seat" (``bearing_seat_width_mm``
   at the far end of the tube).
 Load circles (attachment modes, flexgear.fe.attachment): each gear's contact bands, one per mesh and
 helix half, at the mesh's operating pitch radius (sun: the sun-planet mesh; planet: both meshes; ring:
@@ -27,6 +29,7 @@ import numpy as np
 
 from flexgear.cache import atomic_write_bytes, cache_dir
 from flexgear.fe.attachment import LoadCircle
+from flexgear.fe.bolted import bolt_axes, clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.geometry.involute import gear_set_geometry, helix_halves, tooth_normal_local
 from flexgear.geometry.layout import component_layout, geometry_hash
@@ -34,7 +37,7 @@ from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point"]
+           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints", "gear_seat", "bolt_patches"]
 
 """Variant component name -> geometry component name."""
 
@@ -63,21 +66,30 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
     if component == "ring":
-        flange = [p for p in component_layout(spec, "ring").prisms if p.section.holes][0]
-        return [interface(fe, _bolt_hole_nodes(fe, flange.section, (flange.z0, flange.z1)), "bolt_circle")]
+        return _ring_joint_interfaces(fe, spec, component)
     tube = [p for p in component_layout(spec, component).prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
     if component == "input_shaft":
         sun = component_layout(spec, "sun").prisms
         z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
-        joint = interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")
+        joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
-        web = [p for p in component_layout(spec, component).prisms if p.section.holes][0]
-        joint = interface(fe, _bolt_hole_nodes(fe, web.section, (web.z0, web.z1)), "bolt_circle")
+        joints = _ring_joint_interfaces(fe, spec, component)
         far = (z > tube.z1 - seat - _TOL)
-    return [joint, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
+    return [*joints, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
+
+
+def _ring_joint_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
+    """The ring's or the output shaft's side of their joint, as ``[joints_assumed] ring_output_shaft`` says:
+    "rbe3", one interface "bolt_circle" over the walls of all bolt holes (of the ring's flange, the shaft's
+    web); "bolt_patches", one interface "bolt_<k>" per bolt over its clamped disc on the mating face
+    (flexgear.fe.bolted.clamped_patches)."""
+    if bolt_patches(spec):
+        return [interface(fe, nodes, f"bolt_{k}") for k, nodes in enumerate(clamped_patches(fe, spec))]
+    holed = [p for p in component_layout(spec, component).prisms if p.section.holes][0]
+    return [interface(fe, _bolt_hole_nodes(fe, holed.section, (holed.z0, holed.z1)), "bolt_circle")]
 
 
 def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
@@ -148,7 +160,45 @@ def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
 
 
 JOINT_INTERFACES = {"sun": "bore", "input_shaft": "sun_seat", "ring": "bolt_circle", "output_shaft": "bolt_circle"}
-"""Interface of each component in the fixed joints of section 2.1 (input shaft-sun, ring-output shaft)."""
+"""Interface of each component in the fixed joints of section 2.1 with one joint per pair (input shaft-sun,
+ring-output shaft with ``[joints_assumed] ring_output_shaft = "rbe3"``)."""
+
+
+def bolt_patches(spec: GearboxSpec) -> bool:
+    """Whether the ring and the output shaft are joined by bolt patches: ``[joints_assumed] ring_output_shaft``,
+    except with a truncated basis (``[reduction_assumed] simulation_modes`` > 0, speed experiments and the quick
+    variants), which cannot carry twelve 6-DOF joints (12 modes against 72 constraints: the joints would be
+    redundant and the solver fails): that uses the single RBE3 joint at the bolt circle."""
+    return spec.joints_assumed.ring_output_shaft == "bolt_patches" and spec.reduction_assumed.simulation_modes == 0
+
+
+def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.ndarray]]:
+    """The fixed joints of ``gear`` ("sun" or "ring") and its shaft: (gear interface, shaft interface, point [m]).
+
+    Sun-input shaft: one joint at :func:`joint_point`. Ring-output shaft: one at :func:`joint_point` between the
+    "bolt_circle" interfaces ("rbe3"), or per bolt one between the "bolt_<k>" patches, on the bolt's axis in
+    the flange-web plane ("bolt_patches", ``[joints_assumed] ring_output_shaft``).
+    """
+    shaft = {"sun": "input_shaft", "ring": "output_shaft"}[gear]
+    if gear == "ring" and bolt_patches(spec):
+        centres, _, z_j = bolt_axes(spec)
+        return [(f"bolt_{k}", f"bolt_{k}", np.array([x, y, z_j])) for k, (x, y) in enumerate(centres)]
+    return [(JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft], joint_point(spec, gear))]
+
+
+def gear_seat(spec: GearboxSpec, body: ReducedBody, gear: str) -> Interface:
+    """The interface of a gear's reduced body that its deflections are measured from (and held at).
+
+    Sun, planet: the bore. Ring: its side of the joint to the output shaft (:func:`gear_shaft_joints`), as one
+    RBE3 interface "seat" over the union of its joint interfaces' nodes, each interface weighted equally (the
+    bolt circle itself, or the 12 bolt patches together).
+    """
+    if gear != "ring":
+        return body.interface("bore")
+    parts = [body.interface(a) for a, _, _ in gear_shaft_joints(spec, "ring")]
+    nodes = np.concatenate([i.nodes for i in parts])
+    weights = np.concatenate([i.weights for i in parts]) / len(parts)
+    return Interface("seat", nodes, weights, weights @ body.nodes[nodes])
 
 
 def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",
@@ -160,8 +210,12 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
     circles = component_load_circles(spec, name, red.attachment_order)
+    joint = spec.joints_assumed
+    patches = name in ("ring", "output_shaft") and bolt_patches(spec)
+    # the bolt patches are interfaces: they enter the key (the RBE3 bodies keep their former keys)
+    extra = [("bolt_patches", joint.bolt_patch, joint.bolt_clamp_diameter_mm)] if patches else []
     key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
-                        red.simulation_modes, [c.key() for c in circles], _REDUCTION_VERSION)
+                        red.simulation_modes, [c.key() for c in circles], _REDUCTION_VERSION, *extra)
 
     def build() -> ReducedBody:
         from flexgear.fe.fem import fe_model
@@ -174,8 +228,11 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
         # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
         mesh = component_mesh(spec, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
-        return reduce(fe, component_interfaces(fe, spec, name), red.fixed_interface_modes, kind=red.interface,
-                      n_compare=0, keep_modes=red.simulation_modes or None, load_circles=circles)
+        itfs = component_interfaces(fe, spec, name)
+        rigid = patches and joint.bolt_patch == "rbe2"  # rigid bolt patches, the other interfaces as configured
+        return reduce(fe, itfs, red.fixed_interface_modes, kind=red.interface, n_compare=0,
+                      keep_modes=red.simulation_modes or None, load_circles=circles,
+                      rigid=tuple(i.name for i in itfs if rigid and i.name.startswith("bolt_")))
 
     return cached_reduced_body(f"{name}-{level}-{key}", build)
 

@@ -14,7 +14,8 @@ field that causes the problem and what is allowed:
 - backlash below the normal module (a larger one is a unit slip);
 - bores inside the root circle less the relief groove, shaft inner < outer diameter, the input shaft
   inside the sun's bore, the output shaft inside the ring flange, the flange beyond the rim with room for
-  the bolt holes, the bolts side by side on their circle, bearing seats shorter than the shafts.
+  the bolt holes, the bolts side by side on their circle, bearing seats shorter than the shafts, the bolts'
+  clamped discs wider than their holes and narrower than the bolt spacing.
 
 The checks register themselves with :func:`flexgear.spec.register_feasibility_check` when
 :mod:`flexgear` is imported, so every :func:`flexgear.spec.load_gearbox` and
@@ -151,6 +152,12 @@ def _components(spec: GearboxSpec) -> None:
                         f"expected < {bolt_circle / c.ring_bolt_hole_diameter_mm:.0f} bolt holes of "
                         f"{c.ring_bolt_hole_diameter_mm} mm side by side on the {bolt_circle:.1f} mm bolt circle",
                         c.ring_bolt_count)
+    clamp = spec.joints_assumed.bolt_clamp_diameter_mm
+    spacing = 2 * (bolt_circle / math.pi / 2) * math.sin(math.pi / c.ring_bolt_count)  # chord between bolt axes
+    if not c.ring_bolt_hole_diameter_mm < clamp < spacing:
+        raise SpecError(p, "joints_assumed.bolt_clamp_diameter_mm",
+                        f"expected between the bolt hole diameter {c.ring_bolt_hole_diameter_mm} mm and the bolt "
+                        f"spacing {spacing:.1f} mm (clamped discs of neighbouring bolts must not overlap)", clamp)
 
 
 def check_feasibility(spec: GearboxSpec) -> None:

@@ -11,8 +11,11 @@ flexgear.results.signal_columns:
 - ``{outer,inner}_deflection_{load,centrifugal}_{i}_m``: elastic deflection of the flexible gears of mesh i
   along the tooth normal at the contact (mean of the helix halves), the amount by which the gears yield away
   from each other (positive: the mesh approach is reduced), measured relative to each gear's seat interface
-  (bore of sun and planet, bolt circle of the ring: :data:`GEAR_SEATS`), not its floating frame. Split:
-  centrifugal = the quasi-static response to the spin, q_c = omega^2 K_r^-1 Q_c with
+  (bore of sun and planet, the ring's joint interfaces to the output shaft: flexgear.fe.reduced.gear_seat), not
+  its floating frame. Split:
+  centrifugal = the quasi-static response to the spin with the gear's joint interfaces held (its shaft taken as
+  stiff: rigid bolt patches restrain the ring's growth, an RBE3 bore or bolt circle does not, its mean motion
+  being zero), K_r q_c = omega^2 Q_c - G^T mu, G q_c = 0, G the interfaces' motions, with
   Q_c,j = sum_i m_i (x_i psi_ij,x + y_i psi_ij,y) (the zz entry of the FFRF invariant mXRefTildePsiTilde);
   load = the rest (mesh, bearing and joint forces).
 """
@@ -23,15 +26,13 @@ import math
 
 import numpy as np
 
+from flexgear.fe.reduced import gear_seat, gear_shaft_joints
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.laws.ramps import drive_angle
 from flexgear.spec import COMPONENT_GEOMETRY
 
-__all__ = ["GEAR_SEATS", "transmission_error", "centrifugal_modal_load", "mesh_deflection_signals"]
-
-GEAR_SEATS = {"sun": "bore", "planet": "bore", "ring": "bolt_circle"}
-"""Interface of each gear geometry that deflections are measured from."""
-
+__all__ = ["transmission_error", "centrifugal_modal_load", "centrifugal_response", "held_interfaces",
+           "mesh_deflection_signals"]
 
 def transmission_error(model, time_s: np.ndarray, output_angle: np.ndarray) -> np.ndarray:
     """TE [m] (module docstring) from the output's spin angle [rad] at the load point, at times ``time_s``."""
@@ -48,6 +49,19 @@ def centrifugal_modal_load(reduced) -> np.ndarray:
     """Q_c [N per (rad/s)^2 per modal unit], (m,): the modal force of spinning at omega about z is omega^2 Q_c."""
     inv = np.asarray(reduced.invariants["mXRefTildePsiTilde"], float)
     return inv[2, 2::3].copy()
+
+
+def centrifugal_response(reduced, held: np.ndarray) -> np.ndarray:
+    """q_c per (rad/s)^2 (m,): K_r q = Q_c - G^T mu with G q = 0 (``held`` G (r, m), the held interfaces' motions)."""
+    flex = 1.0 / reduced.stiffness
+    free = centrifugal_modal_load(reduced) * flex
+    mu = np.linalg.lstsq((held * flex) @ held.T, held @ free, rcond=None)[0]
+    return free - flex * (held.T @ mu)
+
+
+def held_interfaces(spec, geometry: str) -> list[str]:
+    """Interfaces of a gear held in its centrifugal response: the ring's joints to the output shaft, else the bore."""
+    return [a for a, _, _ in gear_shaft_joints(spec, "ring")] if geometry == "ring" else ["bore"]
 
 
 def _body_geometry(name: str) -> str:
@@ -80,10 +94,12 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             if not body.flexible:
                 continue
             red = body.reduced
-            seat = GEAR_SEATS[_body_geometry(body_name)]
             if body_name not in offsets:
-                q_c_unit = centrifugal_modal_load(red) / red.stiffness
-                offsets[body_name] = (red.interface_motion(seat), red.interface(seat).point, q_c_unit)
+                geometry = _body_geometry(body_name)
+                joints = held_interfaces(model.spec, geometry)
+                q_c_unit = centrifugal_response(red, np.vstack([red.interface_motion(n) for n in joints]))
+                seat = gear_seat(model.spec, red, geometry)
+                offsets[body_name] = (red.interface_motion(seat), seat.point, q_c_unit)
             motion, p_seat, q_c_unit = offsets[body_name]
             row = _column_row(kin, j, body_name)
             ang = spin * theta  # nominal spin angle of the body

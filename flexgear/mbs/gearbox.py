@@ -59,7 +59,8 @@ class GearboxModel:
     aux_node: int = -1  # node of the contacts' deflection coordinates
     input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
-    joints: dict[str, int] = field(default_factory=dict)  # gear -> fixed joint to its shaft (separate bodies)
+    # gear -> its fixed joints to its shaft (separate bodies): (joint, joint point [m] in the gear's frame)
+    joints: dict[str, list[tuple[int, np.ndarray]]] = field(default_factory=dict)
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
     residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
@@ -131,11 +132,11 @@ GEARS = ("sun", "planet", "ring")
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
-                   joint: tuple[str, np.ndarray] | None = None, support: Support | None = None,
+                   joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
                    cutoff_hz: float = 0.0) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
-    ``joint`` (interface name, point [m]): a flexible body gets that interface's marker at that point;
+    ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
     ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support);
     ``cutoff_hz`` > 0: a gear keeps its modes below it as coordinates, the others as ``dropped`` modes whose
     static compliance the contacts carry (flexgear.mbs.residual).
@@ -148,17 +149,22 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     points = {support.interface: support_points(support)} if support is not None else None
     full = reduced(spec, geometry, level)
-    # at least one dynamic mode: the floating-frame object needs one
-    keep = max(1, full.modes_below(cutoff_hz)) if cutoff_hz > 0 and geometry in GEARS else full.n_modes
+    # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
+    # the modes below the cut-off they are redundant and the solver fails); at least one dynamic mode: the
+    # floating-frame object needs one
+    from flexgear.fe.reduced import bolt_patches
+
+    truncate = cutoff_hz > 0 and geometry in GEARS and not (geometry == "ring" and bolt_patches(spec))
+    keep = max(1, full.modes_below(cutoff_hz)) if truncate else full.n_modes
     body = add_flexible_body(mbs, name, full.truncated(keep) if keep < full.n_modes else full, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
-                             interface_markers={joint[0]: joint[1]} if joint else [], point_markers=points,
+                             interface_markers=joints or [], point_markers=points,
                              show=False)
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes
 
-    return replace(body, dropped=dropped_modes(full, keep, geometry))
+    return replace(body, dropped=dropped_modes(spec, full, keep, geometry))
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -167,9 +173,10 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
     ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
-    exact); otherwise they are two bodies joined by a fixed joint at their interfaces
-    (flexgear.fe.reduced.JOINT_INTERFACES, at flexgear.fe.reduced.joint_point): a flexible body
-    through its interface node set's RBE3 motion, a rigid one at the point. The input bearing and the
+    exact); otherwise they are two bodies joined by fixed joints at their interfaces
+    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring per bolt or at the bolt circle as
+    ``[joints_assumed]`` says): a flexible body through its interface node set's RBE3 (or rigid patch)
+    motion, a rigid one at the joint's point. The input bearing and the
     drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
     body when shaft and gear are one): with ``[supports_assumed] placement = "bearing_seats"`` at the
     shafts' bearing seats and the planets' bores (flexgear.geometry.supports, flexgear.mbs.elements.add_support,
@@ -179,7 +186,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
     "exact", the exact geometry's; ``mass_source`` overrides both.
     """
-    from flexgear.fe.reduced import JOINT_INTERFACES, joint_point
+    from flexgear.fe.reduced import gear_shaft_joints
 
     spec = variant.gearbox
     if spec.gears.arrangement != "star":
@@ -209,13 +216,13 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
             ends[gear] = gear
         else:
-            point = joint_point(spec, gear)
+            joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  (JOINT_INTERFACES[gear], point), cutoff_hz=cutoff)
+                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   (JOINT_INTERFACES[shaft], point), supports[shaft] if seats else None)
+                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None)
             bodies += [lead, other]
-            pairs.append((lead, other, (JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft]), point))
+            pairs.append((lead, other, joints))
             ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -223,7 +230,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      props, reduced, support=supports["planet"] if seats else None,
                                      cutoff_hz=cutoff))
     by_body = {bd.name: bd for bd in bodies}
-    joints = {lead.name: add_interface_joint(mbs, lead, other, itfs, point) for lead, other, itfs, point in pairs}
+    joints = {}
+    for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
+        label = f"joint_{lead.name}_{other.name}"
+        joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
+                             for k, (a, b, p) in enumerate(found)]
     b = spec.bearings
     bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
     bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]

@@ -20,7 +20,7 @@ if TYPE_CHECKING:
     from flexgear.mbs.gearbox import GearboxModel
     from flexgear.spec import Variant
 
-__all__ = ["Recorder", "solver_settings", "solve", "simulation_settings", "add_gearbox_sensors"]
+__all__ = ["Recorder", "solver_settings", "solve", "simulation_settings", "add_gearbox_sensors", "joint_axis_torque"]
 
 
 @dataclass
@@ -158,9 +158,13 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
     }
     sensors["output_spin"] = mbs.AddSensor(SensorNode(nodeNumber=model.output_spin[0],
                                                       outputVariableType=ovt.Coordinates, storeInternal=True))
-    for gear, joint in model.joints.items():
-        sensors[f"joint_{gear}"] = mbs.AddSensor(SensorObject(objectNumber=joint, outputVariableType=ovt.TorqueLocal,
-                                                              storeInternal=True))
+    for gear, joints in model.joints.items():
+        for k, (joint, point) in enumerate(joints):
+            sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
+                objectNumber=joint, outputVariableType=ovt.TorqueLocal, storeInternal=True))
+            if np.hypot(point[0], point[1]) > 0.0:  # off the axis: its force has a moment about the axis
+                sensors[f"joint_{gear}_{k}_force"] = mbs.AddSensor(SensorObject(
+                    objectNumber=joint, outputVariableType=ovt.ForceLocal, storeInternal=True))
     if model.kinematics is not None:
         sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
                                                           outputVariableType=ovt.Coordinates, storeInternal=True))
@@ -177,3 +181,24 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                 sensors[f"{kind}_{i + 1}_{h}"] = mbs.AddSensor(SensorObject(
                     objectNumber=obj, outputVariableType=ovt.Force, storeInternal=True))
     return sensors
+
+
+def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: str) -> tuple[np.ndarray, np.ndarray]:
+    """Time [s] and the torque [N·m] about the axis that ``gear``'s joints to its shaft transmit together.
+
+    T_z = sum_k (M_z,k - (x_k F_y,k - y_k F_x,k)) over its joints at points (x_k, y_k, z_k) of the gear's frame,
+    with each joint's local torque M and force F (``TorqueLocal``, ``ForceLocal``; the local frames share the
+    axis z). The minus: Exudyn's generic joint constrains p_m1 - p_m0 (force +lambda_t on marker 1's body) but
+    the z rotation through t_x0 . t_y1 = 0 (moment -lambda_5 on it), so its force and torque outputs act on
+    different bodies; T_z has the sign of the single joint's M_z. Checked: model 4's twelve bolt joints then
+    carry the load torque within 0.2 % (with a plus, 12 % off).
+    """
+    total = None
+    for k, (_, point) in enumerate(model.joints[gear]):
+        data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
+        torque = data[:, 3].copy()
+        if f"joint_{gear}_{k}_force" in sensors:
+            force = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}_force"]))
+            torque -= point[0] * force[:, 2] - point[1] * force[:, 1]
+        total = torque if total is None else total + torque
+    return data[:, 0], total

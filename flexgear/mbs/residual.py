@@ -4,7 +4,7 @@ A gear's converged basis (flexgear.fe.reduced: fixed-interface modes plus the at
 contact bands) has modes far above the mesh frequency: a 44-tooth sun has 4 modes below 17.6 kHz and 59
 above. Those high modes answer a mesh force quasi-statically, so they can leave the dynamic
 coordinates and return as a static compliance in series with the contact law (the mode-acceleration
-method). The gear's seat (bore, bolt circle: flexgear.mbs.deflection.GEAR_SEATS) carries the reaction, so
+method). The gear's seat (bore, the ring's joint interfaces: flexgear.fe.reduced.gear_seat) carries the reaction, so
 the load set of a unit contact force is the force plus its rigid reaction at the seat, self-equilibrated;
 with mass-normalised free-free modes psi_j (omega_j^2 = lambda_j) its modal load and the contact's
 seat-relative deflection share the row
@@ -15,9 +15,11 @@ seat-relative deflection share the row
 flexgear.mbs.contact_kinematics; g_i = (n, (x - p_seat) x n) the contact's rigid lever to the seat,
 Psi_seat the seat's RBE3 motion), and the dropped modes add the compliance and the centrifugal yield
 
-    C_ik = sum_{j dropped} a_ij a_kj / lambda_j,   y_i = -(spin Omega)^2 sum_{j dropped} a_ij Q_c,j / lambda_j
+    C_ik = sum_{j dropped} a_ij a_kj / lambda_j,   y_i = -(spin Omega)^2 sum_j a_ij (u_j - u'_j)
 
-(Q_c: flexgear.mbs.deflection.centrifugal_modal_load). Summed over all modes, C is the full basis' static
+(u: the whole basis' static centrifugal response per (rad/s)^2 with the gear's joint interfaces held,
+flexgear.mbs.deflection.centrifugal_response; u': that of the kept modes alone, which the integration
+carries, padded with zeros). Summed over all modes, C is the full basis' static
 compliance of the contacts relative to the seat. C and y depend on the gear's spin through alpha = psi -
 phi; they are averaged over phi (a gear blank is nearly axisymmetric; ``spread`` says how far). The
 contacts' residuals of all gears add up to one symmetric C over the contacts; its inverse is the constant
@@ -34,7 +36,7 @@ import numpy as np
 
 from flexgear.laws.compiled import ramp_state
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
-from flexgear.mbs.deflection import GEAR_SEATS, centrifugal_modal_load
+from flexgear.mbs.deflection import centrifugal_response, held_interfaces
 
 __all__ = ["DroppedModes", "dropped_modes", "ResidualCompliance", "residual_compliance", "add_residual_coordinates",
            "CentrifugalYield"]
@@ -44,18 +46,25 @@ __all__ = ["DroppedModes", "dropped_modes", "ResidualCompliance", "residual_comp
 class DroppedModes:
     """The modes of a gear's basis above its dynamic cut-off, with what the residual needs of them."""
 
-    modes: np.ndarray  # (3n, m_d) body frame
-    stiffness: np.ndarray  # lambda_j = omega_j^2 [1/s^2]
-    seat_motion: np.ndarray  # (6, m_d) RBE3 translation [m] and rotation [rad] of the seat per mode
+    modes: np.ndarray  # (3n, m) every mode of the basis, body frame
+    stiffness: np.ndarray  # lambda_j = omega_j^2 [1/s^2], (m,)
+    keep: int  # modes 0..keep-1 are integrated, keep.. are dropped
+    seat_motion: np.ndarray  # (6, m) RBE3 translation [m] and rotation [rad] of the seat per mode
     seat_point: np.ndarray  # (3,) [m] body frame
-    centrifugal_load: np.ndarray  # Q_c (m_d,) [N per (rad/s)^2 per modal unit]
+    centrifugal: np.ndarray  # u - u' (m,) [modal units per (rad/s)^2] (module docstring)
 
 
-def dropped_modes(full, keep: int, geometry: str) -> DroppedModes:
-    """Modes ``keep:`` of the reduced body ``full`` (flexgear.fe.cms.ReducedBody) of gear ``geometry``."""
-    seat = GEAR_SEATS[geometry]
-    return DroppedModes(full.modes[:, keep:], full.stiffness[keep:], full.interface_motion(seat)[:, keep:],
-                        np.asarray(full.interface(seat).point, float), centrifugal_modal_load(full)[keep:])
+def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
+    """Modes ``keep:`` of gear ``geometry``'s reduced body ``full`` (flexgear.fe.cms.ReducedBody) as dropped."""
+    from flexgear.fe.reduced import gear_seat
+
+    seat = gear_seat(spec, full, geometry)
+    held = held_interfaces(spec, geometry)
+    whole = centrifugal_response(full, np.vstack([full.interface_motion(n) for n in held]))
+    kept = full.truncated(keep)
+    part = centrifugal_response(kept, np.vstack([kept.interface_motion(n) for n in held])) if keep else np.zeros(0)
+    return DroppedModes(full.modes, full.stiffness, keep, full.interface_motion(seat), np.asarray(seat.point, float),
+                        whole - np.pad(part, (0, full.n_modes - keep)))
 
 
 @dataclass(frozen=True)
@@ -105,13 +114,15 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
         if not rows:
             continue
         samples = [_rows_at(p, parts, d) for p in 2 * np.pi * np.arange(n_angles) / n_angles]
-        comp = np.stack([(a / d.stiffness) @ a.T for a in samples])
+        k = d.keep
+        comp = np.stack([(a[:, k:] / d.stiffness[k:]) @ a[:, k:].T for a in samples])
         mean = comp.mean(axis=0)
         spread = max(spread, float(np.abs(comp - mean).max() / np.abs(np.diag(mean)).max()))
         total[np.ix_(rows, rows)] += mean
-        second[np.ix_(rows, rows)] += np.mean([(a / d.stiffness**2) @ a.T for a in samples], axis=0)
+        second[np.ix_(rows, rows)] += np.mean([(a[:, k:] / d.stiffness[k:] ** 2) @ a[:, k:].T for a in samples],
+                                              axis=0)
         spins2 = np.array([p[2] ** 2 for p in parts])
-        cent[rows] -= spins2 * np.mean([a @ (d.centrifugal_load / d.stiffness) for a in samples], axis=0)
+        cent[rows] -= spins2 * np.mean([a @ d.centrifugal for a in samples], axis=0)
     return ResidualCompliance(0.5 * (total + total.T), cent, spread, 0.5 * (second + second.T))
 
 

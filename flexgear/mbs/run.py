@@ -23,7 +23,7 @@ import pandas as pd
 
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
-from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
+from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
@@ -224,9 +224,9 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:
             meta.update(elastic_share(mbs, model, sensors, signals, window_start))
-        for gear in model.joints:  # torque about the axis that each gear-shaft joint transmits
-            torque = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}"]))
-            meta[f"joint_torque_{gear}_nm"] = float(torque[torque[:, 0] >= window_start, 3].mean())
+        for gear in model.joints:  # torque about the axis that each gear-shaft joint (set) transmits
+            t, torque = joint_axis_torque(mbs, model, sensors, gear)
+            meta[f"joint_torque_{gear}_nm"] = float(torque[t >= window_start].mean())
         if not np.all(np.isfinite(signals.drop(columns="transmission_ratio").to_numpy())):
             raise FloatingPointError("diverged: non-finite signals")
         if states:
