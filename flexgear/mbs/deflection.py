@@ -118,7 +118,9 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
     if residual is not None:  # e > 0 is a yield: it reduces the penetration; its centrifugal part y(t) likewise
         rows = model.residual.rows
         total[:, rows] -= residual
-        centrifugal[:, rows] -= (rate ** 2)[:, None] * model.residual.yield_per_drive_speed2[rows][None, :]
+        # the residual coordinates carry the dropped modes' free centrifugal yield y; the split takes the whole
+        # basis' joint-held answer instead (flexgear.mbs.residual: y')
+        centrifugal[:, rows] -= (rate ** 2)[:, None] * model.residual.split_yield_per_drive_speed2[rows][None, :]
     out = {}
     for kind in ("outer", "inner"):
         groups: dict[int, list[int]] = {}

@@ -15,11 +15,13 @@ seat-relative deflection share the row
 flexgear.mbs.contact_kinematics; g_i = (n, (x - p_seat) x n) the contact's rigid lever to the seat,
 Psi_seat the seat's RBE3 motion), and the dropped modes add the compliance and the centrifugal yield
 
-    C_ik = sum_{j dropped} a_ij a_kj / lambda_j,   y_i = -(spin Omega)^2 sum_j a_ij (u_j - u'_j)
+    C_ik = sum_{j dropped} a_ij a_kj / lambda_j,   y_i = -(spin Omega)^2 sum_{j dropped} a_ij Q_c,j / lambda_j
 
-(u: the whole basis' static centrifugal response per (rad/s)^2 with the gear's joint interfaces held,
-flexgear.mbs.deflection.centrifugal_response; u': that of the kept modes alone, which the integration
-carries, padded with zeros). Summed over all modes, C is the full basis' static
+(Q_c: flexgear.mbs.deflection.centrifugal_modal_load; the dropped modes' free answer to the spin, the joint
+reactions being carried by the kept modes). The deflection signals split off the centrifugal part as the
+whole basis' static answer with the gear's joints held (flexgear.mbs.deflection): their correction for the
+dropped modes is y'_i = -(spin Omega)^2 sum_j a_ij (u_j - u'_j) (u: that answer per (rad/s)^2 of the whole
+basis, u': of the kept modes alone, padded with zeros). Summed over all modes, C is the full basis' static
 compliance of the contacts relative to the seat. C and y depend on the gear's spin through alpha = psi -
 phi; they are averaged over phi (a gear blank is nearly axisymmetric; ``spread`` says how far). The
 contacts' residuals of all gears add up to one symmetric C over the contacts; its inverse is the constant
@@ -36,7 +38,7 @@ import numpy as np
 
 from flexgear.laws.compiled import ramp_state
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
-from flexgear.mbs.deflection import centrifugal_response, held_interfaces
+from flexgear.mbs.deflection import centrifugal_modal_load, centrifugal_response, held_interfaces
 
 __all__ = ["DroppedModes", "dropped_modes", "ResidualCompliance", "residual_compliance", "add_residual_coordinates",
            "CentrifugalYield"]
@@ -51,7 +53,8 @@ class DroppedModes:
     keep: int  # modes 0..keep-1 are integrated, keep.. are dropped
     seat_motion: np.ndarray  # (6, m) RBE3 translation [m] and rotation [rad] of the seat per mode
     seat_point: np.ndarray  # (3,) [m] body frame
-    centrifugal: np.ndarray  # u - u' (m,) [modal units per (rad/s)^2] (module docstring)
+    centrifugal: np.ndarray  # Q_c / lambda on the dropped modes, 0 on the kept (m,) [per (rad/s)^2]
+    centrifugal_split: np.ndarray  # u - u' (m,) [modal units per (rad/s)^2] (module docstring)
 
 
 def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
@@ -63,8 +66,10 @@ def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
     whole = centrifugal_response(full, np.vstack([full.interface_motion(n) for n in held]))
     kept = full.truncated(keep)
     part = centrifugal_response(kept, np.vstack([kept.interface_motion(n) for n in held])) if keep else np.zeros(0)
+    free = centrifugal_modal_load(full) / full.stiffness
+    free[:keep] = 0.0
     return DroppedModes(full.modes, full.stiffness, keep, full.interface_motion(seat), np.asarray(seat.point, float),
-                        whole - np.pad(part, (0, full.n_modes - keep)))
+                        free, whole - np.pad(part, (0, full.n_modes - keep)))
 
 
 @dataclass(frozen=True)
@@ -79,7 +84,8 @@ class ResidualCompliance:
     matrix: np.ndarray
     yield_per_drive_speed2: np.ndarray
     spread: float
-    mass_moment: np.ndarray | None = None  # sum_j a_ij a_kj / lambda_j^2 [m/N s^2... m s^2/N]: the residual mass
+    split_yield_per_drive_speed2: np.ndarray | None = None  # y' per (rad/s)^2 of the drive (module docstring)
+    mass_moment: np.ndarray | None = None  # sum_j a_ij a_kj / lambda_j^2 [m s^2/N]; C^-1 (this) C^-1: Ritz mass [kg]
 
     @property
     def rows(self) -> np.ndarray:
@@ -97,6 +103,7 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
     """
     n_c = len(contacts)
     total, cent, second = np.zeros((n_c, n_c)), np.zeros(n_c), np.zeros((n_c, n_c))
+    split = np.zeros(n_c)
     spread = 0.0
     for name, d in dropped.items():
         body = bodies[name]
@@ -123,7 +130,8 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
                                               axis=0)
         spins2 = np.array([p[2] ** 2 for p in parts])
         cent[rows] -= spins2 * np.mean([a @ d.centrifugal for a in samples], axis=0)
-    return ResidualCompliance(0.5 * (total + total.T), cent, spread, 0.5 * (second + second.T))
+        split[rows] -= spins2 * np.mean([a @ d.centrifugal_split for a in samples], axis=0)
+    return ResidualCompliance(0.5 * (total + total.T), cent, spread, split, 0.5 * (second + second.T))
 
 
 def _rows_at(phi: float, parts: list, d: DroppedModes) -> np.ndarray:
