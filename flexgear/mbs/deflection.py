@@ -97,7 +97,9 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             if body_name not in offsets:
                 geometry = _body_geometry(body_name)
                 joints = held_interfaces(model.spec, geometry)
-                q_c_unit = centrifugal_response(red, np.vstack([red.interface_motion(n) for n in joints]))
+                dropped = getattr(body, "dropped", None)  # truncated: the whole basis' answer (flexgear.mbs.residual)
+                q_c_unit = (dropped.centrifugal_held[:red.n_modes] if dropped is not None else
+                            centrifugal_response(red, np.vstack([red.interface_motion(n) for n in joints])))
                 seat = gear_seat(model.spec, red, geometry)
                 offsets[body_name] = (red.interface_motion(seat), seat.point, q_c_unit)
             motion, p_seat, q_c_unit = offsets[body_name]

@@ -19,9 +19,9 @@ Psi_seat the seat's RBE3 motion), and the dropped modes add the compliance and t
 
 (Q_c: flexgear.mbs.deflection.centrifugal_modal_load; the dropped modes' free answer to the spin, the joint
 reactions being carried by the kept modes). The deflection signals split off the centrifugal part as the
-whole basis' static answer with the gear's joints held (flexgear.mbs.deflection): their correction for the
-dropped modes is y'_i = -(spin Omega)^2 sum_j a_ij (u_j - u'_j) (u: that answer per (rad/s)^2 of the whole
-basis, u': of the kept modes alone, padded with zeros). Summed over all modes, C is the full basis' static
+whole basis' static answer u per (rad/s)^2 with the gear's joints held (flexgear.mbs.deflection; held on the
+kept modes alone it is ill-posed): its kept components u_j, j < keep, give the kept modes' part, the dropped
+ones the correction y'_i = -(spin Omega)^2 sum_{j dropped} a_ij u_j. Summed over all modes, C is the full basis' static
 compliance of the contacts relative to the seat. C and y depend on the gear's spin through alpha = psi -
 phi; they are averaged over phi (a gear blank is nearly axisymmetric; ``spread`` says how far). The
 contacts' residuals of all gears add up to one symmetric C over the contacts; its inverse is the constant
@@ -54,7 +54,7 @@ class DroppedModes:
     seat_motion: np.ndarray  # (6, m) RBE3 translation [m] and rotation [rad] of the seat per mode
     seat_point: np.ndarray  # (3,) [m] body frame
     centrifugal: np.ndarray  # Q_c / lambda on the dropped modes, 0 on the kept (m,) [per (rad/s)^2]
-    centrifugal_split: np.ndarray  # u - u' (m,) [modal units per (rad/s)^2] (module docstring)
+    centrifugal_held: np.ndarray  # u (m,) [modal units per (rad/s)^2], the whole basis, joints held
 
 
 def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
@@ -64,12 +64,10 @@ def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
     seat = gear_seat(spec, full, geometry)
     held = held_interfaces(spec, geometry)
     whole = centrifugal_response(full, np.vstack([full.interface_motion(n) for n in held]))
-    kept = full.truncated(keep)
-    part = centrifugal_response(kept, np.vstack([kept.interface_motion(n) for n in held])) if keep else np.zeros(0)
     free = centrifugal_modal_load(full) / full.stiffness
     free[:keep] = 0.0
     return DroppedModes(full.modes, full.stiffness, keep, full.interface_motion(seat), np.asarray(seat.point, float),
-                        free, whole - np.pad(part, (0, full.n_modes - keep)))
+                        free, whole)
 
 
 @dataclass(frozen=True)
@@ -130,7 +128,7 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
                                               axis=0)
         spins2 = np.array([p[2] ** 2 for p in parts])
         cent[rows] -= spins2 * np.mean([a @ d.centrifugal for a in samples], axis=0)
-        split[rows] -= spins2 * np.mean([a @ d.centrifugal_split for a in samples], axis=0)
+        split[rows] -= spins2 * np.mean([a[:, k:] @ d.centrifugal_held[k:] for a in samples], axis=0)
     return ResidualCompliance(0.5 * (total + total.T), cent, spread, split, 0.5 * (second + second.T))
 
 
