@@ -91,9 +91,10 @@ def test_dropped_modes_carry_most_of_a_small_gears_compliance(gearbox):
 def test_model4_with_the_cutoff_keeps_the_whole_basis_means():
     """Model 4 (flexible sun and ring), impact law, a short run: cut-off 4x mesh frequency against every mode
     dynamic. Mean mesh forces within 0.1 % (issue 16's rule for means). The 1x mesh amplitudes differ by up to
-    5 % (modes at 4-8x the mesh frequency answer quasi-statically; benchmarks/bench_residual.py). The split of
-    the deflection signals into load and centrifugal parts is not checked here: with the joint-held centrifugal
-    split it does not yet agree for a truncated ring (open defect, see the closing note)."""
+    5 % (modes at 4-8x the mesh frequency answer quasi-statically; benchmarks/bench_residual.py). The deflection
+    signals are not asserted here: in this short window they agree within 0.3 % (ring) and 2.4 % (sun: its
+    residual is spin-averaged, its whole-basis value is not), and tests/test_flexible_physics.py checks them
+    against static_compliance x mesh forces on the default formulation."""
     from flexgear.mbs.run import run_variant
 
     v = fg.load_variant(VARIANTS / "model4.toml")
