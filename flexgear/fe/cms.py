@@ -15,9 +15,9 @@ is T = [Psi_s, Phi_f]:
 - ``kind="rbe2"`` (rigid interface): the interface nodes move as a rigid patch, u_b = R_b q; static
   modes [R_b; -K_ii^-1 K_ib R_b], fixed-interface modes from (K_ii, M_ii): classical Craig-Bampton.
 
-Both are solved with one sparse factorisation. The free body's K is singular, so the rigid-body
-motion is split off exactly: u = R a + u_f with u_f zero on six determinate support coordinates
-(chosen by pivoted QR of the rigid modes R); u^T K u = u_f^T K_ff u_f with K_ff positive definite,
+Both are solved with one sparse Cholesky factorisation (flexgear.fe.cholesky). The free body's K is
+singular, so the rigid-body motion is split off exactly: u = R a + u_f with u_f zero on six determinate
+support coordinates (chosen by pivoted QR of the rigid modes R); u^T K u = u_f^T K_ff u_f with K_ff positive definite,
 and each constrained solve is one K_ff solve plus a small dense saddle-point system.
 
 Free-free modes. T contains the rigid-body modes exactly (a rigid motion is the zero-energy solution
@@ -46,6 +46,7 @@ import scipy.sparse.linalg as sla
 from threadpoolctl import threadpool_limits
 
 from flexgear.fe.attachment import LoadCircle, load_patterns, modal_basis
+from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import FEModel, rigid_body_modes
 from flexgear.geometry.massprops import MassProperties
 
@@ -138,12 +139,11 @@ class _FreeBodySolver:
         self.free = np.flatnonzero(mask)
         self.Rs_inv = np.linalg.inv(self.R[self.support])
         self.R = self.R @ self.Rs_inv  # now R[support] = I: u = R u_s + E_f u_f
-        k_ff = fe.K[self.free][:, self.free].tocsc()
-        self.lu = sla.splu(k_ff, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
-        self.nnz_factor = self.lu.L.nnz + self.lu.U.nnz
+        self.chol = SparseCholesky(fe.K[self.free][:, self.free])  # K_ff: positive definite
+        self.factor_bytes = self.chol.factor_bytes
 
     def solve_ff(self, rhs: np.ndarray) -> np.ndarray:
-        return self.lu.solve(np.ascontiguousarray(rhs))
+        return self.chol.solve(rhs)
 
     def constrained(self, c: sp.spmatrix | np.ndarray) -> _Constrained:
         return _Constrained(self, c)
@@ -338,8 +338,8 @@ def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int,
     mask = np.ones(fe.n_dof, bool)
     mask[bdofs] = False
     idofs = np.flatnonzero(mask)
-    k_ii = fe.K[idofs][:, idofs].tocsc()
-    lu = sla.splu(k_ii, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    k_ii = fe.K[idofs][:, idofs].tocsr()
+    chol = SparseCholesky(k_ii)  # the clamped interior: positive definite
     k_ib = fe.K[idofs][:, bdofs]
     ub = np.zeros((len(bdofs), 6 * len(interfaces)))
     for j, itf in enumerate(interfaces):
@@ -349,10 +349,10 @@ def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int,
         ub[rows, 6 * j:6 * j + 6] = rig
     static = np.zeros((fe.n_dof, ub.shape[1]))
     static[bdofs] = ub
-    static[idofs] = -lu.solve(np.asarray(k_ib @ ub))
+    static[idofs] = -chol.solve(np.asarray(k_ib @ ub))
     m = fe.M
     m_ii = m[idofs][:, idofs]
-    op = sla.LinearOperator(k_ii.shape, matvec=lu.solve, dtype=float)
+    op = sla.LinearOperator(k_ii.shape, matvec=chol.solve, dtype=float)
     fixed = np.zeros((fe.n_dof, 0))
     if n_modes:
         _, vec = sla.eigsh(k_ii, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", tol=1e-10)
@@ -360,20 +360,20 @@ def _rbe2_basis(fe: FEModel, interfaces: list[Interface], n_modes: int,
         fixed[idofs] = vec
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
-        attached[idofs] = lu.solve(np.ascontiguousarray(patterns[idofs]))
-    return static, fixed, attached, lu.L.nnz + lu.U.nnz
+        attached[idofs] = chol.solve(patterns[idofs])
+    return static, fixed, attached, chol.factor_bytes
 
 
 @dataclass
 class BasisParts:
     """The reduction basis before compression: interface static modes (3n, 6 J), fixed-interface modes
     (3n, n_modes, lowest first), attachment modes (3n, sum 2 N + 1, per circle in the order of
-    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor size."""
+    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor's memory [bytes]."""
 
     static: np.ndarray
     fixed: np.ndarray
     attached: np.ndarray
-    nnz: int
+    factor_bytes: int
     solver: _FreeBodySolver | None = None
 
 
@@ -393,7 +393,7 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
     static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
     fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
-    return BasisParts(static, fixed, attached, solver.nnz_factor, solver)
+    return BasisParts(static, fixed, attached, solver.factor_bytes, solver)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
@@ -417,16 +417,21 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
     itfs = [interface(fe, i) if isinstance(i, str) else i for i in interfaces]
     t0 = time.perf_counter()
     parts = reduction_basis(fe, itfs, n_modes, kind, load_circles)
-    modes, lam, dropped = modal_basis(np.hstack([parts.static, parts.fixed, parts.attached]), fe.K, fe.M)
+    t_full, full = time.perf_counter(), np.zeros(0)
+    if n_compare:  # here, while the factor exists: it is freed before the dense work on the basis
+        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
+    t_full = time.perf_counter() - t_full
+    n_attached, factor_bytes = parts.attached.shape[1], parts.factor_bytes
+    basis = np.hstack([parts.static, parts.fixed, parts.attached])
+    del parts  # the factor and the blocks: the peak memory is the factor's or the basis's, not both
+    modes, lam, dropped = modal_basis(basis, fe.K, fe.M)
+    del basis
     if keep_modes is not None:
         modes, lam = modes[:, :keep_modes], lam[:keep_modes]
-    t_reduce = time.perf_counter() - t0
-    full = np.zeros(0)
-    if n_compare:
-        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
+    t_reduce = time.perf_counter() - t0 - t_full
     invariants = ffrf_invariants(fe.mass_scalar, fe.nodes, modes)
-    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_nnz": float(parts.nnz),
-            "attachment_vectors": float(parts.attached.shape[1]), "dropped_directions": float(dropped),
+    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_mb": factor_bytes / 1e6,
+            "attachment_vectors": float(n_attached), "dropped_directions": float(dropped),
             "reduce_time_s": t_reduce, "total_time_s": time.perf_counter() - t0}
     return ReducedBody(fe.nodes, modes, lam, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), full, itfs, kind,
                        n_modes, fe.mass_properties(), invariants, fe.surface_triangles, info)

@@ -155,7 +155,8 @@ def _refine_teeth(geo, spec: GearboxSpec, component: str, size: float, mp) -> No
                     mp.RestrictH(p.x, p.y, p.z, size)
 
 
-def _netgen_mesh(brep: Path, spec: GearboxSpec, component: str, level: str, order: int):
+def _netgen_mesh(brep: Path, spec: GearboxSpec, component: str, level: str):
+    """The first-order Netgen mesh of the solid, its OCC geometry attached (a second order is raised from it)."""
     import netgen.meshing as nm
     from netgen.occ import OCCGeometry
 
@@ -166,10 +167,7 @@ def _netgen_mesh(brep: Path, spec: GearboxSpec, component: str, level: str, orde
         grading=_GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=settings.optimisation_steps,
         optsteps3d=settings.optimisation_steps)
     _refine_teeth(geo, spec, component, settings.tooth_size_mm * 1e-3, mp)
-    ngmesh = geo.GenerateMesh(mp=mp)
-    if order > 1:
-        ngmesh.SecondOrder()
-    return ngmesh
+    return geo.GenerateMesh(mp=mp)
 
 
 def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -242,16 +240,49 @@ def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", ord
         raise ValueError(f"unknown mesh level {level!r}; gearbox.toml [meshing_assumed] has "
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
+    cached = _cached_mesh(spec, component, level, order, progress)
+    return cached if cached is not None else _build_mesh(spec, component, level, order, progress)[0]
+
+
+def _cached_mesh(spec: GearboxSpec, component: str, level: str, order: int,
+                 progress: bool) -> ComponentMesh | None:
+    """The cached mesh of ``component`` at ``level`` and ``order``, or None."""
     paths = _paths(spec, component, level, order)
     brep = component_brep(spec, component, progress)
-    if paths["npz"].exists() and paths["vol"].exists() and paths["json"].exists():
-        data = np.load(paths["npz"])
-        info = json.loads(paths["json"].read_text())
-        regions = {k[len("region_"):]: data[k] for k in data.files if k.startswith("region_")}
-        return ComponentMesh(component, level, order, data["nodes"], data["elements"], data["surface"], regions,
-                             info["build_time_s"], paths["vol"], brep)
+    if not (paths["npz"].exists() and paths["vol"].exists() and paths["json"].exists()):
+        return None
+    data = np.load(paths["npz"])
+    info = json.loads(paths["json"].read_text())
+    regions = {k[len("region_"):]: data[k] for k in data.files if k.startswith("region_")}
+    return ComponentMesh(component, level, order, data["nodes"], data["elements"], data["surface"], regions,
+                         info["build_time_s"], paths["vol"], brep)
+
+
+def _build_mesh(spec: GearboxSpec, component: str, level: str, order: int, progress: bool):
+    """Mesh ``component`` (cache miss), store it; (ComponentMesh, its Netgen mesh with the OCC geometry).
+
+    Netgen meshes once per component and level: a second-order mesh is the first-order mesh (the cached
+    one, or meshed and stored here) raised by ``SecondOrder()``, edge nodes on the true surfaces, the same
+    topology the reduction's FE model is built on (flexgear.fe.fem raises the order the same way).
+    """
+    from netgen.occ import OCCGeometry
+
+    paths = _paths(spec, component, level, order)
+    brep = component_brep(spec, component, progress)
     t0 = time.perf_counter()
-    ngmesh = _netgen_mesh(brep, spec, component, level, order)
+    if order == 1:
+        ngmesh = _netgen_mesh(brep, spec, component, level)
+    else:
+        first = _cached_mesh(spec, component, level, 1, progress)
+        if first is None:
+            first, ngmesh = _build_mesh(spec, component, level, 1, progress)
+        else:
+            import netgen.meshing as nm
+
+            ngmesh = nm.Mesh()
+            ngmesh.Load(str(first.vol_path))
+            ngmesh.SetGeometry(OCCGeometry(str(brep)))
+        ngmesh.SecondOrder()
     nodes, elements, surface = _arrays(ngmesh, order)
     build = time.perf_counter() - t0
     surface = _orient_outward(nodes, surface)
@@ -271,7 +302,7 @@ def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", ord
     role = "" if order == spec.meshing_assumed[level].element_order else " (topology for the reduction)"
     _say(progress, f"  {component} ({level}): {mesh.n_elements} tetrahedra, {mesh.n_nodes} nodes, "
                    f"order {order}{role}, meshed in {build:.1f} s")
-    return mesh
+    return mesh, ngmesh
 
 
 def build_meshes(spec: GearboxSpec, level: str = "default", progress: bool = True,
