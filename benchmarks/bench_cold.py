@@ -11,9 +11,10 @@ Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold mak
 CPU time is the sum over the command's processes (user + system; on a busy machine the steadier figure,
 but parallel work counts once per core). Peak memory is the largest maximum resident set size among the
 command's processes and their descendants (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process that runs
-only that command); with worker processes running side by side the machine needs their sum, so the
-largest sum of the resident sets of the command's process tree, sampled every 0.2 s, is reported too
-(it can miss a peak shorter than that).
+only that command). With worker processes side by side the machine needs their sum, so the largest sum
+over the command's process tree, sampled every 0.2 s (a shorter peak can be missed), is reported too, of
+the resident sets (shared library pages counted once per process: an upper bound) and of the proportional
+set sizes (each shared page split among the processes that map it: the memory the tree occupies).
 Each round uses its own empty folders, removed afterwards.
 """
 
@@ -36,8 +37,21 @@ from speed_common import figure_line, load_average
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def _tree_rss(root: int) -> int:
-    """Sum of the resident sets [bytes] of process ``root`` and its descendants (Linux /proc)."""
+def _pss(pid: int) -> int:
+    """Proportional set size [bytes] of process ``pid`` (Linux /proc/PID/smaps_rollup; 0 if it has ended)."""
+    try:
+        with open(f"/proc/{pid}/smaps_rollup") as f:
+            for line in f:
+                if line.startswith("Pss:"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return 0
+
+
+def _tree_memory(root: int) -> tuple[int, int]:
+    """Sums of the resident sets and of the proportional set sizes [bytes] of process ``root`` and its
+    descendants (Linux /proc)."""
     parent, rss = {}, {}
     for entry in os.listdir("/proc"):
         if not entry.isdigit():
@@ -51,12 +65,13 @@ def _tree_rss(root: int) -> int:
     children: dict[int, list[int]] = {}
     for pid, ppid in parent.items():
         children.setdefault(ppid, []).append(pid)
-    total, todo = 0, [root]
+    total_rss, total_pss, todo = 0, 0, [root]
     while todo:
         pid = todo.pop()
-        total += rss.get(pid, 0)
+        total_rss += rss.get(pid, 0)
+        total_pss += _pss(pid)
         todo += children.get(pid, [])
-    return total
+    return total_rss, total_pss
 
 
 def _child(cmd: list[str]) -> None:
@@ -64,12 +79,12 @@ def _child(cmd: list[str]) -> None:
     and the largest sampled sum over its process tree [bytes]."""
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
-    peak_sum = [0]
+    peak_sum = [0, 0]
     stop = threading.Event()
 
     def sample() -> None:
         while not stop.wait(0.2):
-            peak_sum[0] = max(peak_sum[0], _tree_rss(proc.pid))
+            peak_sum[:] = [max(p, m) for p, m in zip(peak_sum, _tree_memory(proc.pid), strict=True)]
 
     sampler = threading.Thread(target=sample, daemon=True)
     sampler.start()
@@ -81,6 +96,7 @@ def _child(cmd: list[str]) -> None:
     tail = stderr.strip().splitlines()[-3:] if proc.returncode else []
     print(json.dumps({"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "returncode": proc.returncode,
                       "max_rss_bytes": usage.ru_maxrss * 1024, "tree_rss_bytes": peak_sum[0],
+                      "tree_pss_bytes": peak_sum[1],
                       "stderr_tail": tail}))  # ru_maxrss: KiB (Linux)
 
 
@@ -110,6 +126,7 @@ def main() -> None:
     cpus: dict[str, list[float]] = {s: [] for s in a.sections}
     rss: dict[str, list[float]] = {s: [] for s in a.sections}
     tree: dict[str, list[float]] = {s: [] for s in a.sections}
+    tree_pss: dict[str, list[float]] = {s: [] for s in a.sections}
     for i in range(a.repeat):
         for section in a.sections:
             folder = Path(tempfile.mkdtemp(prefix=f"flexgear-bench-{section}-"))
@@ -123,9 +140,10 @@ def main() -> None:
             cpus[section].append(res["cpu_s"])
             rss[section].append(res["max_rss_bytes"] / 1e9)
             tree[section].append(res["tree_rss_bytes"] / 1e9)
+            tree_pss[section].append(res["tree_pss_bytes"] / 1e9)
             print(f"round {i + 1} {section}: wall {res['wall_s']:.1f} s, CPU {res['cpu_s']:.1f} s, "
-                  f"peak RSS {rss[section][-1]:.2f} GB (largest process), {tree[section][-1]:.2f} GB (sum over "
-                  f"the processes); {load_average()}", flush=True)
+                  f"peak RSS {rss[section][-1]:.2f} GB (largest process), sums over the processes: RSS "
+                  f"{tree[section][-1]:.2f} GB, PSS {tree_pss[section][-1]:.2f} GB; {load_average()}", flush=True)
     print()
     goals = {"cold": ("<= 90 s", ""), "make": ("", "<= 2 GB")}
     for section in a.sections:
@@ -133,7 +151,8 @@ def main() -> None:
         print(figure_line(f"{section} CPU, all processes [s]", cpus[section]))
         print(figure_line(f"{section} peak RSS, largest process [GB]", rss[section], "GB")
               + f"   goal {goals[section][1] or '-'}")
-        print(figure_line(f"{section} peak RSS, sum over processes [GB]", tree[section], "GB")
+        print(figure_line(f"{section} peak RSS, sum over processes [GB]", tree[section], "GB"))
+        print(figure_line(f"{section} peak PSS, sum over processes [GB]", tree_pss[section], "GB")
               + f"   goal {goals[section][1] or '-'}")
     print(f"after: {load_average()}")
 

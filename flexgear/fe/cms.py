@@ -139,7 +139,9 @@ class _FreeBodySolver:
         self.free = np.flatnonzero(mask)
         self.Rs_inv = np.linalg.inv(self.R[self.support])
         self.R = self.R @ self.Rs_inv  # now R[support] = I: u = R u_s + E_f u_f
-        self.chol = SparseCholesky(fe.K[self.free][:, self.free])  # K_ff: positive definite
+        # K_ff (positive definite): its lower triangle, which is the lower triangle of K restricted to the
+        # (ascending) free coordinates, all the factorisation reads
+        self.chol = SparseCholesky(sp.tril(fe.K, format="csr")[self.free][:, self.free])
         self.factor_bytes = self.chol.factor_bytes
 
     def solve_ff(self, rhs: np.ndarray) -> np.ndarray:

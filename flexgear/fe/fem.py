@@ -157,7 +157,8 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
     block = np.arange(3 * n)  # NGSolve order: all x, all y, all z -> interleaved position 3 i + c
     k_inter = _to_scipy(k_form.mat, 3 * n, 3 * (block % n) + block // n)
     del k_form
-    k_inter = ((k_inter + k_inter.T) * 0.5).tocsr()  # remove round-off asymmetry
+    k_inter = (k_inter + k_inter.T).tocsr()  # remove round-off asymmetry: (K + K^T) / 2, halved in place
+    k_inter.data *= 0.5
     mass_scalar = _to_scipy(m_form.mat, n)
     del m_form
 
