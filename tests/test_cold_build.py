@@ -6,12 +6,12 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import scipy.sparse.linalg as sla
+from test_flexible import STEEL, ring_mesh
 
 from flexgear.fe.build import COLD_BUILD_ORDER, build_components
 from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import fe_model
 from flexgear.spec import GEOMETRY_COMPONENTS
-from test_flexible import STEEL, ring_mesh
 
 
 def test_cholesky_solves_the_stiffness_system_as_superlu_does():
