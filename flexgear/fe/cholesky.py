@@ -25,7 +25,8 @@ def _ng_array(values: np.ndarray, cls):
 
 
 class SparseCholesky:
-    """Factor of a symmetric positive-definite sparse matrix ``k`` (n, n); only its lower triangle is read.
+    """Factor of a symmetric positive-definite sparse matrix ``k`` (n, n); only its lower triangle is read
+    (pass that alone to save memory).
 
     :meth:`solve` returns K^-1 rhs for rhs (n,) or (n, k); ``factor_bytes`` is the factor's memory [bytes].
     """
@@ -36,12 +37,13 @@ class SparseCholesky:
 
         if k.shape[0] != k.shape[1]:
             raise ValueError(f"SparseCholesky: matrix must be square, got shape {k.shape}")
-        lower = sp.tril(k, format="coo")
+        lower = sp.tril(k, format="csr")  # rows as run lengths: no COO copy of the row indices
         self.n = k.shape[0]
-        mat = la.SparseMatrixd.CreateFromCOO(_ng_array(lower.row, pyngcore.Array_I_S),
-                                             _ng_array(lower.col, pyngcore.Array_I_S),
+        rows = np.repeat(np.arange(self.n, dtype=np.int32), np.diff(lower.indptr))
+        mat = la.SparseMatrixd.CreateFromCOO(_ng_array(rows, pyngcore.Array_I_S),
+                                             _ng_array(lower.indices, pyngcore.Array_I_S),
                                              _ng_array(lower.data, pyngcore.Array_D_S), self.n, self.n)
-        del lower
+        del lower, rows
         self._inv = mat.Inverse(inverse="sparsecholesky")
         self._x, self._y = mat.CreateColVector(), mat.CreateColVector()
         self.factor_bytes = sum(u.host for u in self._inv.GetMemoryUsage())

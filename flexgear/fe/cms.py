@@ -56,6 +56,7 @@ __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights"
 _EPS = np.zeros((3, 3, 3))
 _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
 _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
+_SOLVE_BLOCK = 8  # columns per block of constrained static solves (memory: 6 work arrays of 3n x 8)
 
 
 @dataclass(frozen=True)
@@ -169,9 +170,21 @@ class _Constrained:
         self.p = p
 
     def solve(self, g: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
-        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k), e (p, k)."""
-        s, p = self.s, self.p
+        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k), e (p, k).
+
+        Columns are solved in blocks of ``_SOLVE_BLOCK``: each is independent, and the work arrays stay small.
+        """
         g = np.atleast_2d(g.T).T
+        if g.shape[1] <= _SOLVE_BLOCK:
+            return self._solve(g, e)
+        u = np.empty(g.shape)
+        for j in range(0, g.shape[1], _SOLVE_BLOCK):
+            cols = slice(j, j + _SOLVE_BLOCK)
+            u[:, cols] = self._solve(g[:, cols], None if e is None else e[:, cols])
+        return u
+
+    def _solve(self, g: np.ndarray, e: np.ndarray | None) -> np.ndarray:
+        s, p = self.s, self.p
         y = s.solve_ff(g[s.free])
         rhs = np.vstack([np.asarray(self.c_f @ y) - (0.0 if e is None else e), s.R.T @ g])
         sol = la.lu_solve(self.lu_small, rhs)
