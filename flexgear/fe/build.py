@@ -5,8 +5,8 @@ process: mesh (one Netgen run; flexgear.fe.mesh keeps the first-order mesh in me
 then the reduced body (flexgear.fe.reduced, cached like any other call). The components are independent,
 so the results are those of the serial build (same cache entries). Longest tasks are started first
 (:data:`COLD_BUILD_ORDER`) so that two workers finish together. Memory: each worker holds one
-component at a time (the coarse ring's at most about 1.3 GB, the others less; measured by
-benchmarks/bench_cold.py, which reports the sum over the worker processes too).
+component at a time; at the coarse level the largest process (the ring's) peaks at 1.3 GB and the whole
+process tree at 1.9-2.0 GB (sum of proportional set sizes; benchmarks/bench_cold.py measures both).
 """
 
 from __future__ import annotations
