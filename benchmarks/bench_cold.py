@@ -12,7 +12,7 @@ CPU time is the sum over the command's processes (user + system; on a busy machi
 but parallel work counts once per core). Peak memory is the largest maximum resident set size among the
 command's processes and their descendants (``getrusage(RUSAGE_CHILDREN)`` of a wrapper process that runs
 only that command). With worker processes side by side the machine needs their sum, so the largest sum
-over the command's process tree, sampled every 0.2 s (a shorter peak can be missed), is reported too, of
+over the command's process tree, sampled every 0.5 s (a shorter peak can be missed), is reported too, of
 the resident sets (shared library pages counted once per process: an upper bound) and of the proportional
 set sizes (each shared page split among the processes that map it: the memory the tree occupies).
 Each round uses its own empty folders, removed afterwards.
@@ -35,6 +35,7 @@ from pathlib import Path
 from speed_common import figure_line, load_average
 
 ROOT = Path(__file__).resolve().parents[1]
+_SAMPLE_S = 0.5  # s between memory samples (each reads /proc of every process; 0.2 s took ~10 % of a core)
 
 
 def _pss(pid: int) -> int:
@@ -83,7 +84,7 @@ def _child(cmd: list[str]) -> None:
     stop = threading.Event()
 
     def sample() -> None:
-        while not stop.wait(0.2):
+        while not stop.wait(_SAMPLE_S):
             peak_sum[:] = [max(p, m) for p, m in zip(peak_sum, _tree_memory(proc.pid), strict=True)]
 
     sampler = threading.Thread(target=sample, daemon=True)
