@@ -229,30 +229,29 @@ def _args_meshes(p: argparse.ArgumentParser) -> None:
                    help="gearbox file (default: %(default)s)")
     p.add_argument("--level", default="coarse", help="mesh level of gearbox.toml [meshing_assumed] (default: coarse)")
     p.add_argument("--no-reduce", action="store_true", help="meshes only, no reduced flexible bodies")
+    p.add_argument("--workers", type=int, default=2, metavar="N",
+                   help="worker processes, one component each (default: %(default)s; 1: in this process)")
 
 
 def cmd_meshes(a: argparse.Namespace) -> int:
-    from flexgear.fe.mesh import component_mesh
-    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.fe.build import build_components
     from flexgear.spec import GEOMETRY_COMPONENTS, SpecError, load_gearbox
 
     spec = load_gearbox(a.gearbox)
     if a.level not in spec.meshing_assumed:
         raise SpecError(a.gearbox, "meshing_assumed", f"has no level {a.level!r}; levels: "
                         f"{', '.join(sorted(spec.meshing_assumed))}")
-    with Progress(len(GEOMETRY_COMPONENTS), f"meshes ({a.level})", "parts", fmt="{:.0f}",
+    if a.workers < 1:
+        raise SystemExit(f"flexgear meshes: --workers must be >= 1, got {a.workers}")
+    what = "meshes" if a.no_reduce else "meshes and reduced bodies"
+    with Progress(len(GEOMETRY_COMPONENTS), f"{what} ({a.level})", "parts", fmt="{:.0f}",
                   plain_step=1 / len(GEOMETRY_COMPONENTS)) as bar:
-        for i, name in enumerate(GEOMETRY_COMPONENTS, 1):
-            mesh = component_mesh(spec, name, a.level)
-            bar.update_to(i, postfix=f"{name}: {mesh.n_elements} tetrahedra, order {mesh.order}")
-    if a.no_reduce:
-        return 0
-    components = GEOMETRY_COMPONENTS
-    with Progress(len(components), f"reduced bodies ({a.level})", "parts", fmt="{:.0f}",
-                  plain_step=1 / len(components)) as bar:
-        for i, component in enumerate(components, 1):
-            body = component_reduced_body(spec, component, a.level)
-            bar.update_to(i, postfix=f"{component}: {body.n_modes} modes, first {body.frequencies_hz[0]:.0f} Hz")
+        def done(c) -> None:
+            modes = "" if c.n_modes is None else f", {c.n_modes} modes, first {c.first_frequency_hz:.0f} Hz"
+            bar.update_to(bar.value + 1, postfix=f"{c.component}: {c.n_elements} tetrahedra, order "
+                          f"{c.element_order}{modes}")
+
+        build_components(spec, a.level, reduce=not a.no_reduce, workers=a.workers, on_done=done)
     return 0
 
 

@@ -16,9 +16,9 @@ is T = [Psi_s, Phi_f]:
   modes [R_b; -K_ii^-1 K_ib R_b], fixed-interface modes from (K_ii, M_ii): classical Craig-Bampton.
   Mixed (``rigid=`` names): those interfaces rigid, the others RBE3 rows on the interior (bolt patches).
 
-Both are solved with one sparse factorisation. The free body's K is singular, so the rigid-body
-motion is split off exactly: u = R a + u_f with u_f zero on six determinate support coordinates
-(chosen by pivoted QR of the rigid modes R); u^T K u = u_f^T K_ff u_f with K_ff positive definite,
+Both are solved with one sparse Cholesky factorisation (flexgear.fe.cholesky). The free body's K is
+singular, so the rigid-body motion is split off exactly: u = R a + u_f with u_f zero on six determinate
+support coordinates (chosen by pivoted QR of the rigid modes R); u^T K u = u_f^T K_ff u_f with K_ff positive definite,
 and each constrained solve is one K_ff solve plus a small dense saddle-point system.
 
 Free-free modes. T contains the rigid-body modes exactly (a rigid motion is the zero-energy solution
@@ -47,6 +47,7 @@ import scipy.sparse.linalg as sla
 from threadpoolctl import threadpool_limits
 
 from flexgear.fe.attachment import LoadCircle, load_patterns, modal_basis
+from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import FEModel, rigid_body_modes
 from flexgear.geometry.massprops import MassProperties
 
@@ -56,6 +57,7 @@ __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights"
 _EPS = np.zeros((3, 3, 3))
 _EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
 _EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
+_SOLVE_BLOCK = 8  # columns per block of constrained static solves (memory: 6 work arrays of 3n x 8)
 
 
 @dataclass(frozen=True)
@@ -139,12 +141,13 @@ class _FreeBodySolver:
         self.free = np.flatnonzero(mask)
         self.Rs_inv = np.linalg.inv(self.R[self.support])
         self.R = self.R @ self.Rs_inv  # now R[support] = I: u = R u_s + E_f u_f
-        k_ff = fe.K[self.free][:, self.free].tocsc()
-        self.lu = sla.splu(k_ff, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
-        self.nnz_factor = self.lu.L.nnz + self.lu.U.nnz
+        # K_ff (positive definite): its lower triangle, which is the lower triangle of K restricted to the
+        # (ascending) free coordinates, all the factorisation reads
+        self.chol = SparseCholesky(sp.tril(fe.K, format="csr")[self.free][:, self.free])
+        self.factor_bytes = self.chol.factor_bytes
 
     def solve_ff(self, rhs: np.ndarray) -> np.ndarray:
-        return self.lu.solve(np.ascontiguousarray(rhs))
+        return self.chol.solve(rhs)
 
     def constrained(self, c: sp.spmatrix | np.ndarray) -> _Constrained:
         return _Constrained(self, c)
@@ -168,9 +171,21 @@ class _Constrained:
         self.p = p
 
     def solve(self, g: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
-        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k), e (p, k)."""
-        s, p = self.s, self.p
+        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k), e (p, k).
+
+        Columns are solved in blocks of ``_SOLVE_BLOCK``: each is independent, and the work arrays stay small.
+        """
         g = np.atleast_2d(g.T).T
+        if g.shape[1] <= _SOLVE_BLOCK:
+            return self._solve(g, e)
+        u = np.empty(g.shape)
+        for j in range(0, g.shape[1], _SOLVE_BLOCK):
+            cols = slice(j, j + _SOLVE_BLOCK)
+            u[:, cols] = self._solve(g[:, cols], None if e is None else e[:, cols])
+        return u
+
+    def _solve(self, g: np.ndarray, e: np.ndarray | None) -> np.ndarray:
+        s, p = self.s, self.p
         y = s.solve_ff(g[s.free])
         rhs = np.vstack([np.asarray(self.c_f @ y) - (0.0 if e is None else e), s.R.T @ g])
         sol = la.lu_solve(self.lu_small, rhs)
@@ -381,19 +396,19 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
         attached[idofs] = solve(patterns[idofs])
-    return static, fixed, attached, lu.L.nnz + lu.U.nnz
+    return static, fixed, attached, 12 * (lu.L.nnz + lu.U.nnz)  # bytes: a float64 value and an int32 index each
 
 
 @dataclass
 class BasisParts:
     """The reduction basis before compression: interface static modes (3n, 6 J), fixed-interface modes
     (3n, n_modes, lowest first), attachment modes (3n, sum 2 N + 1, per circle in the order of
-    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor size."""
+    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor's memory [bytes]."""
 
     static: np.ndarray
     fixed: np.ndarray
     attached: np.ndarray
-    nnz: int
+    factor_bytes: int
     solver: _FreeBodySolver | None = None
 
 
@@ -414,7 +429,7 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
     static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
     fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
-    return BasisParts(static, fixed, attached, solver.nnz_factor, solver)
+    return BasisParts(static, fixed, attached, solver.factor_bytes, solver)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
@@ -442,16 +457,21 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
     itfs = [interface(fe, i) if isinstance(i, str) else i for i in interfaces]
     t0 = time.perf_counter()
     parts = reduction_basis(fe, itfs, n_modes, kind, load_circles, rigid=tuple(rigid))
-    modes, lam, dropped = modal_basis(np.hstack([parts.static, parts.fixed, parts.attached]), fe.K, fe.M)
+    t_full, full = time.perf_counter(), np.zeros(0)
+    if n_compare:  # here, while the factor exists: it is freed before the dense work on the basis
+        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
+    t_full = time.perf_counter() - t_full
+    n_attached, factor_bytes = parts.attached.shape[1], parts.factor_bytes
+    basis = np.hstack([parts.static, parts.fixed, parts.attached])
+    del parts  # the factor and the blocks: the peak memory is the factor's or the basis's, not both
+    modes, lam, dropped = modal_basis(basis, fe.K, fe.M)
+    del basis
     if keep_modes is not None:
         modes, lam = modes[:, :keep_modes], lam[:keep_modes]
-    t_reduce = time.perf_counter() - t0
-    full = np.zeros(0)
-    if n_compare:
-        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
+    t_reduce = time.perf_counter() - t0 - t_full
     invariants = ffrf_invariants(fe.mass_scalar, fe.nodes, modes)
-    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_nnz": float(parts.nnz),
-            "attachment_vectors": float(parts.attached.shape[1]), "dropped_directions": float(dropped),
+    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_mb": factor_bytes / 1e6,
+            "attachment_vectors": float(n_attached), "dropped_directions": float(dropped),
             "reduce_time_s": t_reduce, "total_time_s": time.perf_counter() - t0}
     return ReducedBody(fe.nodes, modes, lam, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), full, itfs, kind,
                        n_modes, fe.mass_properties(), invariants, fe.surface_triangles, info)

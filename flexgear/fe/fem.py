@@ -112,9 +112,15 @@ def rigid_body_modes(nodes: np.ndarray, centre: np.ndarray | None = None) -> np.
     return modes.reshape(3 * n, 6)
 
 
-def _to_scipy(mat, n: int) -> sp.csr_matrix:
+def _to_scipy(mat, n: int, position: np.ndarray | None = None) -> sp.csr_matrix:
+    """NGSolve sparse matrix -> SciPy CSR (n, n); ``position[i]``: the row/column that NGSolve's i becomes."""
     rows, cols, vals = mat.COO()
-    return sp.csr_matrix((np.asarray(vals), (np.asarray(rows), np.asarray(cols))), shape=(n, n))
+    rows, cols = np.asarray(rows), np.asarray(cols)
+    if position is not None:
+        rows, cols = position[rows], position[cols]
+    out = sp.csr_matrix((np.asarray(vals), (rows, cols)), shape=(n, n))
+    out.sort_indices()
+    return out
 
 
 def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None = None) -> FEModel:
@@ -148,17 +154,16 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
     with ngs.TaskManager():
         k_form.Assemble()
         m_form.Assemble()
-    k_block = _to_scipy(k_form.mat, 3 * n)  # NGSolve order: all x, all y, all z
+    block = np.arange(3 * n)  # NGSolve order: all x, all y, all z -> interleaved position 3 i + c
+    k_inter = _to_scipy(k_form.mat, 3 * n, 3 * (block % n) + block // n)
     del k_form
-    perm = np.arange(3 * n).reshape(3, n).T.ravel()  # interleaved position -> block position
-    k_inter = k_block[perm][:, perm].tocsr()
-    del k_block
-    k_inter = ((k_inter + k_inter.T) * 0.5).tocsr()  # remove round-off asymmetry
+    k_inter = (k_inter + k_inter.T).tocsr()  # remove round-off asymmetry: (K + K^T) / 2, halved in place
+    k_inter.data *= 0.5
     mass_scalar = _to_scipy(m_form.mat, n)
     del m_form
 
     # node coordinates: NGSolve's point order equals the nodal dof order (checked above: same count)
-    nodes = np.array([tuple(p) for p in ngmesh.Points()], float)
+    nodes = np.array(ngmesh.Coordinates(), float)
 
     names = [b for b in dict.fromkeys(m.GetBoundaries()) if b != "default"] if regions is None else regions
     region_nodes, region_weights = {}, {}
