@@ -49,14 +49,13 @@ from threadpoolctl import threadpool_limits
 from flexgear.fe.attachment import LoadCircle, load_patterns, modal_basis
 from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import FEModel, rigid_body_modes
+from flexgear.fe.invariants import EPS as _EPS
+from flexgear.fe.invariants import ffrf_invariants
 from flexgear.geometry.massprops import MassProperties
 
 __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights", "reduce", "reduction_basis",
            "full_free_modes", "ffrf_invariants"]
 
-_EPS = np.zeros((3, 3, 3))
-_EPS[0, 1, 2] = _EPS[1, 2, 0] = _EPS[2, 0, 1] = 1.0
-_EPS[0, 2, 1] = _EPS[2, 1, 0] = _EPS[1, 0, 2] = -1.0
 _SOLVE_BLOCK = 8  # columns per block of constrained static solves (memory: 6 work arrays of 3n x 8)
 
 
@@ -307,43 +306,6 @@ class ReducedBody:
             return cls(z["nodes"], z["modes"], z["stiffness"], z["frequencies_hz"], z["full_frequencies_hz"], itfs,
                        str(z["kind"]), int(z["n_fixed"]), MassProperties(float(z["mass"]), z["com"], z["inertia"]),
                        inv, z["surface_triangles"], info)
-
-
-def ffrf_invariants(mass_scalar: sp.spmatrix, nodes: np.ndarray, modes: np.ndarray) -> dict[str, np.ndarray]:
-    """Constant terms of the floating-frame equations (names as in Exudyn's ObjectFFRFreducedOrder).
-
-    With Phi_t = 1 (x) I_3, xRef, Psi (3n, m) and skew stacks xRefTilde, PsiTilde:
-    mass = 1^T M_s 1, centerOfMass = X^T M_s 1 / mass, inertia = xRefTilde^T M xRefTilde (about the
-    frame origin), mPsiTildePsi = PsiTilde^T M Psi, mPsiTildePsiTilde, mPhitTPsi, mPhitTPsiTilde,
-    mXRefTildePsi, mXRefTildePsiTilde, all evaluated through M_s only.
-    """
-    n, m = len(nodes), modes.shape[1]
-    xm = modes.reshape(n, 3, m).transpose(0, 2, 1).reshape(n, 3 * m)  # column 3j+c: component c of mode j
-    ms_x = mass_scalar @ xm
-    gmat = (xm.T @ ms_x).reshape(m, 3, m, 3)  # G[j, c, l, d]
-    ones = mass_scalar @ np.ones(n)
-    mass = float(ones.sum())
-    q = nodes.T @ (mass_scalar @ nodes)
-    hmat = (nodes.T @ ms_x).reshape(3, m, 3)  # H[c, l, d] = sum M_ik x_i^c psi_l^d(k)
-    phit_psi = (ones @ xm).reshape(m, 3).T  # (3, m)
-    psi_tilde_psi = -np.einsum("ecd,jcld->jel", _EPS, gmat).reshape(3 * m, m)
-    g_blocks = gmat.transpose(0, 2, 1, 3)  # (j, l, c, d)
-    trace = np.trace(g_blocks, axis1=2, axis2=3)
-    psi_tilde_psi_tilde = (trace[:, :, None, None] * np.eye(3) - g_blocks.transpose(0, 1, 3, 2))
-    psi_tilde_psi_tilde = psi_tilde_psi_tilde.transpose(0, 2, 1, 3).reshape(3 * m, 3 * m)
-
-    def skew(v: np.ndarray) -> np.ndarray:
-        return np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
-
-    phit_psi_tilde = np.hstack([skew(phit_psi[:, j]) for j in range(m)]) if m else np.zeros((3, 0))
-    xref_tilde_psi = -np.einsum("ecd,cld->el", _EPS, hmat)
-    h_blocks = hmat.transpose(1, 0, 2)  # (l, c, d)
-    xref_tilde_psi_tilde = np.hstack([np.trace(h) * np.eye(3) - h.T for h in h_blocks]) if m else np.zeros((3, 0))
-    return {"mass": np.array(mass), "centerOfMass": nodes.T @ ones / mass,
-            "inertia": np.trace(q) * np.eye(3) - q,
-            "mPsiTildePsi": psi_tilde_psi, "mPsiTildePsiTilde": psi_tilde_psi_tilde,
-            "mPhitTPsi": phit_psi, "mPhitTPsiTilde": phit_psi_tilde,
-            "mXRefTildePsi": xref_tilde_psi, "mXRefTildePsiTilde": xref_tilde_psi_tilde}
 
 
 def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str], n_modes: int,
