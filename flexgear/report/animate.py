@@ -133,8 +133,11 @@ def write_animation(run_dir: str | Path, out_dir: str | Path | None = None, scal
             a = np.array([row[f"{m.name}_a{i}{j}"] for i in range(3) for j in range(3)]).reshape(3, 3)
             u = np.zeros_like(m.points)
             if m.modes is not None:
-                q = np.array([row[f"{m.name}_q{j}"] for j in range(m.modes.shape[1])])
-                u = (m.modes @ q).reshape(-1, 3)
+                # the integrated modes only: a gear's modes above the dynamic cut-off were not recorded (their
+                # static residual acts at the contacts, flexgear.mbs.residual)
+                n = sum(1 for j in range(m.modes.shape[1]) if f"{m.name}_q{j}" in row)
+                q = np.array([row[f"{m.name}_q{j}"] for j in range(n)])
+                u = (m.modes[:, :n] @ q).reshape(-1, 3)
             points.append(p + (m.points + scale * u) @ a.T)
             elastic.append(u @ a.T)
         name = f"{result.name}_{k:04d}.vtu"
