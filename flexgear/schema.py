@@ -26,6 +26,7 @@ __all__ = [
     "Contact",
     "ContactAssumed",
     "SupportsAssumed",
+    "JointsAssumed",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",

@@ -304,6 +304,7 @@ class MeshFriction:
                  ramp_time: float, drive_speed: float, residual: tuple[int, np.ndarray] | None = None):
         self.mbs, self.container, self.contacts = mbs, container, contacts
         self.residual = residual  # (node, contact rows) of the residual deflections e: the law acts on delta - e
+        self._tooth_index: tuple[np.ndarray, np.ndarray] | None = None
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
         self.sliding_rows = _assemble_rows(bodies, contacts, row=1)
         self.spin_rows = _assemble_rows(bodies, contacts, row=2)
@@ -353,11 +354,13 @@ class MeshFriction:
         reduced by its residual deflection e (flexgear.mbs.residual): the tooth deflection the law sees."""
         q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
         if self.residual is not None:
-            node, rows = self.residual
-            first, aux = mbs.GetNodeODE2Index(node), mbs.GetNodeODE2Index(self.aux_node)
-            e = np.arange(first, first + len(rows))
-            q[aux + rows] -= q[e]
-            q_t[aux + rows] -= q_t[e]
+            if self._tooth_index is None:  # (deflection, residual) coordinate indices, once (a per-step path)
+                node, rows = self.residual
+                first = mbs.GetNodeODE2Index(node)
+                self._tooth_index = (mbs.GetNodeODE2Index(self.aux_node) + rows, np.arange(first, first + len(rows)))
+            delta, e = self._tooth_index
+            q[delta] -= q[e]
+            q_t[delta] -= q_t[e]
         return q, q_t
 
     def __call__(self, mbs, t: float) -> bool:

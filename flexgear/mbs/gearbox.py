@@ -133,13 +133,14 @@ GEARS = ("sun", "planet", "ring")
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
-                   cutoff_hz: float = 0.0) -> Body:
+                   cutoff_hz: float = 0.0, dropped: dict | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
     ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support);
     ``cutoff_hz`` > 0: a gear keeps its modes below it as coordinates, the others as ``dropped`` modes whose
-    static compliance the contacts carry (flexgear.mbs.residual).
+    static compliance the contacts carry (flexgear.mbs.residual); ``dropped``: those per geometry, shared by
+    the bodies of one build (the five planets compute them once).
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
@@ -164,7 +165,10 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
         return body
     from flexgear.mbs.residual import dropped_modes
 
-    return replace(body, dropped=dropped_modes(spec, full, keep, geometry))
+    cache = {} if dropped is None else dropped
+    if geometry not in cache:
+        cache[geometry] = dropped_modes(spec, full, keep, geometry)
+    return replace(body, dropped=cache[geometry])
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -206,6 +210,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     level = variant.mesh_level
     seats = spec.supports_assumed.placement == "bearing_seats"
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
+    dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
     supports = gearbox_supports(spec)
     bodies: list[Body] = []
     pairs = []
@@ -218,7 +223,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         else:
             joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff)
+                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
                                    {b: p for _, b, p in joints}, supports[shaft] if seats else None)
             bodies += [lead, other]
@@ -228,7 +233,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"] if seats else None,
-                                     cutoff_hz=cutoff))
+                                     cutoff_hz=cutoff, dropped=dropped))
     by_body = {bd.name: bd for bd in bodies}
     joints = {}
     for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)

@@ -182,11 +182,15 @@ class CentrifugalYield:
         rows = residual.rows
         self.obj, self.ramp_time, self.drive_speed = obj, ramp_time, drive_speed
         self.unit = np.linalg.solve(residual.matrix[np.ix_(rows, rows)], residual.yield_per_drive_speed2[rows])
+        self._steady = False
 
     def force(self, t: float) -> np.ndarray:
         """K y(t) [N]."""
         return (self.drive_speed * ramp_state(float(t), self.ramp_time)[1]) ** 2 * self.unit
 
     def __call__(self, mbs, t: float) -> bool:
+        if t > self.ramp_time and self._steady:  # constant after the ramp: written once
+            return True
         mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        self._steady = t > self.ramp_time
         return True
