@@ -71,8 +71,10 @@ def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = Fa
     return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
 
 
-def _choice(*choices: str, doc: str = "") -> Any:
-    return field(metadata={"choices": choices, "doc": doc})
+def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:
+    if default is None:
+        return field(metadata={"choices": choices, "doc": doc})
+    return field(default=default, metadata={"choices": choices, "doc": doc})
 
 
 def _text(doc: str = "", default: str | None = None) -> Any:
@@ -281,6 +283,10 @@ class ReductionSettings:
     # leave the time integration and return as the static residual compliance of the contacts
     # (flexgear.mbs.residual); 0 keeps every mode dynamic.
     dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
+    # "ffrf": Exudyn's nonlinear floating-frame terms; "linear": the frame a rigid body, the modes linear
+    # equations with the spin's gyroscopic, softening and centrifugal terms at the prescribed speed
+    # (flexgear.mbs.spin).
+    floating_frame: str = _choice("ffrf", "linear", default="ffrf")
 
 
 @dataclass(frozen=True)
@@ -393,12 +399,16 @@ class JointsAssumed:
     ``ring_output_shaft`` "bolt_patches": per bolt a patch over its clamped disc on each mating face, joined
     pairwise; "rbe3": one RBE3 interface over all bolt-hole walls of each body, one fixed joint at the bolt
     circle. ``bolt_patch`` "rbe2" (rigid disc) or "rbe3"; ``bolt_clamp_diameter_mm`` the disc's diameter.
+    ``joint_equations`` "generic" (Exudyn's ObjectJointGeneric on the interface markers) or "linear" (first
+    order about the prescribed spin, flexgear.mbs.joints; joints on the axis only, bolt patches stay generic).
     """
 
     ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),
                                                                       "doc": "ring-output shaft joint model"})
     bolt_patch: str = field(default="rbe2", metadata={"choices": ("rbe2", "rbe3"), "doc": "bolt patch kind"})
     bolt_clamp_diameter_mm: float = field(default=21.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
+    joint_equations: str = field(default="generic", metadata={"choices": ("generic", "linear"),
+                                                               "doc": "gear-shaft joint equations"})
 
 
 @dataclass(frozen=True)

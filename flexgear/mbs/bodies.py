@@ -51,3 +51,21 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)
+
+
+def zero_user_jacobian(n: int):
+    """A ``jacobianUserFunction`` for an ``ObjectGenericODE2`` of ``n`` coordinates without user forces.
+
+    Exudyn differentiates an ``ObjectGenericODE2`` numerically (n evaluations of its equations per
+    Jacobian) unless it has this function; its constant stiffness and damping matrices (sparse) are then
+    added to the Jacobian exactly. Returns the function (it returns an all-zero sparse matrix).
+    """
+    import exudyn as exu
+
+    zero = exu.MatrixContainer()
+    zero.SetWithSparseMatrixCSR(n, n, np.zeros((0, 3)), useDenseMatrix=False)
+
+    def jacobian(mbs, t, item, q, q_t, f_ode2, f_ode2_t):  # noqa: ARG001 (Exudyn's signature)
+        return zero
+
+    return jacobian

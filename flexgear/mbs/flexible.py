@@ -36,6 +36,9 @@ class FlexibleBody(Body):
     # modes of the converged basis left out of the time integration (flexgear.mbs.residual.DroppedModes);
     # their static compliance returns at the contacts
     dropped: object | None = None
+    # floating_frame = "linear": the body's spin terms (flexgear.mbs.spin.SpinMatrices) and nominal spin [rad/s]
+    spin: object | None = None
+    nominal_spin_rad_s: float = 0.0
 
 
 def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):
@@ -67,7 +70,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       velocity=(0.0, 0.0, 0.0), angular_velocity=(0.0, 0.0, 0.0),
                       stiffness_damping_s: float = 0.0, mass_damping_per_s: float = 0.0,
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
-                      point_markers: dict[str, list] | None = None, show: bool = True) -> FlexibleBody:
+                      point_markers: dict[str, list] | None = None, show: bool = True,
+                      floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -79,6 +83,9 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     mode basis; the floating-frame inertia terms come from the real mesh only. ``point_markers``:
     {interface: points [m, body frame]}: one virtual node per point moving rigidly with the interface
     (:func:`interface_point_modes`) and a ``MarkerSuperElementPosition`` on it (bearing springs at a seat).
+    ``floating_frame``: "ffrf" (Exudyn's nonlinear floating-frame terms) or "linear" (flexgear.mbs.spin: the
+    frame an ``ObjectRigidBody``, the modes linear equations at ``nominal_spin_rad_s`` about the body's z
+    axis; the object then only places the markers; add a flexgear.mbs.spin.SpinSchedule for the ramp).
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -108,6 +115,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         mc.SetWithDenseMatrix(np.diag(diag), useDenseMatrix=False)
         return mc
 
+    if floating_frame not in ("ffrf", "linear"):
+        raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
     if interface_markers is None:
         interface_markers = [i.name for i in reduced.interfaces]
     points = (dict(interface_markers) if isinstance(interface_markers, dict)
@@ -137,9 +146,22 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         mPsiTildePsi=inv["mPsiTildePsi"], mPsiTildePsiTilde=inv["mPsiTildePsiTilde"],
         mPhitTPsi=inv["mPhitTPsi"], mPhitTPsiTilde=inv["mPhitTPsiTilde"],
         mXRefTildePsi=inv["mXRefTildePsi"], mXRefTildePsiTilde=inv["mXRefTildePsiTilde"],
-        computeFFRFterms=True,
+        computeFFRFterms=floating_frame == "ffrf",
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
+    spin = None
+    if floating_frame == "linear":
+        from exudyn.itemInterface import ObjectRigidBody
+        from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
+
+        from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices
+
+        # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body (exact mass properties)
+        mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
+                                      inertia=InertiaTensor2Inertia6D(inv["inertia"]),
+                                      centerOfMass=list(map(float, inv["centerOfMass"]))))
+        spin = spin_matrices(reduced)
+        add_linear_modal_equations(mbs, name, modal, reduced.stiffness, damping, spin, nominal_spin_rad_s)
     markers = {}
     for itf_name, start in first.items():
         markers[itf_name] = mbs.AddMarker(MarkerSuperElementRigid(
@@ -153,7 +175,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
-                        modal, markers, reduced, points)
+                        modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s))
 
 
 

@@ -64,6 +64,7 @@ class GearboxModel:
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
     residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
+    linear_joints: bool = False  # joints are flexgear.mbs.joints constraints (Force output: ground force, moment)
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -133,14 +134,15 @@ GEARS = ("sun", "planet", "ring")
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
-                   cutoff_hz: float = 0.0, dropped: dict | None = None) -> Body:
+                   cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
     ``support``: the point markers of that bearing's springs on its interface (flexgear.mbs.elements.add_support);
     ``cutoff_hz`` > 0: a gear keeps its modes below it as coordinates, the others as ``dropped`` modes whose
     static compliance the contacts carry (flexgear.mbs.residual); ``dropped``: those per geometry, shared by
-    the bodies of one build (the five planets compute them once).
+    the bodies of one build (the five planets compute them once); ``spin_rad_s``: the nominal spin about the
+    body's z axis [rad/s] (the linear floating frame's spin terms, flexgear.mbs.spin).
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
@@ -160,7 +162,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     body = add_flexible_body(mbs, name, full.truncated(keep) if keep < full.n_modes else full, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=joints or [], point_markers=points,
-                             show=False)
+                             show=False, floating_frame=spec.reduction_assumed.floating_frame,
+                             nominal_spin_rad_s=spin_rad_s)
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes
@@ -169,6 +172,12 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if geometry not in cache:
         cache[geometry] = dropped_modes(spec, full, keep, geometry)
     return replace(body, dropped=cache[geometry])
+
+
+def _linear_joints(spec: GearboxSpec, found: list) -> bool:
+    """Whether a gear's joints to its shaft are linear constraints (flexgear.mbs.joints): as configured, and
+    only when every joint point lies on the axis."""
+    return spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9 for _, _, p in found)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -209,13 +218,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     geo = gear_set_geometry(spec)
     level = variant.mesh_level
     seats = spec.supports_assumed.placement == "bearing_seats"
+    lc = spec.load_case
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
     supports = gearbox_supports(spec)
     bodies: list[Body] = []
     pairs = []
     ends = {}
-    for gear, shaft in (("sun", "input_shaft"), ("ring", "output_shaft")):
+    for gear, shaft, spin in (("sun", "input_shaft", th.input_speed), ("ring", "output_shaft", th.output_speed)):
         if form[gear] == "rigid" and form[shaft] == "rigid":
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
             bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
@@ -223,9 +233,9 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         else:
             joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped)
+                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None)
+                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin)
             bodies += [lead, other]
             pairs.append((lead, other, joints))
             ends[gear] = shaft
@@ -233,11 +243,20 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"] if seats else None,
-                                     cutoff_hz=cutoff, dropped=dropped))
+                                     cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed))
     by_body = {bd.name: bd for bd in bodies}
-    joints = {}
+    joints, extra = {}, []
+    spins = {"sun": 1.0, "ring": th.output_speed / th.input_speed}  # spin per drive angle
     for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
+        if _linear_joints(spec, found):
+            from flexgear.mbs.joints import LinearInterfaceJoint
+
+            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, spins[lead.name], lc.ramp_time_s,
+                                         lc.input_speed_rad_s, label) for a, b, p in found]
+            extra += made
+            joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]
+            continue
         joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
                              for k, (a, b, p) in enumerate(found)]
     b = spec.bearings
@@ -249,10 +268,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
         for body, key in placed:
             add_support(mbs, by_body[body], supports[key])
-    lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
-    train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s,
+    linear = [(bd.modal_node, bd.spin, bd.nominal_spin_rad_s) for bd in bodies if getattr(bd, "spin", None)]
+    if linear:
+        from flexgear.mbs.spin import SpinSchedule
+
+        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s))
+    train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m)
@@ -269,4 +292,4 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
-                        train.residual)
+                        train.residual, linear_joints=any(_linear_joints(spec, found) for _, _, found in pairs))

@@ -74,7 +74,7 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
 def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearContact], ramp_time: float,
                    drive_speed: float, *, friction: bool = True,
                    carrier: Carrier | None = None, contact_fourier_order: int = 8,
-                   radial_band: float | None = None) -> GearTrain:
+                   radial_band: float | None = None, extra_pre_steps: list | None = None) -> GearTrain:
     """Add the bushings ``elements``, the gear ``contacts`` and their per-step updates for ``bodies``.
 
     ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
@@ -82,8 +82,8 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; rigid gears only).
     Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
     from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
-    tooth height). Sets the system's pre-step user function if
-    any update is needed.
+    tooth height). ``extra_pre_steps``: further pre-step callables (mbs, t) -> bool, run first. Sets the
+    system's pre-step user function if any update is needed.
     """
     by_name = {b.name: b for b in bodies}
     if len(by_name) != len(bodies):
@@ -117,7 +117,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
                                                                  offsets, n_total, markers)
     train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords,
                       residual=residual, residual_node=residual_node)
-    pre_steps = [schedule] if schedule is not None else []
+    pre_steps = [*(extra_pre_steps or []), *([schedule] if schedule is not None else [])]
     if markers:
         from flexgear.mbs.residual import CentrifugalYield
 

@@ -1,0 +1,120 @@
+"""The linear floating frame (flexgear.mbs.spin) and the linear gear-shaft joints (flexgear.mbs.joints).
+
+Checked against an independent implementation, Exudyn's own nonlinear ``ObjectFFRFreducedOrder``: at a
+spinning state with elastic coordinates and velocities, both give the same modal accelerations (the
+gyroscopic, spin-softening and centrifugal terms of the linear form are exact for a body spinning about its
+axis); the ramp schedule adds exactly the difference to the scheduled spin; a short run of model 4 and of
+model 7 with the linear forms keeps the reference's mean mesh forces (0.1 %) and 1x mesh amplitudes (2 %),
+issue 16's rule for a faster formulation.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import VARIANTS
+
+import flexgear as fg
+from flexgear.fe.reduced import component_reduced_body
+from flexgear.study.agreement import harmonic_amplitudes
+
+
+@pytest.fixture(scope="module")
+def gearbox():
+    return fg.load_gearbox(VARIANTS / "gearbox.toml")
+
+
+def _modal_acceleration(body, frame: str, spin: float, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
+    """Accelerations of all coordinates (frame, then modal) of one free spinning body, from Exudyn's equations."""
+    import exudyn as exu
+
+    from flexgear.mbs.flexible import add_flexible_body
+    from flexgear.mbs.spin import SpinSchedule
+
+    mbs = exu.SystemContainer().AddSystem()
+    b = add_flexible_body(mbs, "b", body, [0.0, 0.0, 0.0], angular_velocity=(0.0, 0.0, spin), interface_markers=[],
+                          show=False, floating_frame=frame, nominal_spin_rad_s=spin, stiffness_damping_s=1e-5)
+    mbs.SetNodeParameter(b.modal_node, "initialCoordinates", list(q))
+    mbs.SetNodeParameter(b.modal_node, "initialCoordinates_t", list(q_t))
+    schedule = SpinSchedule(mbs, [(b.modal_node, b.spin, spin)], 1e-3) if frame == "linear" else None
+    mbs.Assemble()
+    if schedule is not None:  # after the ramp: the centrifugal load at the nominal spin
+        mbs.SetObjectParameter(schedule.obj, "forceVector", schedule.force(1.0, q, q_t))
+    solver = exu.MainSolverImplicitSecondOrder()
+    solver.InitializeSolver(mbs, exu.SimulationSettings())
+    solver.ComputeODE2RHS(mbs)
+    n = solver.GetODE2size()
+    rhs = np.asarray(solver.GetSystemResidual())[:n]
+    solver.ComputeMassMatrix(mbs)
+    return np.linalg.solve(np.asarray(solver.GetSystemMassMatrix())[:n, :n], rhs)
+
+
+@pytest.mark.parametrize("component, spin", [("ring", -203.3), ("sun", 628.3)])
+def test_linear_modal_equations_equal_exudyns_floating_frame(gearbox, component, spin):
+    """Ring at the output speed, sun at the input speed (Table 5), 12 modes, elastic coordinates of a few
+    micrometres and velocities: the modal accelerations of the linear form equal the FFRF object's within 1e-8."""
+    body = component_reduced_body(gearbox, component).truncated(12)
+    rng = np.random.default_rng(7)
+    q = rng.normal(size=12) * 1e-4 / np.sqrt(body.stiffness)
+    q_t = rng.normal(size=12) * 1e-3
+    ref = _modal_acceleration(body, "ffrf", spin, q, q_t)[6:]
+    new = _modal_acceleration(body, "linear", spin, q, q_t)[6:]
+    assert np.abs(new - ref).max() < 1e-8 * np.abs(ref).max()
+    # the spin terms matter here: without them the accelerations differ by far more than that
+    assert np.abs(_modal_acceleration(body, "linear", 0.0, q, q_t)[6:] - ref).max() > 1e-4 * np.abs(ref).max()
+
+
+def test_spin_schedule_adds_the_ramps_difference(gearbox):
+    """During the ramp, the constant nominal-spin matrices plus the schedule's force equal the spin terms at the
+    scheduled speed Omega(t) exactly: -(2 Omega G q' - Omega^2 S q) + Omega^2 c."""
+    from flexgear.laws.ramps import ramp_fraction
+    from flexgear.mbs.spin import SpinSchedule, spin_matrices
+
+    body = component_reduced_body(gearbox, "ring").truncated(10)
+    s = spin_matrices(body)
+    assert np.allclose(s.gyroscopic, -s.gyroscopic.T) and np.allclose(s.softening, s.softening.T)
+    nominal, ramp = -203.3, 0.1
+    sched = SpinSchedule.__new__(SpinSchedule)
+    sched.ramp_time, sched.gyro, sched.soft, sched.cent = ramp, s.gyroscopic, s.softening, s.centrifugal
+    sched.nominal = np.full(10, nominal)
+    rng = np.random.default_rng(3)
+    q, q_t = rng.normal(size=10), rng.normal(size=10)
+    for t in (0.0, 0.03, 0.07, 0.2):
+        w = nominal * ramp_fraction(t, ramp)
+        exact = -(2 * w * s.gyroscopic @ q_t - w * w * s.softening @ q) + w * w * s.centrifugal
+        implicit = -(2 * nominal * s.gyroscopic @ q_t - nominal ** 2 * s.softening @ q)
+        assert np.allclose(implicit + sched.force(t, q, q_t), exact, rtol=1e-12, atol=1e-9 * np.abs(implicit).max())
+
+
+def _short_runs(case: str, configs: list[dict]):
+    from flexgear.mbs.run import run_variant
+
+    v = fg.load_variant(VARIANTS / f"{case}.toml")
+    g = v.gearbox
+    lc = dataclasses.replace(g.load_case, ramp_time_s=0.006, end_time_s=0.024)
+    runs = []
+    for cfg in configs:
+        red = dataclasses.replace(g.reduction_assumed, floating_frame=cfg["frame"])
+        joints = dataclasses.replace(g.joints_assumed, joint_equations=cfg["joint"])
+        spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints)
+        run = run_variant(dataclasses.replace(v, gearbox=spec))
+        assert run.ok, run.meta.get("reason")
+        runs.append(run.signals[run.signals.time_s >= 2 * lc.ramp_time_s])
+    return runs, fg.theory(g).mesh_frequency
+
+
+@pytest.mark.parametrize("case", ["model4", "model7"])
+def test_linear_forms_keep_the_reference_signals(case):
+    """Exudyn's FFRF bodies and generic joints (the reference) against the linear floating frame and joints,
+    study's law, 6-18 ms after the ramps: mean mesh forces within 0.1 %, their 1x mesh amplitudes within 2 %."""
+    (ref, new), f_mesh = _short_runs(case, [{"frame": "ffrf", "joint": "generic"},
+                                            {"frame": "linear", "joint": "linear"}])
+    dt = float(np.median(np.diff(ref.time_s.to_numpy())))
+    for kind in ("outer", "inner"):
+        for i in range(1, 6):
+            col = f"{kind}_mesh_force_{i}_n"
+            assert new[col].mean() == pytest.approx(ref[col].mean(), rel=1e-3)
+            a_ref, a_new = (harmonic_amplitudes(s[col].to_numpy(), dt, f_mesh, (1,))[0] for s in (ref, new))
+            assert a_new == pytest.approx(a_ref, rel=0.02)
