@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
-__all__ = ["Body", "add_rigid_body"]
+__all__ = ["Body", "add_rigid_body", "matrix_container", "zero_user_jacobian"]
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,15 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)
+
+
+def matrix_container(a: np.ndarray):
+    """A dense (n, n) array as Exudyn's sparse ``MatrixContainer`` (its zeros dropped)."""
+    import exudyn as exu
+
+    mc = exu.MatrixContainer()
+    mc.SetWithDenseMatrix(np.asarray(a, float), useDenseMatrix=False)
+    return mc
 
 
 def zero_user_jacobian(n: int):

@@ -31,7 +31,7 @@ from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_se
 from flexgear.geometry.pair import _EZ, helix_halves
 from flexgear.laws.contact import ContactLaw, friction_forces, normal_force, periodic_value
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, zero_user_jacobian
 from flexgear.mbs.elements import _keep_alive
 from flexgear.spec import Contact, ContactAssumed
 
@@ -136,7 +136,8 @@ class MeshConstraint:
                     nodes.append(by_name[n].modal_node)
                     cols.append(np.arange(modal_offsets[n], modal_offsets[n] + by_name[n].reduced.n_modes))
             cols = np.concatenate(cols)
-            span = mbs.AddObject(ObjectGenericODE2(name=f"mesh_span_{pair[0]}_{pair[1]}", nodeNumbers=nodes))
+            span = mbs.AddObject(ObjectGenericODE2(name=f"mesh_span_{pair[0]}_{pair[1]}", nodeNumbers=nodes,
+                                                   jacobianUserFunction=zero_user_jacobian(len(cols))))
             block = mbs.AddObject(ObjectConnectorCoordinateVector(
                 name=f"mesh_kinematics_{pair[0]}_{pair[1]}",
                 markerNumbers=[aux_marker, mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],

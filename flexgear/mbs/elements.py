@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.geometry.supports import Support
 from flexgear.laws.ramps import drive_angle, ramp_fraction
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
 from flexgear.spec import Bearing
 
 
@@ -70,7 +70,8 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_
         damping[s, s] += e.damping_matrix()
     obj = mbs.AddObject(ObjectGenericODE2(
         name="frame_elements", nodeNumbers=[b.node for b in bodies] + list(extra_nodes or []),
-        massMatrix=np.zeros((n, n)), stiffnessMatrix=stiffness, dampingMatrix=damping, forceVector=np.zeros(n),
+        stiffnessMatrix=matrix_container(stiffness), dampingMatrix=matrix_container(damping), forceVector=np.zeros(n),
+        jacobianUserFunction=zero_user_jacobian(n),
     ))
     marker = mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=obj))
     return obj, marker
@@ -145,7 +146,8 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, 
                                        referenceCoordinates=[0.0], initialCoordinates=[0.0],
                                        initialCoordinates_t=[0.0]))
     span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_{interface}_span",
-                                           nodeNumbers=[body.node, body.modal_node]))
+                                           nodeNumbers=[body.node, body.modal_node],
+                                           jacobianUserFunction=zero_user_jacobian(6 + body.reduced.n_modes)))
     row = np.concatenate([np.eye(6)[5], r])[None, :]
     mbs.AddObject(ObjectConnectorCoordinateVector(
         name=f"{body.name}_{interface}_spin_tie",

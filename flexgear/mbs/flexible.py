@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.fe.cms import ReducedBody
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, matrix_container
 
 __all__ = ["FlexibleBody", "add_flexible_body", "interface_virtual_nodes", "interface_point_modes"]
 
@@ -110,11 +110,6 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                                         referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
                                         initialCoordinates_t=[0.0] * m))
 
-    def container(diag: np.ndarray):
-        mc = exu.MatrixContainer()
-        mc.SetWithDenseMatrix(np.diag(diag), useDenseMatrix=False)
-        return mc
-
     if floating_frame not in ("ffrf", "linear"):
         raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
     if interface_markers is None:
@@ -139,8 +134,9 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     inv = reduced.invariants
     obj = mbs.AddObject(ObjectFFRFreducedOrder(
         name=name, nodeNumbers=[node, modal],
-        massMatrixReduced=container(np.ones(m)), stiffnessMatrixReduced=container(reduced.stiffness),
-        dampingMatrixReduced=container(damping) if np.any(damping) else [],
+        massMatrixReduced=matrix_container(np.eye(m)),
+        stiffnessMatrixReduced=matrix_container(np.diag(reduced.stiffness)),
+        dampingMatrixReduced=matrix_container(np.diag(damping)) if np.any(damping) else [],
         modeBasis=np.vstack(modes), referencePositions=np.vstack(positions).ravel(),
         mass=float(inv["mass"]), inertia=inv["inertia"], centerOfMass=inv["centerOfMass"],
         mPsiTildePsi=inv["mPsiTildePsi"], mPsiTildePsiTilde=inv["mPsiTildePsiTilde"],

@@ -14,8 +14,8 @@ frame node, R_n = R_z(phi_n); Psi_t, Psi_r the interface's RBE3 translation at p
 coordinate, flexgear.fe.cms.ReducedBody.interface_motion). A fixed joint makes both equal for the two bodies
 (the same point p in ground at the reference): six linear equations C(t) q = 0 whose coefficients turn
 with R_n. They are one ``ObjectConnectorCoordinateVector`` over the two bodies' coordinates, rewritten
-before each step (:meth:`LinearInterfaceJoint.__call__`); its multipliers lambda (``Force`` output) are
-the joint's force [N] (ground x, y, z) and moment [N m] (ground x, y, z) on the second body.
+before each step (:meth:`LinearInterfaceJoint.__call__`), one marker per body; its multipliers lambda
+(``Force`` output) are the joint's force [N] (ground x, y, z) and moment [N m] (ground x, y, z) on the second body.
 The joint point must lie on the axis (x = y = 0: the sun's bore, the ring's bolt-circle RBE3); a joint
 off the axis (the ring on bolt patches) keeps ``ObjectJointGeneric``.
 """
@@ -25,7 +25,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, zero_user_jacobian
 
 __all__ = ["LinearInterfaceJoint"]
 
@@ -43,9 +43,7 @@ class LinearInterfaceJoint:
     def __init__(self, mbs, body: Body, other: Body, interfaces: tuple[str, str], point, spin_per_drive_angle: float,
                  ramp_time: float, drive_speed: float, name: str = ""):
         from exudyn.itemInterface import (
-            MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
-            NodePointGround,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
@@ -54,11 +52,11 @@ class LinearInterfaceJoint:
         if np.hypot(point[0], point[1]) > 1e-9:
             raise ValueError(f"LinearInterfaceJoint {name!r}: the joint point must lie on the z axis, got {point}")
         self.spin, self.ramp_time, self.drive_speed = float(spin_per_drive_angle), float(ramp_time), float(drive_speed)
-        nodes, parts, self.q_ref = [], [], []
+        parts, q_ref, markers = [], [], []
         for b, itf, sign in ((body, interfaces[0], -1.0), (other, interfaces[1], 1.0)):
-            nodes.append(b.node)
+            nodes = [b.node]
             local = point - b.position
-            self.q_ref.append(np.concatenate([b.position, np.zeros(3)]))
+            q_ref.append(np.concatenate([b.position, np.zeros(3)]))
             modal = np.zeros((6, 0))
             if b.flexible:
                 red = b.reduced
@@ -67,17 +65,22 @@ class LinearInterfaceJoint:
                 trans = motion[:3] + np.cross(motion[3:].T, arm).T  # translation at the joint point
                 modal = np.vstack([trans, motion[3:]])
                 nodes.append(b.modal_node)
-                self.q_ref.append(np.zeros(red.n_modes))
+                q_ref.append(np.zeros(red.n_modes))
             parts.append((sign, local, modal))
+            # one marker per body: Exudyn's constraint costs rows x columns^2 per marker (its dense Jacobian)
+            span = mbs.AddObject(ObjectGenericODE2(name=f"{name}_{b.name}_span", nodeNumbers=nodes,
+                                                   jacobianUserFunction=zero_user_jacobian(6 + modal.shape[1])))
+            markers.append(mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)))
         self.parts = parts
         self._parts: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
-        self.q_ref = np.concatenate(self.q_ref)
-        ground = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=mbs.AddNode(NodePointGround())))
-        span = mbs.AddObject(ObjectGenericODE2(name=f"{name}_span", nodeNumbers=nodes))
-        s1 = self.matrix_at(0.0)
+        self.q_ref = np.concatenate(q_ref)
+        self._split = 6 + parts[0][2].shape[1]  # columns of the first body
+        c = self.matrix_at(0.0)
+        # Exudyn's equation: scalingMarker1 q_1 - scalingMarker0 q_0 - offset = 0
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
-            name=name, markerNumbers=[ground, mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
-            scalingMarker0=np.zeros((6, 0)), scalingMarker1=s1, offset=s1 @ self.q_ref))
+            name=name, markerNumbers=markers, scalingMarker0=-c[:, :self._split], scalingMarker1=c[:, self._split:],
+            offset=c @ self.q_ref))
+        self._moving = [k for k, (_, _, modal) in enumerate(parts) if modal.shape[1]]  # blocks that turn
 
     def matrix_at(self, t: float) -> np.ndarray:
         """C(t) (6, columns): rows ground translation x, y, z and rotation x, y, z of body 2 minus body 1."""
@@ -100,12 +103,16 @@ class LinearInterfaceJoint:
         return np.hstack(blocks)
 
     def __call__(self, mbs, t: float) -> bool:
-        """Pre-step: C(t) = C_0 + cos(phi_n) C_c + sin(phi_n) C_s (the point on the axis: the offset C q_ref is
-        constant, written at construction)."""
+        """Pre-step: C(t) = C_0 + cos(phi_n) C_c + sin(phi_n) C_s into the flexible bodies' markers (the point
+        on the axis: a rigid body's block and the offset C q_ref are constant, written at construction)."""
         if self._parts is None:
             c0 = self._matrix(0.0, 0.0)
             self._parts = (c0, self._matrix(1.0, 0.0) - c0, self._matrix(0.0, 1.0) - c0)
         phi = self.spin * float(drive_angle(t, self.ramp_time, self.drive_speed))
         c0, cc, cs = self._parts
-        mbs.SetObjectParameter(self.obj, "scalingMarker1", c0 + np.cos(phi) * cc + np.sin(phi) * cs)
+        c = c0 + np.cos(phi) * cc + np.sin(phi) * cs
+        if 0 in self._moving:
+            mbs.SetObjectParameter(self.obj, "scalingMarker0", -c[:, :self._split])
+        if 1 in self._moving:
+            mbs.SetObjectParameter(self.obj, "scalingMarker1", c[:, self._split:])
         return True

@@ -37,6 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexgear.laws.compiled import ramp_state
+from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
 from flexgear.mbs.deflection import centrifugal_modal_load, centrifugal_response, held_interfaces
 
@@ -168,8 +169,9 @@ def add_residual_coordinates(mbs, residual: ResidualCompliance) -> tuple[int, in
                                        referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
                                        initialCoordinates_t=[0.0] * n))
     obj = mbs.AddObject(ObjectGenericODE2(name="mesh_residual_compliance", nodeNumbers=[node],
-                                          massMatrix=mass, stiffnessMatrix=stiffness,
-                                          forceVector=np.zeros(n)))
+                                          massMatrix=matrix_container(mass),
+                                          stiffnessMatrix=matrix_container(stiffness),
+                                          forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
     markers = {int(r): mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k)) for k, r in enumerate(rows)}
     return node, obj, markers
 

@@ -31,7 +31,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexgear.laws.ramps import ramp_fraction
-from flexgear.mbs.bodies import zero_user_jacobian
+from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.deflection import centrifugal_modal_load
 
 __all__ = ["SpinMatrices", "spin_matrices", "add_linear_modal_equations", "SpinSchedule"]
@@ -64,22 +64,16 @@ def add_linear_modal_equations(mbs, name: str, modal_node: int, stiffness: np.nd
     ``nominal_spin_rad_s`` [rad/s]; the centrifugal load and the ramp's difference come from
     :class:`SpinSchedule`. Returns the object.
     """
-    import exudyn as exu
     from exudyn.itemInterface import ObjectGenericODE2
 
     w = float(nominal_spin_rad_s)
-
-    def container(a: np.ndarray):
-        mc = exu.MatrixContainer()
-        mc.SetWithDenseMatrix(a, useDenseMatrix=False)
-        return mc
-
     m = len(stiffness)
     k = np.diag(stiffness) - w * w * spin.softening
     d = np.diag(np.broadcast_to(damping, (m,))) + 2.0 * w * spin.gyroscopic
     return mbs.AddObject(ObjectGenericODE2(name=f"{name}_modal_equations", nodeNumbers=[modal_node],
-                                           massMatrix=container(np.eye(m)), stiffnessMatrix=container(k),
-                                           dampingMatrix=container(d), jacobianUserFunction=zero_user_jacobian(m)))
+                                           massMatrix=matrix_container(np.eye(m)),
+                                           stiffnessMatrix=matrix_container(k), dampingMatrix=matrix_container(d),
+                                           jacobianUserFunction=zero_user_jacobian(m)))
 
 
 class SpinSchedule:
