@@ -385,11 +385,15 @@ class SupportsAssumed:
 
     ``placement`` "bearing_seats": bushings at the shafts' bearing seats and the planets' bores, drive and load at
     the input shaft's and output shaft's bearing-seat interfaces; "gear_centres": all on the body frames at the
-    gear mid-planes (the former model, kept for comparison).
+    gear mid-planes (the former model, kept for comparison). ``seat_equations`` (flexible bodies' seats):
+    "markers", three spring-dampers on the seat's virtual nodes; "linear", the same springs summed into one 6 x 6
+    bearing on the seat's motion, first order about the prescribed spin (flexgear.mbs.joints.LinearSeat).
     """
 
     placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
                                                               "doc": "where supports act"})
+    seat_equations: str = field(default="markers", metadata={"choices": ("markers", "linear"),
+                                                             "doc": "seat bearings of flexible bodies"})
 
 
 @dataclass(frozen=True)

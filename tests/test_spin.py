@@ -1,4 +1,4 @@
-"""The linear floating frame (flexgear.mbs.spin) and the linear gear-shaft joints (flexgear.mbs.joints).
+"""The linear floating frame (flexgear.mbs.spin), gear-shaft joints and seat bearings (flexgear.mbs.joints).
 
 Checked against an independent implementation, Exudyn's own nonlinear ``ObjectFFRFreducedOrder``: at a
 spinning state with elastic coordinates and velocities, both give the same modal accelerations (the
@@ -98,7 +98,8 @@ def _short_runs(case: str, configs: list[dict]):
     for cfg in configs:
         red = dataclasses.replace(g.reduction_assumed, floating_frame=cfg["frame"])
         joints = dataclasses.replace(g.joints_assumed, joint_equations=cfg["joint"])
-        spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints)
+        seats = dataclasses.replace(g.supports_assumed, seat_equations=cfg["seat"])
+        spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints, supports_assumed=seats)
         run = run_variant(dataclasses.replace(v, gearbox=spec))
         assert run.ok, run.meta.get("reason")
         runs.append(run.signals[run.signals.time_s >= 2 * lc.ramp_time_s])
@@ -107,10 +108,11 @@ def _short_runs(case: str, configs: list[dict]):
 
 @pytest.mark.parametrize("case", ["model4", "model7"])
 def test_linear_forms_keep_the_reference_signals(case):
-    """Exudyn's FFRF bodies and generic joints (the reference) against the linear floating frame and joints,
+    """Exudyn's FFRF bodies, generic joints and seat springs on virtual nodes (the reference) against the linear
+    floating frame, joints and seat bearings,
     study's law, 6-18 ms after the ramps: mean mesh forces within 0.1 %, their 1x mesh amplitudes within 2 %."""
-    (ref, new), f_mesh = _short_runs(case, [{"frame": "ffrf", "joint": "generic"},
-                                            {"frame": "linear", "joint": "linear"}])
+    (ref, new), f_mesh = _short_runs(case, [{"frame": "ffrf", "joint": "generic", "seat": "markers"},
+                                            {"frame": "linear", "joint": "linear", "seat": "linear"}])
     dt = float(np.median(np.diff(ref.time_s.to_numpy())))
     for kind in ("outer", "inner"):
         for i in range(1, 6):
@@ -118,3 +120,17 @@ def test_linear_forms_keep_the_reference_signals(case):
             assert new[col].mean() == pytest.approx(ref[col].mean(), rel=1e-3)
             a_ref, a_new = (harmonic_amplitudes(s[col].to_numpy(), dt, f_mesh, (1,))[0] for s in (ref, new))
             assert a_new == pytest.approx(a_ref, rel=0.02)
+
+
+def test_seat_bearing_matrix_is_the_three_springs(gearbox):
+    """The linear seat's 6x6 stiffness equals the three springs' (flexgear.geometry.supports): radial k_r, axial
+    k_a, tilt k_t about the centre (two rows of k_r/2 at +-sqrt(k_t/k_r)), no translation-tilt coupling."""
+    from flexgear.geometry.supports import gearbox_supports
+    from flexgear.mbs.joints import seat_matrices
+
+    sup = gearbox_supports(gearbox)["output_shaft"]
+    k6, d6 = seat_matrices(sup)
+    expected = np.diag([sup.radial_stiffness, sup.radial_stiffness, sup.axial_stiffness,
+                        sup.tilt_stiffness, sup.tilt_stiffness, 0.0])
+    assert np.allclose(k6, expected, rtol=1e-12, atol=1e-9 * sup.radial_stiffness)
+    assert np.allclose(d6, sup.damping_per_stiffness * k6)

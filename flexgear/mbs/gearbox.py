@@ -150,7 +150,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     from flexgear.mbs.flexible import add_flexible_body
 
-    points = {support.interface: support_points(support)} if support is not None else None
+    markers = support is not None and spec.supports_assumed.seat_equations == "markers"
+    points = {support.interface: support_points(support)} if markers else None
     full = reduced(spec, geometry, level)
     # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
     # the modes below the cut-off they are redundant and the solver fails); at least one dynamic mode: the
@@ -245,16 +246,15 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      props, reduced, support=supports["planet"] if seats else None,
                                      cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed))
     by_body = {bd.name: bd for bd in bodies}
-    joints, extra = {}, []
+    joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
     spins = {"sun": 1.0, "ring": th.output_speed / th.input_speed}  # spin per drive angle
     for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
         if _linear_joints(spec, found):
             from flexgear.mbs.joints import LinearInterfaceJoint
 
-            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, spins[lead.name], lc.ramp_time_s,
-                                         lc.input_speed_rad_s, label) for a, b, p in found]
-            extra += made
+            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, spins[lead.name], label) for a, b, p in found]
+            turning += [e for j in made for e in j.turning()]
             joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]
             continue
         joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
@@ -267,9 +267,19 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         bushings = []
         placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
         for body, key in placed:
+            if by_body[body].flexible and spec.supports_assumed.seat_equations == "linear":
+                from flexgear.mbs.joints import LinearSeat
+
+                spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
+                turning += LinearSeat(mbs, by_body[body], supports[key], spin).turning()
+                continue
             add_support(mbs, by_body[body], supports[key])
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
+    if turning:
+        from flexgear.mbs.joints import TurningBlocks
+
+        extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
     linear = [(bd.modal_node, bd.spin, bd.nominal_spin_rad_s) for bd in bodies if getattr(bd, "spin", None)]
     if linear:
         from flexgear.mbs.spin import SpinSchedule
