@@ -251,6 +251,9 @@ class SolverSettings:
     # divergence guard (flexgear.mbs.run.RunGuard); defaults keep older gearbox files valid
     wall_time_budget_s: float = _num(0.0, lo_open=True, default=7200.0)
     runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
+    # linear floating frame (flexgear.mbs.spin.SpinSchedule): interval [s] of the spin-term matrix updates
+    # during the ramp
+    spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 __all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces",
-           "periodic_values", "ramp_state", "interpolated_columns", "mesh_step"]
+           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step"]
 
 
 @njit(cache=True)
@@ -126,6 +126,23 @@ def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi
         i1 = (i0 + 1) % n_grid
         for m in range(n_modes[j]):
             matrix[rows[j], first[j] + m] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])
+
+
+@njit(cache=True)
+def turn_columns(buffer, rows, spin, dest, theta):  # pragma: no cover - compiled
+    """Write blockdiag(R_z(spin_j theta), R_z(spin_j theta)) rows[:, j] into buffer[:, dest_j] for every column j.
+
+    Compiled twin of flexgear.mbs.joints.TurningBlocks.turned (``rows`` (6, W), ``spin`` (W,), ``theta`` [rad]).
+    """
+    for j in range(rows.shape[1]):
+        c = math.cos(spin[j] * theta)
+        s = math.sin(spin[j] * theta)
+        k = dest[j]
+        for r in (0, 3):
+            buffer[r, k] = c * rows[r, j] - s * rows[r + 1, j]
+            buffer[r + 1, k] = s * rows[r, j] + c * rows[r + 1, j]
+        buffer[2, k] = rows[2, j]
+        buffer[5, k] = rows[5, j]
 
 
 @njit(cache=True)

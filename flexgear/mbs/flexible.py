@@ -39,6 +39,8 @@ class FlexibleBody(Body):
     # floating_frame = "linear": the body's spin terms (flexgear.mbs.spin.SpinMatrices) and nominal spin [rad/s]
     spin: object | None = None
     nominal_spin_rad_s: float = 0.0
+    modal_equations: int = -1  # their ObjectGenericODE2 ("linear")
+    modal_damping: np.ndarray | None = None  # diagonal of D [1/s] ("linear")
 
 
 def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):
@@ -145,7 +147,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         computeFFRFterms=floating_frame == "ffrf",
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
-    spin = None
+    spin, equations = None, -1
     if floating_frame == "linear":
         from exudyn.itemInterface import ObjectRigidBody
         from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
@@ -157,7 +159,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                                       inertia=InertiaTensor2Inertia6D(inv["inertia"]),
                                       centerOfMass=list(map(float, inv["centerOfMass"]))))
         spin = spin_matrices(reduced)
-        add_linear_modal_equations(mbs, name, modal, reduced.stiffness, damping, spin, nominal_spin_rad_s)
+        # at rest: flexgear.mbs.spin.SpinSchedule moves the spin terms with the ramp
+        equations = add_linear_modal_equations(mbs, name, modal, reduced.stiffness, damping, spin, 0.0)
     markers = {}
     for itf_name, start in first.items():
         markers[itf_name] = mbs.AddMarker(MarkerSuperElementRigid(
@@ -171,7 +174,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
-                        modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s))
+                        modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s),
+                        modal_equations=equations, modal_damping=np.broadcast_to(damping, (m,)).copy())
 
 
 

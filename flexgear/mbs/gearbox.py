@@ -280,11 +280,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         from flexgear.mbs.joints import TurningBlocks
 
         extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
-    linear = [(bd.modal_node, bd.spin, bd.nominal_spin_rad_s) for bd in bodies if getattr(bd, "spin", None)]
+    linear = [bd for bd in bodies if getattr(bd, "spin", None) is not None]
     if linear:
         from flexgear.mbs.spin import SpinSchedule
 
-        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s))
+        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s))
     train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,

@@ -193,18 +193,23 @@ class LinearSeat:
 class TurningBlocks:
     """Pre-step function: the modal blocks R_n(t) Psi of the linear joints' and seats' constraints (``entries``:
     their :meth:`turning` lists), phi_n = spin x the prescribed drive angle (STEP ramp ``ramp_time`` [s] to
-    ``drive_speed`` [rad/s]); all blocks turned in one vectorised operation, then written."""
+    ``drive_speed`` [rad/s]). Every entry's matrix is a slice of one buffer, its turning columns written by one
+    compiled call (flexgear.laws.compiled.turn_columns), then each matrix handed to its constraint."""
 
     def __init__(self, entries: list[tuple], ramp_time: float, drive_speed: float):
         self.ramp_time, self.drive_speed = float(ramp_time), float(drive_speed)
-        self.rows = np.hstack([e[4] for e in entries])  # (6, W)
+        self.rows = np.ascontiguousarray(np.hstack([e[4] for e in entries]))  # (6, W)
         self.spin = np.concatenate([np.full(e[4].shape[1], e[5]) for e in entries])
-        starts = np.cumsum([0] + [e[4].shape[1] for e in entries])
-        self.items = [(e[0], e[1], e[2].copy(), e[3], slice(a, b))
+        widths = [e[2].shape[1] for e in entries]
+        starts = np.cumsum([0, *widths])
+        self.buffer = np.hstack([e[2] for e in entries]).astype(float)  # the templates side by side
+        self.dest = np.concatenate([a + e[3] for e, a in zip(entries, starts[:-1], strict=True)]).astype(np.int64)
+        # views of the buffer, which the kernel rewrites in place
+        self.items = [(e[0], e[1], self.buffer[:, a:b])
                       for e, a, b in zip(entries, starts[:-1], starts[1:], strict=True)]
 
     def turned(self, t: float) -> np.ndarray:
-        """All blocks at time t: blockdiag(R_z(phi_n), R_z(phi_n)) rows, column by column (6, W)."""
+        """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
         from flexgear.laws.compiled import ramp_state
 
         phi = self.spin * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0])
@@ -216,8 +221,10 @@ class TurningBlocks:
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        turned = self.turned(t)
-        for obj, param, matrix, cols, part in self.items:
-            matrix[:, cols] = turned[:, part]
-            mbs.SetObjectParameter(obj, param, matrix)
+        from flexgear.laws.compiled import ramp_state, turn_columns
+
+        turn_columns(self.buffer, self.rows, self.spin, self.dest, self.drive_speed * ramp_state(t, self.ramp_time)[0])
+        set_parameter = mbs.SetObjectParameter
+        for obj, param, matrix in self.items:
+            set_parameter(obj, param, matrix)
         return True

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.laws.compiled import ramp_state
 from flexgear.laws.ramps import ramp_fraction
 from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.deflection import centrifugal_modal_load
@@ -56,79 +57,72 @@ def spin_matrices(reduced) -> SpinMatrices:
     return SpinMatrices(0.5 * (g - g.T), 0.5 * (s + s.T), centrifugal_modal_load(reduced))
 
 
-def add_linear_modal_equations(mbs, name: str, modal_node: int, stiffness: np.ndarray, damping: np.ndarray,
-                               spin: SpinMatrices, nominal_spin_rad_s: float) -> int:
-    """The modal equations at the nominal spin as one ``ObjectGenericODE2`` on ``modal_node``.
+def spin_terms(stiffness: np.ndarray, damping: np.ndarray, spin: SpinMatrices, spin_rad_s: float
+               ) -> tuple[np.ndarray, np.ndarray]:
+    """K = diag(``stiffness``) - Omega^2 S and D = diag(``damping``) + 2 Omega G at the spin Omega [rad/s]."""
+    w = float(spin_rad_s)
+    m = len(stiffness)
+    return (np.diag(stiffness) - w * w * spin.softening,
+            np.diag(np.broadcast_to(damping, (m,))) + 2.0 * w * spin.gyroscopic)
 
-    M = I, K = diag(``stiffness``) - Omega_n^2 S, D = ``damping`` (diagonal) + 2 Omega_n G, with Omega_n =
-    ``nominal_spin_rad_s`` [rad/s]; the centrifugal load and the ramp's difference come from
-    :class:`SpinSchedule`. Returns the object.
-    """
+
+def add_linear_modal_equations(mbs, name: str, modal_node: int, stiffness: np.ndarray, damping: np.ndarray,
+                               spin: SpinMatrices, spin_rad_s: float) -> int:
+    """The modal equations as one ``ObjectGenericODE2`` on ``modal_node``: M = I and :func:`spin_terms` at
+    ``spin_rad_s`` [rad/s] (:class:`SpinSchedule` moves them with the ramp and adds the centrifugal load).
+    Returns the object."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    w = float(nominal_spin_rad_s)
-    m = len(stiffness)
-    k = np.diag(stiffness) - w * w * spin.softening
-    d = np.diag(np.broadcast_to(damping, (m,))) + 2.0 * w * spin.gyroscopic
+    k, d = spin_terms(stiffness, damping, spin, spin_rad_s)
     return mbs.AddObject(ObjectGenericODE2(name=f"{name}_modal_equations", nodeNumbers=[modal_node],
-                                           massMatrix=matrix_container(np.eye(m)),
+                                           massMatrix=matrix_container(np.eye(len(stiffness))),
                                            stiffnessMatrix=matrix_container(k), dampingMatrix=matrix_container(d),
-                                           jacobianUserFunction=zero_user_jacobian(m)))
+                                           jacobianUserFunction=zero_user_jacobian(len(stiffness))))
 
 
 class SpinSchedule:
-    """Pre-step function: the centrifugal load and the spin terms' difference to the nominal spin.
+    """Pre-step function: the linear bodies' spin terms at the prescribed speed Omega(t) = Omega_n STEP(t, 0, 0,
+    T, 1) (T = ``ramp_time`` [s]).
 
-    One massless ``ObjectGenericODE2`` over the linear bodies' modal nodes carries the force vector
-
-        f = Omega(t)^2 c - 2 (Omega(t) - Omega_n) G q' + (Omega(t)^2 - Omega_n^2) S q
-
-    (Omega(t) = Omega_n STEP(t, 0, 0, T, 1), the prescribed speed ramp; q, q' at the step's start: explicit,
-    and zero once the ramp is over, when f = Omega_n^2 c is written once).
+    The centrifugal load Omega(t)^2 c, on one massless ``ObjectGenericODE2`` over the modal nodes, every step;
+    the matrices K(Omega), D(Omega) (:func:`spin_terms`) of each body's modal equations every
+    ``update_interval`` [s] of the ramp, at the step's speed, and once at its end (exact from then on). During
+    the ramp the speed in the matrices lags by at most Omega_n max|STEP'| ``update_interval`` = 1.5 Omega_n
+    ``update_interval`` / T.
     """
 
-    def __init__(self, mbs, bodies: list[tuple[int, SpinMatrices, float]], ramp_time: float):
-        """``bodies``: (modal node, its :class:`SpinMatrices`, nominal spin [rad/s]) per linear body."""
+    def __init__(self, mbs, bodies: list, ramp_time: float, update_interval: float):
+        """``bodies``: flexible bodies with ``floating_frame = "linear"`` (flexgear.mbs.flexible.FlexibleBody:
+        ``modal_node``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_damping``)."""
         from exudyn.itemInterface import ObjectGenericODE2
 
-        self.ramp_time = float(ramp_time)
-        nodes = [b[0] for b in bodies]
-        sizes = [len(b[1].centrifugal) for b in bodies]
-        self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=nodes,
-                                                   forceVector=np.zeros(sum(sizes)),
-                                                   jacobianUserFunction=zero_user_jacobian(sum(sizes))))
-        self._nodes = nodes
-        self._index: np.ndarray | None = None  # global ODE2 indices of the modal coordinates (after Assemble)
-        n = sum(sizes)
-        self.gyro, self.soft = np.zeros((n, n)), np.zeros((n, n))
-        self.cent, self.nominal = np.zeros(n), np.zeros(n)
-        start = 0
-        for (_, s, w), size in zip(bodies, sizes, strict=True):
-            sl = slice(start, start + size)
-            self.gyro[sl, sl], self.soft[sl, sl] = s.gyroscopic, s.softening
-            self.cent[sl], self.nominal[sl] = s.centrifugal, w
-            start += size
+        self.ramp_time, self.interval = float(ramp_time), float(update_interval)
+        self.bodies = bodies
+        n = sum(b.reduced.n_modes for b in bodies)
+        self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=[b.modal_node for b in bodies],
+                                                   forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
+        self.cent = np.concatenate([b.nominal_spin_rad_s ** 2 * b.spin.centrifugal for b in bodies])  # Omega_n^2 c
+        self._next = 0.0  # time of the next matrix update
         self._steady = False
 
-    def force(self, t: float, q: np.ndarray, q_t: np.ndarray) -> np.ndarray:
-        """f(t) of the class docstring for modal coordinates ``q`` and velocities ``q_t``."""
+    def force(self, t: float) -> np.ndarray:
+        """Omega(t)^2 c, stacked over the bodies."""
+        return ramp_state(float(t), self.ramp_time)[1] ** 2 * self.cent
+
+    def matrices(self, t: float) -> list[tuple[np.ndarray, np.ndarray]]:
+        """(K, D) of every body at the speed of time t."""
         r = float(ramp_fraction(float(t), self.ramp_time))
-        w = r * self.nominal
-        f = w * w * self.cent
-        if r < 1.0:
-            f -= 2.0 * self.gyro @ ((w - self.nominal) * q_t)
-            f += self.soft @ ((w * w - self.nominal ** 2) * q)
-        return f
+        return [spin_terms(b.reduced.stiffness, b.modal_damping, b.spin, r * b.nominal_spin_rad_s) for b in self.bodies]
 
     def __call__(self, mbs, t: float) -> bool:
         if self._steady:
             return True
-        if self._index is None:
-            self._index = np.concatenate([
-                mbs.GetNodeODE2Index(n) + np.arange(mbs.GetNode(n)["numberOfODE2Coordinates"]) for n in self._nodes])
-        data = mbs.systemData
-        q = np.asarray(data.GetODE2Coordinates())[self._index]
-        q_t = np.asarray(data.GetODE2Coordinates_t())[self._index]
-        mbs.SetObjectParameter(self.obj, "forceVector", self.force(t, q, q_t))
-        self._steady = t > self.ramp_time
+        mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        last = t >= self.ramp_time
+        if t >= self._next or last:
+            for b, (k, d) in zip(self.bodies, self.matrices(t), strict=True):
+                mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", matrix_container(k))
+                mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", matrix_container(d))
+            self._next = t + self.interval
+        self._steady = last
         return True
