@@ -135,3 +135,33 @@ def test_seat_bearing_matrix_is_the_three_springs(gearbox):
                         sup.tilt_stiffness, sup.tilt_stiffness, 0.0])
     assert np.allclose(k6, expected, rtol=1e-12, atol=1e-9 * sup.radial_stiffness)
     assert np.allclose(d6, sup.damping_per_stiffness * k6)
+
+
+def test_turning_blocks_kernel_equals_the_rotation():
+    """The compiled kernel that turns the linear joints' and seats' modal blocks writes blockdiag(R_z, R_z) rows
+    at each column's own spin (numpy reference :meth:`TurningBlocks.turned`), into each constraint's matrix beside
+    its constant template columns."""
+    from flexgear.mbs.joints import TurningBlocks
+
+    rng = np.random.default_rng(5)
+    joint = (1, "scalingMarker0", np.hstack([np.eye(6), np.zeros((6, 3))]), np.arange(6, 9), rng.normal(size=(6, 3)),
+             1.0)
+    seat = (2, "scalingMarker1", np.zeros((6, 4)), np.arange(4), rng.normal(size=(6, 4)), -0.3)
+    blocks = TurningBlocks([joint, seat], 0.5, 628.3)
+
+    class Recorder:
+        written: dict = {}
+
+        def SetObjectParameter(self, obj, param, value):  # noqa: N802 (Exudyn's name)
+            self.written[obj, param] = np.array(value)
+
+    rec = Recorder()
+    for t in (0.0, 0.21, 0.7):
+        blocks(rec, t)
+        ref = blocks.turned(t)
+        assert np.allclose(rec.written[1, "scalingMarker0"][:, :6], np.eye(6))
+        assert np.allclose(rec.written[1, "scalingMarker0"][:, 6:], ref[:, :3], rtol=1e-13, atol=1e-13)
+        assert np.allclose(rec.written[2, "scalingMarker1"], ref[:, 3:], rtol=1e-13, atol=1e-13)
+        # a rotation about z: the z rows unchanged, the x-y pairs keep their length
+        assert np.allclose(ref[[2, 5]], np.hstack([joint[4], seat[4]])[[2, 5]])
+        assert np.allclose(np.hypot(ref[0], ref[1]), np.hypot(*np.hstack([joint[4], seat[4]])[:2]))
