@@ -91,8 +91,9 @@ def test_rigid_and_flexible_twins_carry_identical_mass_properties():
         planet = build_star_gearbox(mbs, variant, reduced_source=annulus_source).bodies["planet1"]
         mass, com, inertia = (np.asarray(mbs.GetObjectParameter(planet.obj, k)) for k in ("mass", "centerOfMass",
                                                                                           "inertia"))
-        # rigid: inertia about the frame origin as Exudyn's 6-vector; flexible: the 3x3 tensor
-        props[form] = mass, com, Inertia6D2InertiaTensor(inertia) if form == "rigid" else inertia
+        # inertia about the frame origin: Exudyn's 6-vector of an ObjectRigidBody (rigid, and the frame of a
+        # linear flexible body), the 3x3 tensor of an ObjectFFRFreducedOrder
+        props[form] = mass, com, Inertia6D2InertiaTensor(inertia) if inertia.shape == (6,) else inertia
     (m_r, c_r, j_r), (m_f, c_f, j_f) = props["rigid"], props["flexible"]
     assert m_f == pytest.approx(m_r, rel=1e-12)
     assert np.abs(c_f - c_r).max() < 1e-12

@@ -40,6 +40,7 @@ class FlexibleBody(Body):
     spin: object | None = None
     nominal_spin_rad_s: float = 0.0
     modal_equations: int = -1  # their ObjectGenericODE2 ("linear")
+    superelement: bool = True  # an ObjectFFRFreducedOrder places markers and mesh nodes (else ``obj`` is the frame)
     modal_damping: np.ndarray | None = None  # diagonal of D [1/s] ("linear")
 
 
@@ -73,7 +74,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       stiffness_damping_s: float = 0.0, mass_damping_per_s: float = 0.0,
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
                       point_markers: dict[str, list] | None = None, show: bool = True,
-                      floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0) -> FlexibleBody:
+                      floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0,
+                      superelement: bool = True) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -88,6 +90,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     ``floating_frame``: "ffrf" (Exudyn's nonlinear floating-frame terms) or "linear" (flexgear.mbs.spin: the
     frame an ``ObjectRigidBody``, the modes linear equations at ``nominal_spin_rad_s`` about the body's z
     axis; the object then only places the markers; add a flexgear.mbs.spin.SpinSchedule for the ramp).
+    ``superelement`` False ("linear" only): no ``ObjectFFRFreducedOrder`` at all (no interface or point markers,
+    no mesh-node sensors; its zero mass matrix cost ~7 % of model 7's step); ``obj`` is then the frame's rigid body.
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -114,6 +118,10 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
 
     if floating_frame not in ("ffrf", "linear"):
         raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
+    if not superelement and (floating_frame == "ffrf" or interface_markers or point_markers):
+        raise ValueError(f"{name}: a body without superelement needs floating_frame 'linear' and no markers")
+    if not superelement:
+        interface_markers = []
     if interface_markers is None:
         interface_markers = [i.name for i in reduced.interfaces]
     points = (dict(interface_markers) if isinstance(interface_markers, dict)
@@ -134,7 +142,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         count += len(pts)
     damping = mass_damping_per_s + stiffness_damping_s * reduced.stiffness
     inv = reduced.invariants
-    obj = mbs.AddObject(ObjectFFRFreducedOrder(
+    obj = -1 if not superelement else mbs.AddObject(ObjectFFRFreducedOrder(
         name=name, nodeNumbers=[node, modal],
         massMatrixReduced=matrix_container(np.eye(m)),
         stiffnessMatrixReduced=matrix_container(np.diag(reduced.stiffness)),
@@ -155,12 +163,13 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices
 
         # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body (exact mass properties)
-        mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
+        frame = mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
                                       inertia=InertiaTensor2Inertia6D(inv["inertia"]),
                                       centerOfMass=list(map(float, inv["centerOfMass"]))))
         spin = spin_matrices(reduced)
         # at rest: flexgear.mbs.spin.SpinSchedule moves the spin terms with the ramp
         equations = add_linear_modal_equations(mbs, name, modal, reduced.stiffness, damping, spin, 0.0)
+        obj = obj if superelement else frame
     markers = {}
     for itf_name, start in first.items():
         markers[itf_name] = mbs.AddMarker(MarkerSuperElementRigid(
@@ -175,7 +184,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
                         modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s),
-                        modal_equations=equations, modal_damping=np.broadcast_to(damping, (m,)).copy())
+                        modal_equations=equations, modal_damping=np.broadcast_to(damping, (m,)).copy(),
+                        superelement=superelement)
 
 
 

@@ -134,7 +134,8 @@ GEARS = ("sun", "planet", "ring")
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
-                   cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0) -> Body:
+                   cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
+                   superelement: bool = True) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
@@ -142,7 +143,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     ``cutoff_hz`` > 0: a gear keeps its modes below it as coordinates, the others as ``dropped`` modes whose
     static compliance the contacts carry (flexgear.mbs.residual); ``dropped``: those per geometry, shared by
     the bodies of one build (the five planets compute them once); ``spin_rad_s``: the nominal spin about the
-    body's z axis [rad/s] (the linear floating frame's spin terms, flexgear.mbs.spin).
+    body's z axis [rad/s] (the linear floating frame's spin terms, flexgear.mbs.spin); ``superelement``: whether a
+    flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible).
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
@@ -152,6 +154,9 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     markers = support is not None and spec.supports_assumed.seat_equations == "markers"
     points = {support.interface: support_points(support)} if markers else None
+    if spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9
+                                                               for p in (joints or {}).values()):
+        joints = {}  # linear joints (flexgear.mbs.joints) need no interface markers
     full = reduced(spec, geometry, level)
     # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
     # the modes below the cut-off they are redundant and the solver fails); at least one dynamic mode: the
@@ -164,7 +169,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=joints or [], point_markers=points,
                              show=False, floating_frame=spec.reduction_assumed.floating_frame,
-                             nominal_spin_rad_s=spin_rad_s)
+                             nominal_spin_rad_s=spin_rad_s, superelement=superelement or bool(joints or points)
+                             or spec.reduction_assumed.floating_frame == "ffrf")
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes
@@ -182,7 +188,7 @@ def _linear_joints(spec: GearboxSpec, found: list) -> bool:
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
-                       reduced_source: ReducedSource | None = None) -> GearboxModel:
+                       reduced_source: ReducedSource | None = None, superelements: bool = False) -> GearboxModel:
     """Assemble the star gearbox of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards).
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
@@ -198,7 +204,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     with "gear_centres" on the frame coordinates at the frame origin (gear mid-plane).
     Rigid components carry the mass properties of the variant's ``rigid_mass_properties``: "mesh",
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
-    "exact", the exact geometry's; ``mass_source`` overrides both.
+    "exact", the exact geometry's; ``mass_source`` overrides both. ``superelements``: every flexible body keeps
+    its ``ObjectFFRFreducedOrder`` even when the linear forms need none (for mesh-node sensors: recorded states).
     """
     from flexgear.fe.reduced import gear_shaft_joints
 
@@ -234,9 +241,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         else:
             joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin)
+                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin,
+                                  superelement=superelements)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin)
+                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin,
+                                   superelement=superelements)
             bodies += [lead, other]
             pairs.append((lead, other, joints))
             ends[gear] = shaft
@@ -244,7 +253,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"] if seats else None,
-                                     cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed))
+                                     cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed,
+                                     superelement=superelements))
     by_body = {bd.name: bd for bd in bodies}
     joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
     spins = {"sun": 1.0, "ring": th.output_speed / th.input_speed}  # spin per drive angle

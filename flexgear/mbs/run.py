@@ -213,7 +213,7 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
         sc = exu.SystemContainer()
         mbs = sc.AddSystem()
-        model = build_star_gearbox(mbs, variant, mass_source, reduced_source)
+        model = build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements=record_states_every > 0)
         sensors = add_gearbox_sensors(mbs, model)
         states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()

@@ -62,6 +62,8 @@ def add_state_sensors(mbs, model: GearboxModel) -> dict[str, int]:
         if body.flexible:
             sensors[f"{name}/modal"] = mbs.AddSensor(SensorNode(nodeNumber=body.modal_node,
                                                                 outputVariableType=ovt.Coordinates, storeInternal=True))
+            if not getattr(body, "superelement", True):  # no FFRF object: no mesh-node sensor
+                continue
             sensors[f"{name}/probe"] = mbs.AddSensor(SensorSuperElement(
                 bodyNumber=body.obj, meshNodeNumber=bodies[name]["probe_node"], outputVariableType=ovt.Position,
                 storeInternal=True))
