@@ -64,7 +64,8 @@ class GearboxModel:
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
     residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
-    linear_joints: bool = False  # joints are flexgear.mbs.joints constraints (Force output: ground force, moment)
+    # gears whose joints are flexgear.mbs.joints constraints (Force output: ground force, moment)
+    linear_joints: tuple[str, ...] = ()
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -312,4 +313,5 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
-                        train.residual, linear_joints=any(_linear_joints(spec, found) for _, _, found in pairs))
+                        train.residual,
+                        linear_joints=tuple(lead.name for lead, _, found in pairs if _linear_joints(spec, found)))

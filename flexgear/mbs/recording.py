@@ -160,7 +160,7 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                                                       outputVariableType=ovt.Coordinates, storeInternal=True))
     for gear, joints in model.joints.items():
         for k, (joint, point) in enumerate(joints):
-            if model.linear_joints:  # multipliers: ground force [N] and moment [N m] (flexgear.mbs.joints)
+            if gear in model.linear_joints:  # multipliers: ground force [N] and moment [N m] (flexgear.mbs.joints)
                 sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
                     objectNumber=joint, outputVariableType=ovt.Force, storeInternal=True))
                 continue
@@ -200,7 +200,7 @@ def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: s
     total = None
     for k, (_, point) in enumerate(model.joints[gear]):
         data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
-        if model.linear_joints:  # on the axis: the moment multiplier about z is the torque
+        if gear in model.linear_joints:  # on the axis: the moment multiplier about z is the torque
             total = data[:, 6] if total is None else total + data[:, 6]
             continue
         torque = data[:, 3].copy()
