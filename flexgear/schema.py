@@ -72,9 +72,8 @@ def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = Fa
 
 
 def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:
-    if default is None:
-        return field(metadata={"choices": choices, "doc": doc})
-    return field(default=default, metadata={"choices": choices, "doc": doc})
+    meta = {"choices": choices, "doc": doc}
+    return field(metadata=meta) if default is None else field(default=default, metadata=meta)
 
 
 def _text(doc: str = "", default: str | None = None) -> Any:
@@ -251,8 +250,7 @@ class SolverSettings:
     # divergence guard (flexgear.mbs.run.RunGuard); defaults keep older gearbox files valid
     wall_time_budget_s: float = _num(0.0, lo_open=True, default=7200.0)
     runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
-    # linear floating frame (flexgear.mbs.spin.SpinSchedule): interval [s] of the spin-term matrix updates
-    # during the ramp
+    # linear floating frame: interval [s] of the spin-term updates in the ramp (flexgear.mbs.spin.SpinSchedule)
     spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
 
 
@@ -286,9 +284,7 @@ class ReductionSettings:
     # leave the time integration and return as the static residual compliance of the contacts
     # (flexgear.mbs.residual); 0 keeps every mode dynamic.
     dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
-    # "ffrf": Exudyn's nonlinear floating-frame terms; "linear": the frame a rigid body, the modes linear
-    # equations with the spin's gyroscopic, softening and centrifugal terms at the prescribed speed
-    # (flexgear.mbs.spin).
+    # "ffrf": Exudyn's nonlinear floating frame; "linear": flexgear.mbs.spin (rigid frame + linear modal equations)
     floating_frame: str = _choice("ffrf", "linear", default="ffrf")
 
 

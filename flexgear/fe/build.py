@@ -5,8 +5,9 @@ process: mesh (one Netgen run; flexgear.fe.mesh keeps the first-order mesh in me
 then the reduced body (flexgear.fe.reduced, cached like any other call). The components are independent,
 so the results are those of the serial build (same cache entries). Longest tasks are started first
 (:data:`COLD_BUILD_ORDER`) so that two workers finish together. Memory: each worker holds one
-component at a time; at the coarse level the largest process (the ring's) peaks at 1.3 GB and the whole
-process tree at 1.9-2.0 GB (sum of proportional set sizes; benchmarks/bench_cold.py measures both).
+component at a time, and its large arrays go back to the system when freed (flexgear.heap); at the coarse
+level the largest process (the ring's) peaks at 1.2 GB and the whole process tree at 1.75 GB (sum of
+proportional set sizes, 1.93 GB with glibc's rising mmap threshold; benchmarks/bench_cold.py measures both).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
+from flexgear.heap import lean_heap
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = ["ComponentSummary", "build_components", "COLD_BUILD_ORDER"]
@@ -71,8 +73,10 @@ def build_components(spec: GearboxSpec, level: str, reduce: bool = True, workers
         for component in order:
             finish(build_component(spec, component, level, reduce))
     else:
-        # spawn: a fresh interpreter per worker (NGSolve's task threads do not survive a fork)
-        with ProcessPoolExecutor(max_workers=int(workers), mp_context=multiprocessing.get_context("spawn")) as pool:
+        # spawn: a fresh interpreter per worker (NGSolve's task threads do not survive a fork); lean_heap: the
+        # large arrays a component frees go back to the system before the next one
+        with ProcessPoolExecutor(max_workers=int(workers), mp_context=multiprocessing.get_context("spawn"),
+                                 initializer=lean_heap) as pool:
             futures = [pool.submit(build_component, spec, c, level, reduce) for c in order]
             for future in as_completed(futures):
                 finish(future.result())
