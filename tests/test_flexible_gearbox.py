@@ -98,3 +98,19 @@ def test_rigid_and_flexible_twins_carry_identical_mass_properties():
     assert m_f == pytest.approx(m_r, rel=1e-12)
     assert np.abs(c_f - c_r).max() < 1e-12
     assert np.abs(j_f - j_r).max() < 1e-9 * np.abs(j_r).max()
+
+
+def test_generic_bolt_joints_beside_a_linear_sun_joint():
+    """Model 4 with the ring on bolt patches: the sun's joint on the axis is linear (flexgear.mbs.joints), the
+    ring's twelve bolt joints off the axis stay ObjectJointGeneric. Each gear's joints carry its shaft's torque:
+    the sun the drive torque, the ring the load torque of Table 5 (a model mixing both kinds once recorded the
+    wrong sensor type)."""
+    v = load_variant(VARIANTS / "model4.toml")
+    g = v.gearbox
+    g = g.with_changes(load_case=dataclasses.replace(g.load_case, ramp_time_s=0.01, end_time_s=0.02),
+                       joints_assumed=dataclasses.replace(g.joints_assumed, ring_output_shaft="bolt_patches"))
+    result = run_variant(dataclasses.replace(v, gearbox=g), reduced_source=annulus_source)
+    assert result.ok, result.meta.get("reason")
+    th = result.meta["theory"]
+    assert abs(result.meta["joint_torque_sun_nm"]) == pytest.approx(th["input_torque_nm"], rel=0.01)
+    assert abs(result.meta["joint_torque_ring_nm"]) == pytest.approx(th["output_torque_nm"], rel=0.01)
