@@ -132,6 +132,12 @@ GEARS = ("sun", "planet", "ring")
 """Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
 
 
+def _linear_joints(spec: GearboxSpec, points) -> bool:
+    """Whether a gear's joints to its shaft at ``points`` [m] are linear constraints (flexgear.mbs.joints): as
+    configured, and only when every joint point lies on the axis."""
+    return spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9 for p in points)
+
+
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
@@ -155,8 +161,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     markers = support is not None and spec.supports_assumed.seat_equations == "markers"
     points = {support.interface: support_points(support)} if markers else None
-    if spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9
-                                                               for p in (joints or {}).values()):
+    if _linear_joints(spec, (joints or {}).values()):
         joints = {}  # linear joints (flexgear.mbs.joints) need no interface markers
     full = reduced(spec, geometry, level)
     # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
@@ -180,12 +185,6 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if geometry not in cache:
         cache[geometry] = dropped_modes(spec, full, keep, geometry)
     return replace(body, dropped=cache[geometry])
-
-
-def _linear_joints(spec: GearboxSpec, found: list) -> bool:
-    """Whether a gear's joints to its shaft are linear constraints (flexgear.mbs.joints): as configured, and
-    only when every joint point lies on the axis."""
-    return spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9 for _, _, p in found)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
@@ -248,7 +247,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                    {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin,
                                    superelement=superelements)
             bodies += [lead, other]
-            pairs.append((lead, other, joints))
+            pairs.append((lead, other, joints, spin / th.input_speed))  # spin per drive angle
             ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -258,13 +257,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      superelement=superelements))
     by_body = {bd.name: bd for bd in bodies}
     joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
-    spins = {"sun": 1.0, "ring": th.output_speed / th.input_speed}  # spin per drive angle
-    for lead, other, found in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
+    linear_gears = []  # gears whose joints are linear constraints
+    for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
-        if _linear_joints(spec, found):
+        if _linear_joints(spec, [p for _, _, p in found]):
             from flexgear.mbs.joints import LinearInterfaceJoint
 
-            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, spins[lead.name], label) for a, b, p in found]
+            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label) for a, b, p in found]
+            linear_gears.append(lead.name)
             turning += [e for j in made for e in j.turning()]
             joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]
             continue
@@ -286,7 +286,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                 continue
             add_support(mbs, by_body[body], supports[key])
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
-    # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
     if turning:
         from flexgear.mbs.joints import TurningBlocks
 
@@ -296,6 +295,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         from flexgear.mbs.spin import SpinSchedule
 
         extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s))
+    # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
     train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
@@ -314,4 +314,4 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
                         train.residual,
-                        linear_joints=tuple(lead.name for lead, _, found in pairs if _linear_joints(spec, found)))
+                        linear_joints=tuple(linear_gears))

@@ -33,7 +33,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from flexgear.mbs.bodies import Body, zero_user_jacobian
+from flexgear.laws.compiled import ramp_state, turn_columns
+from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
 
 __all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "interface_rows", "seat_matrices"]
 
@@ -160,8 +161,6 @@ class LinearSeat:
             ObjectGenericODE2,
         )
 
-        from flexgear.mbs.bodies import matrix_container
-
         self.spin = float(spin_per_drive_angle)
         centre = np.array([0.0, 0.0, support.centre_z])
         self.rows = interface_rows(body, support.interface, centre)
@@ -210,8 +209,6 @@ class TurningBlocks:
 
     def turned(self, t: float) -> np.ndarray:
         """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
-        from flexgear.laws.compiled import ramp_state
-
         phi = self.spin * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0])
         c, s = np.cos(phi), np.sin(phi)
         r = self.rows
@@ -221,8 +218,6 @@ class TurningBlocks:
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        from flexgear.laws.compiled import ramp_state, turn_columns
-
         turn_columns(self.buffer, self.rows, self.spin, self.dest, self.drive_speed * ramp_state(t, self.ramp_time)[0])
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:

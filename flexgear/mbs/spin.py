@@ -17,11 +17,9 @@ Exudyn uses) are
 
 with Omega(t) the body's prescribed spin (the drive's STEP ramp times the body's nominal speed,
 flexgear.theory). The frame itself is an ``ObjectRigidBody`` with the body's exact mass properties on the
-same node; the superelement markers still place every interface and contact by frame motion plus
-modes. Left out (second order): the inertia tensor's change with q, the terms in the tilt rates and in
-the angular acceleration. At the nominal spin the matrices above are constant: one ``ObjectGenericODE2``
-per body carries them (analytic Jacobian); during the ramp one shared force vector adds the difference
-to the scheduled spin (:class:`SpinSchedule`), written once when the ramp ends.
+same node. Left out (second order): the inertia tensor's change with q, the terms in the tilt rates and in
+the angular acceleration. One ``ObjectGenericODE2`` per body carries M, K(Omega), D(Omega) (constant
+Jacobian); :class:`SpinSchedule` moves K and D with the ramp and writes the centrifugal load.
 """
 
 from __future__ import annotations
@@ -31,7 +29,6 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexgear.laws.compiled import ramp_state
-from flexgear.laws.ramps import ramp_fraction
 from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.deflection import centrifugal_modal_load
 
@@ -111,7 +108,7 @@ class SpinSchedule:
 
     def matrices(self, t: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """(K, D) of every body at the speed of time t."""
-        r = float(ramp_fraction(float(t), self.ramp_time))
+        r = ramp_state(float(t), self.ramp_time)[1]
         return [spin_terms(b.reduced.stiffness, b.modal_damping, b.spin, r * b.nominal_spin_rad_s) for b in self.bodies]
 
     def __call__(self, mbs, t: float) -> bool:
