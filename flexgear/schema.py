@@ -277,8 +277,7 @@ class ReductionSettings:
     contact_fourier_order: int = _num(1, 60, integer=True)
     # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
     attachment_order: int = _num(0, 60, integer=True)
-    # 0: keep every mode of the (attachment-corrected) basis; n > 0: only the n lowest (loses the
-    # static correction: for speed experiments only).
+    # 0: keep every mode of the (attachment-corrected) basis; n > 0: the n lowest (loses the static correction)
     simulation_modes: int = _num(0, 400, integer=True, default=0)
     # Gears only (bodies with gear contacts): modes above this multiple of the nominal mesh frequency
     # leave the time integration and return as the static residual compliance of the contacts
@@ -286,6 +285,8 @@ class ReductionSettings:
     dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
     # "ffrf": Exudyn's nonlinear floating frame; "linear": flexgear.mbs.spin (rigid frame + linear modal equations)
     floating_frame: str = _choice("ffrf", "linear", default="ffrf")
+    # "linear" bodies: "interface": linear joints' and seats' interface motions as coordinates (flexgear.mbs.flexible)
+    modal_coordinates: str = _choice("modal", "interface", default="modal")
 
 
 @dataclass(frozen=True)

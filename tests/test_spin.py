@@ -78,7 +78,9 @@ def test_spin_schedule_follows_the_ramp(gearbox):
     s = spin_matrices(body)
     assert np.allclose(s.gyroscopic, -s.gyroscopic.T) and np.allclose(s.softening, s.softening.T)
     nominal, ramp = -203.3, 0.1
-    flex = SimpleNamespace(reduced=body, spin=s, nominal_spin_rad_s=nominal, modal_damping=1e-5 * body.stiffness)
+    m = body.n_modes
+    flex = SimpleNamespace(reduced=body, spin=s, nominal_spin_rad_s=nominal,
+                           modal_matrices=(np.eye(m), np.diag(body.stiffness), np.diag(1e-5 * body.stiffness)))
     sched = SpinSchedule.__new__(SpinSchedule)
     sched.ramp_time, sched.bodies, sched.cent = ramp, [flex], nominal ** 2 * s.centrifugal
     for t in (0.0, 0.03, 0.07, 0.2):
@@ -97,7 +99,8 @@ def _short_runs(case: str, configs: list[dict]):
     lc = dataclasses.replace(g.load_case, ramp_time_s=0.006, end_time_s=0.024)
     runs = []
     for cfg in configs:
-        red = dataclasses.replace(g.reduction_assumed, floating_frame=cfg["frame"])
+        red = dataclasses.replace(g.reduction_assumed, floating_frame=cfg["frame"],
+                                  modal_coordinates=cfg.get("coordinates", g.reduction_assumed.modal_coordinates))
         joints = dataclasses.replace(g.joints_assumed, joint_equations=cfg["joint"])
         seats = dataclasses.replace(g.supports_assumed, seat_equations=cfg["seat"])
         spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints, supports_assumed=seats)
@@ -165,3 +168,54 @@ def test_turning_blocks_kernel_equals_the_rotation():
         # a rotation about z: the z rows unchanged, the x-y pairs keep their length
         assert np.allclose(ref[[2, 5]], np.hstack([joint[4], seat[4]])[[2, 5]])
         assert np.allclose(np.hypot(ref[0], ref[1]), np.hypot(*np.hstack([joint[4], seat[4]])[:2]))
+
+
+def test_interface_coordinates_are_an_exact_change_of_coordinates(gearbox):
+    """The output shaft's basis with its ring joint and bearing seat as coordinates (flexgear.mbs.flexible.
+    interface_basis): the first twelve coordinates are the two interfaces' RBE3 motions (P T = [I, 0]), the mass
+    matrix is blockdiag((P P^T)^-1, I) exactly, and the free frequencies in the new coordinates are the modal
+    ones (generalised eigenvalues of T^T Lambda T, T^T T) within 1e-9."""
+    import scipy.linalg
+
+    from flexgear.fe.reduced import gear_shaft_joints
+    from flexgear.mbs.flexible import interface_basis, interface_mass
+
+    body = component_reduced_body(gearbox, "output_shaft")
+    names = (gear_shaft_joints(gearbox, "ring")[0][1], "bearing_seat")
+    t = interface_basis(body, names)
+    p = np.vstack([body.interface_motion(n) for n in names])
+    expected = np.hstack([np.eye(12), np.zeros((12, body.n_modes - 12))])
+    assert np.abs(p @ t - expected).max() < 1e-9
+    mass = interface_mass(t, 12)
+    assert np.allclose(mass, t.T @ t, rtol=0.0, atol=1e-9 * np.abs(mass).max())
+    lam = scipy.linalg.eigh(t.T @ np.diag(body.stiffness) @ t, mass, eigvals_only=True)
+    assert np.allclose(np.sort(lam), np.sort(body.stiffness), rtol=1e-9)
+    assert interface_basis(body.truncated(10), names) is None  # ten modes cannot carry twelve interface motions
+
+
+def test_interface_coordinates_keep_model7_and_shrink_its_constraints():
+    """Model 7, short run, on interface coordinates against modal coordinates: the same equations in other
+    coordinates, so the signals agree to the Newton tolerance (mean mesh forces 1e-5, 1x amplitudes 1e-3, the
+    gears' load deflections 1e-4); the ring joint's constraint spans six modal columns per body (was 35-47)."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+
+    v = fg.load_variant(VARIANTS / "model7.toml")
+    red = v.gearbox.reduction_assumed
+    spec = v.gearbox.with_changes(reduction_assumed=dataclasses.replace(red, modal_coordinates="interface"))
+    mbs = exu.SystemContainer().AddSystem()
+    build_star_gearbox(mbs, dataclasses.replace(v, gearbox=spec))
+    joint = mbs.GetObject(mbs.GetObjectNumber("joint_ring_output_shaft"))
+    assert np.shape(joint["scalingMarker0"]) == (6, 12) and np.shape(joint["scalingMarker1"]) == (6, 12)
+    (ref, new), f_mesh = _short_runs("model7", [{"frame": "linear", "joint": "linear", "seat": "linear",
+                                                 "coordinates": c} for c in ("modal", "interface")])
+    dt = float(np.median(np.diff(ref.time_s.to_numpy())))
+    for kind in ("outer", "inner"):
+        for i in range(1, 6):
+            col = f"{kind}_mesh_force_{i}_n"
+            assert new[col].mean() == pytest.approx(ref[col].mean(), rel=1e-5)
+            a_ref, a_new = (harmonic_amplitudes(s[col].to_numpy(), dt, f_mesh, (1,))[0] for s in (ref, new))
+            assert a_new == pytest.approx(a_ref, rel=1e-3)
+            col = f"{kind}_deflection_load_{i}_m"
+            assert new[col].mean() == pytest.approx(ref[col].mean(), rel=1e-4)

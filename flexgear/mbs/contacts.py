@@ -133,7 +133,7 @@ class MeshConstraint:
             cols = [np.arange(6 * index[n], 6 * index[n] + 6) for n in pair]
             for n in pair:
                 if by_name[n].flexible:
-                    nodes.append(by_name[n].modal_node)
+                    nodes += by_name[n].modal_nodes  # q~ in node order (FlexibleBody)
                     cols.append(np.arange(modal_offsets[n], modal_offsets[n] + by_name[n].reduced.n_modes))
             cols = np.concatenate(cols)
             span = mbs.AddObject(ObjectGenericODE2(name=f"mesh_span_{pair[0]}_{pair[1]}", nodeNumbers=nodes,

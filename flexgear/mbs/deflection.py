@@ -101,7 +101,9 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
                 q_c_unit = (dropped.centrifugal_held[:red.n_modes] if dropped is not None else
                             centrifugal_response(red, np.vstack([red.interface_motion(n) for n in joints])))
                 seat = gear_seat(model.spec, red, geometry)
-                offsets[body_name] = (red.interface_motion(seat), seat.point, q_c_unit)
+                # in the body's coordinates q~, as the contact tables and the recorded coordinates
+                offsets[body_name] = (body.to_coordinates(red.interface_motion(seat)), seat.point,
+                                      body.coordinates_of(q_c_unit))
             motion, p_seat, q_c_unit = offsets[body_name]
             row = _column_row(kin, j, body_name)
             ang = spin * theta  # nominal spin angle of the body

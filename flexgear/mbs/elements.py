@@ -141,14 +141,14 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, 
 
     if interface is None or not body.flexible:
         return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5)), body.node, 5
-    r = body.reduced.interface_motion(interface)[5]
+    modal_nodes, r = body.span(body.reduced.interface_motion(interface)[5][None, :])
     spin = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_{interface}_spin", numberOfODE2Coordinates=1,
                                        referenceCoordinates=[0.0], initialCoordinates=[0.0],
                                        initialCoordinates_t=[0.0]))
     span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_{interface}_span",
-                                           nodeNumbers=[body.node, body.modal_node],
-                                           jacobianUserFunction=zero_user_jacobian(6 + body.reduced.n_modes)))
-    row = np.concatenate([np.eye(6)[5], r])[None, :]
+                                           nodeNumbers=[body.node, *modal_nodes],
+                                           jacobianUserFunction=zero_user_jacobian(6 + r.shape[1])))
+    row = np.concatenate([np.eye(6)[5], r[0]])[None, :]
     mbs.AddObject(ObjectConnectorCoordinateVector(
         name=f"{body.name}_{interface}_spin_tie",
         markerNumbers=[mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=spin)),

@@ -21,9 +21,7 @@ import numpy as np
 from flexgear.fe.cms import ReducedBody
 from flexgear.mbs.bodies import Body, matrix_container
 
-__all__ = ["FlexibleBody", "add_flexible_body", "interface_virtual_nodes", "interface_point_modes"]
-
-
+__all__ = ["FlexibleBody", "add_flexible_body", "interface_basis", "interface_virtual_nodes", "interface_point_modes"]
 
 @dataclass(frozen=True)
 class FlexibleBody(Body):
@@ -41,7 +39,72 @@ class FlexibleBody(Body):
     nominal_spin_rad_s: float = 0.0
     modal_equations: int = -1  # their ObjectGenericODE2 ("linear")
     superelement: bool = True  # an ObjectFFRFreducedOrder places markers and mesh nodes (else ``obj`` is the frame)
-    modal_damping: np.ndarray | None = None  # diagonal of D [1/s] ("linear")
+    # ("linear") M, K and D of the modal equations at rest in the body's coordinates q~ (q = basis q~)
+    modal_matrices: tuple[np.ndarray, np.ndarray, np.ndarray] | None = None
+    # the nodes of q~ in order and their sizes; ``basis`` T (m, m) with q = T q~ (None: q~ = q, one node,
+    # ``modal_node``); with interface coordinates (:func:`interface_basis`) ``modal_node`` is -1
+    modal_nodes: tuple[int, ...] = ()
+    modal_sizes: tuple[int, ...] = ()
+    basis: np.ndarray | None = None
+
+    def to_coordinates(self, rows: np.ndarray) -> np.ndarray:
+        """``rows`` (r, m) over the modal coordinates q as rows over the body's coordinates q~ (rows T)."""
+        return rows if self.basis is None else rows @ self.basis
+
+    def coordinates_of(self, q: np.ndarray) -> np.ndarray:
+        """q~ of modal coordinates ``q`` (m,) (T^-1 q)."""
+        return q if self.basis is None else np.linalg.solve(self.basis, q)
+
+    def modes_of(self, coordinates: np.ndarray) -> np.ndarray:
+        """Modal coordinates q (..., m) of the body's coordinates q~ (..., m) (q = T q~, row by row)."""
+        return coordinates if self.basis is None else coordinates @ self.basis.T
+
+    def span(self, rows: np.ndarray) -> tuple[list[int], np.ndarray]:
+        """``rows`` (r, m) over q as rows over the body's coordinates, kept only on the nodes they touch: (nodes,
+        rows over those nodes' coordinates). An interface's rows then span its own six coordinates: a constraint on
+        them costs Exudyn rows x 6^2, not rows x m^2 (its dense marker Jacobian). Blocks below 1e-9 of the largest
+        entry are round-off of exact zeros (the interface rows of the other coordinates vanish by construction)."""
+        r = self.to_coordinates(np.atleast_2d(rows))
+        if self.basis is None:
+            return [self.modal_node], r
+        scale = np.abs(r).max()
+        nodes, blocks, start = [], [], 0
+        for node, size in zip(self.modal_nodes, self.modal_sizes, strict=True):
+            block = r[:, start:start + size]
+            start += size
+            if np.abs(block).max() > 1e-9 * scale:
+                nodes.append(node)
+                blocks.append(block)
+        return nodes, np.hstack(blocks)
+
+
+def interface_basis(reduced: ReducedBody, names: tuple[str, ...]) -> np.ndarray | None:
+    """T (m, m) of modal coordinates q = T q~ whose first 6 k coordinates are the RBE3 motions (translation [m],
+    rotation [rad]) of the k interfaces ``names`` (P q, P the stacked ``reduced.interface_motion`` rows).
+
+    Columns: A = P^T (P P^T)^-1 (the least-norm modal combinations of unit interface motions), then an orthonormal
+    basis N of P's null space (the interfaces held). P A = I and P N = 0; with M = I the mass matrix in q~ is
+    blockdiag((P P^T)^-1, I) (:func:`interface_mass`), as sparse as before but for one 6 k block. None when P has
+    rank below 6 k or at least m rows (too few modes to carry the interface motions).
+    """
+    if not names:
+        return None
+    p = np.vstack([reduced.interface_motion(n) for n in names])
+    k, m = p.shape
+    if k >= m:
+        return None
+    _, sv, vt = np.linalg.svd(p)
+    if sv[-1] < 1e-8 * sv[0]:
+        return None
+    return np.hstack([p.T @ np.linalg.inv(p @ p.T), vt[k:].T])
+
+
+def interface_mass(basis: np.ndarray, n_interface: int) -> np.ndarray:
+    """T^T T of :func:`interface_basis` with its exact zeros: A^T N = 0 and N^T N = I (``n_interface`` = 6 k)."""
+    k = n_interface
+    out = np.eye(basis.shape[1])
+    out[:k, :k] = basis[:, :k].T @ basis[:, :k]
+    return out
 
 
 def interface_virtual_nodes(reduced: ReducedBody, name: str, point=None, arm: float = 0.01):
@@ -75,7 +138,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
                       point_markers: dict[str, list] | None = None, show: bool = True,
                       floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0,
-                      superelement: bool = True) -> FlexibleBody:
+                      superelement: bool = True, interface_coordinates: tuple[str, ...] = ()) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -92,6 +155,9 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     axis; the object then only places the markers; add a flexgear.mbs.spin.SpinSchedule for the ramp).
     ``superelement`` False ("linear" only): no ``ObjectFFRFreducedOrder`` at all (no interface or point markers,
     no mesh-node sensors; its zero mass matrix cost ~7 % of model 7's step); ``obj`` is then the frame's rigid body.
+    ``interface_coordinates`` (without superelement): interfaces whose RBE3 motions become coordinates of their own
+    six-coordinate node (:func:`interface_basis`; the other coordinates on one more node), for constraints on them
+    (flexgear.mbs.joints); ignored when the basis cannot carry them.
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -112,14 +178,18 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     node_item.name = f"{name}_node"
     node = mbs.AddNode(node_item)
     m = reduced.n_modes
-    modal = mbs.AddNode(NodeGenericODE2(name=f"{name}_modes", numberOfODE2Coordinates=m,
-                                        referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
-                                        initialCoordinates_t=[0.0] * m))
-
     if floating_frame not in ("ffrf", "linear"):
         raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
     if not superelement and (floating_frame == "ffrf" or interface_markers or point_markers):
         raise ValueError(f"{name}: a body without superelement needs floating_frame 'linear' and no markers")
+    basis = None if superelement else interface_basis(reduced, tuple(interface_coordinates))
+    sizes = (m,) if basis is None else (*[6] * len(interface_coordinates), m - 6 * len(interface_coordinates))
+    labels = ("modes",) if basis is None else (*interface_coordinates, "modes")
+    modal_nodes = tuple(mbs.AddNode(NodeGenericODE2(name=f"{name}_{label}", numberOfODE2Coordinates=n,
+                                                    referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
+                                                    initialCoordinates_t=[0.0] * n))
+                        for label, n in zip(labels, sizes, strict=True))
+    modal = modal_nodes[0] if basis is None else -1
     if not superelement:
         interface_markers = []
     if interface_markers is None:
@@ -155,20 +225,25 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         computeFFRFterms=floating_frame == "ffrf",
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
-    spin, equations = None, -1
+    spin, equations, matrices = None, -1, None
     if floating_frame == "linear":
         from exudyn.itemInterface import ObjectRigidBody
         from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
 
-        from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices
+        from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices, transformed
 
         # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body (exact mass properties)
         frame = mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
                                       inertia=InertiaTensor2Inertia6D(inv["inertia"]),
                                       centerOfMass=list(map(float, inv["centerOfMass"]))))
         spin = spin_matrices(reduced)
+        matrices = (np.eye(m), np.diag(reduced.stiffness), np.diag(np.broadcast_to(damping, (m,))))
+        if basis is not None:
+            spin = transformed(spin, basis)
+            matrices = (interface_mass(basis, 6 * len(interface_coordinates)),
+                        *(basis.T @ a @ basis for a in matrices[1:]))
         # at rest: flexgear.mbs.spin.SpinSchedule moves the spin terms with the ramp
-        equations = add_linear_modal_equations(mbs, name, modal, reduced.stiffness, damping, spin, 0.0)
+        equations = add_linear_modal_equations(mbs, name, modal_nodes, matrices, spin, 0.0)
         obj = obj if superelement else frame
     markers = {}
     for itf_name, start in first.items():
@@ -184,8 +259,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
                         modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s),
-                        modal_equations=equations, modal_damping=np.broadcast_to(damping, (m,)).copy(),
-                        superelement=superelement)
+                        modal_equations=equations, superelement=superelement, modal_matrices=matrices,
+                        modal_nodes=modal_nodes, modal_sizes=sizes, basis=basis)
 
 
 

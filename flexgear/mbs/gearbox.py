@@ -161,8 +161,14 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     markers = support is not None and spec.supports_assumed.seat_equations == "markers"
     points = {support.interface: support_points(support)} if markers else None
+    coordinates = []  # interfaces of linear joints and seats: on their own coordinates if so configured
     if _linear_joints(spec, (joints or {}).values()):
+        coordinates += list(joints or {})
         joints = {}  # linear joints (flexgear.mbs.joints) need no interface markers
+    if support is not None and not markers:
+        coordinates.append(support.interface)
+    if spec.reduction_assumed.modal_coordinates != "interface":
+        coordinates = []
     full = reduced(spec, geometry, level)
     # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
     # the modes below the cut-off they are redundant and the solver fails); at least one dynamic mode: the
@@ -176,7 +182,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
                              interface_markers=joints or [], point_markers=points,
                              show=False, floating_frame=spec.reduction_assumed.floating_frame,
                              nominal_spin_rad_s=spin_rad_s, superelement=superelement or bool(joints or points)
-                             or spec.reduction_assumed.floating_frame == "ffrf")
+                             or spec.reduction_assumed.floating_frame == "ffrf",
+                             interface_coordinates=tuple(dict.fromkeys(coordinates)))
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes

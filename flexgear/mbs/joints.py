@@ -101,9 +101,9 @@ class LinearInterfaceJoint:
             local = point - b.position
             q_ref.append(np.concatenate([b.position, np.zeros(3)]))
             modal = np.zeros((6, 0))
-            if b.flexible:
-                modal = interface_rows(b, itf, local)
-                nodes.append(b.modal_node)
+            if b.flexible:  # on the interface's own coordinates when the body has them (FlexibleBody.span)
+                modal_nodes, modal = b.span(interface_rows(b, itf, local))
+                nodes += modal_nodes
                 q_ref.append(np.zeros(modal.shape[1]))
             parts.append((sign, local, modal))
             # one marker per body: Exudyn's constraint costs rows x columns^2 per marker (its dense Jacobian)
@@ -163,7 +163,7 @@ class LinearSeat:
 
         self.spin = float(spin_per_drive_angle)
         centre = np.array([0.0, 0.0, support.centre_z])
-        self.rows = interface_rows(body, support.interface, centre)
+        modal_nodes, self.rows = body.span(interface_rows(body, support.interface, centre))
         frame = _frame_rows(centre)
         self.node = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_seat", numberOfODE2Coordinates=6,
                                                 referenceCoordinates=[0.0] * 6, initialCoordinates=[0.0] * 6,
@@ -177,10 +177,13 @@ class LinearSeat:
         # Exudyn's equation: scalingMarker1 q - scalingMarker0 (s, frame) - offset = 0, i.e.
         # R_n Psi q + J_f (frame - reference) - s = 0
         q_ref = np.concatenate([body.position, np.zeros(3)])
+        modal = (MarkerNodeCoordinates(nodeNumber=modal_nodes[0]) if len(modal_nodes) == 1 else
+                 MarkerObjectODE2Coordinates(objectNumber=mbs.AddObject(ObjectGenericODE2(
+                     name=f"{body.name}_seat_modes", nodeNumbers=modal_nodes,
+                     jacobianUserFunction=zero_user_jacobian(self.rows.shape[1])))))
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
             name=f"{body.name}_seat_tie",
-            markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)),
-                           mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=body.modal_node))],
+            markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
             scalingMarker0=np.hstack([np.eye(6), -frame]), scalingMarker1=self.rows, offset=frame @ q_ref))
 
     def turning(self) -> list[tuple]:

@@ -176,9 +176,9 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
             sensors["residual"] = mbs.AddSensor(SensorNode(nodeNumber=model.residual_node,
                                                            outputVariableType=ovt.Coordinates, storeInternal=True))
         for name, body in model.bodies.items():
-            if body.flexible:
-                sensors[f"modes_{name}"] = mbs.AddSensor(SensorNode(
-                    nodeNumber=body.modal_node, outputVariableType=ovt.Coordinates, storeInternal=True))
+            for k, node in enumerate(body.modal_nodes if body.flexible else ()):  # q~ node by node, in order
+                sensors[f"modes_{name}/{k}"] = mbs.AddSensor(SensorNode(
+                    nodeNumber=node, outputVariableType=ovt.Coordinates, storeInternal=True))
     for kind, groups in (("outer", model.outer_contacts), ("inner", model.inner_contacts)):
         for i, halves in enumerate(groups):
             for h, obj in enumerate(halves):

@@ -61,7 +61,8 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     time = cols["time_s"]
     extra = {"transmission_error_m": transmission_error(model, time, data("output_spin")[:, 1 + model.output_spin[1]])}
     if model.kinematics is not None:
-        modal = {k[len("modes_"):]: data(k)[:, 1:] for k in sensors if k.startswith("modes_")}
+        modal = {name: np.hstack([data(k)[:, 1:] for k in sensors if k.startswith(f"modes_{name}/")])
+                 for name, body in model.bodies.items() if body.flexible}  # each body's q~ (recording.py)
         residual = data("residual")[:, 1:] if "residual" in sensors else None
         extra.update(mesh_deflection_signals(model, time, modal, residual))
     return pd.concat([frame, pd.DataFrame(extra)], axis=1)

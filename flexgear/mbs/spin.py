@@ -32,7 +32,7 @@ from flexgear.laws.compiled import ramp_state
 from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.deflection import centrifugal_modal_load
 
-__all__ = ["SpinMatrices", "spin_matrices", "add_linear_modal_equations", "SpinSchedule"]
+__all__ = ["SpinMatrices", "spin_matrices", "transformed", "add_linear_modal_equations", "SpinSchedule"]
 
 
 @dataclass(frozen=True)
@@ -54,27 +54,32 @@ def spin_matrices(reduced) -> SpinMatrices:
     return SpinMatrices(0.5 * (g - g.T), 0.5 * (s + s.T), centrifugal_modal_load(reduced))
 
 
+def transformed(spin: SpinMatrices, basis: np.ndarray) -> SpinMatrices:
+    """The spin terms in coordinates q~ with q = ``basis`` q~ (T^T G T, T^T S T, T^T c)."""
+    t = basis
+    return SpinMatrices(t.T @ spin.gyroscopic @ t, t.T @ spin.softening @ t, t.T @ spin.centrifugal)
+
+
 def spin_terms(stiffness: np.ndarray, damping: np.ndarray, spin: SpinMatrices, spin_rad_s: float
                ) -> tuple[np.ndarray, np.ndarray]:
-    """K = diag(``stiffness``) - Omega^2 S and D = diag(``damping``) + 2 Omega G at the spin Omega [rad/s]."""
+    """K = ``stiffness`` - Omega^2 S and D = ``damping`` + 2 Omega G (m, m) at the spin Omega [rad/s]."""
     w = float(spin_rad_s)
-    m = len(stiffness)
-    return (np.diag(stiffness) - w * w * spin.softening,
-            np.diag(np.broadcast_to(damping, (m,))) + 2.0 * w * spin.gyroscopic)
+    return stiffness - w * w * spin.softening, damping + 2.0 * w * spin.gyroscopic
 
 
-def add_linear_modal_equations(mbs, name: str, modal_node: int, stiffness: np.ndarray, damping: np.ndarray,
-                               spin: SpinMatrices, spin_rad_s: float) -> int:
-    """The modal equations as one ``ObjectGenericODE2`` on ``modal_node``: M = I and :func:`spin_terms` at
-    ``spin_rad_s`` [rad/s] (:class:`SpinSchedule` moves them with the ramp and adds the centrifugal load).
-    Returns the object."""
+def add_linear_modal_equations(mbs, name: str, modal_nodes: tuple[int, ...], matrices: tuple, spin: SpinMatrices,
+                               spin_rad_s: float) -> int:
+    """The modal equations as one ``ObjectGenericODE2`` on ``modal_nodes``: ``matrices`` (M, K, D) at rest (M = I,
+    K = Lambda, D diagonal in modal coordinates) with :func:`spin_terms` at ``spin_rad_s`` [rad/s]
+    (:class:`SpinSchedule` moves them with the ramp and adds the centrifugal load). Returns the object."""
     from exudyn.itemInterface import ObjectGenericODE2
 
+    mass, stiffness, damping = matrices
     k, d = spin_terms(stiffness, damping, spin, spin_rad_s)
-    return mbs.AddObject(ObjectGenericODE2(name=f"{name}_modal_equations", nodeNumbers=[modal_node],
-                                           massMatrix=matrix_container(np.eye(len(stiffness))),
+    return mbs.AddObject(ObjectGenericODE2(name=f"{name}_modal_equations", nodeNumbers=list(modal_nodes),
+                                           massMatrix=matrix_container(mass),
                                            stiffnessMatrix=matrix_container(k), dampingMatrix=matrix_container(d),
-                                           jacobianUserFunction=zero_user_jacobian(len(stiffness))))
+                                           jacobianUserFunction=zero_user_jacobian(len(mass))))
 
 
 class SpinSchedule:
@@ -90,13 +95,14 @@ class SpinSchedule:
 
     def __init__(self, mbs, bodies: list, ramp_time: float, update_interval: float):
         """``bodies``: flexible bodies with ``floating_frame = "linear"`` (flexgear.mbs.flexible.FlexibleBody:
-        ``modal_node``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_damping``)."""
+        ``modal_nodes``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_matrices``)."""
         from exudyn.itemInterface import ObjectGenericODE2
 
         self.ramp_time, self.interval = float(ramp_time), float(update_interval)
         self.bodies = bodies
         n = sum(b.reduced.n_modes for b in bodies)
-        self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=[b.modal_node for b in bodies],
+        nodes = [node for b in bodies for node in b.modal_nodes]
+        self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=nodes,
                                                    forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
         self.cent = np.concatenate([b.nominal_spin_rad_s ** 2 * b.spin.centrifugal for b in bodies])  # Omega_n^2 c
         self._next = 0.0  # time of the next matrix update
@@ -109,7 +115,7 @@ class SpinSchedule:
     def matrices(self, t: float) -> list[tuple[np.ndarray, np.ndarray]]:
         """(K, D) of every body at the speed of time t."""
         r = ramp_state(float(t), self.ramp_time)[1]
-        return [spin_terms(b.reduced.stiffness, b.modal_damping, b.spin, r * b.nominal_spin_rad_s) for b in self.bodies]
+        return [spin_terms(*b.modal_matrices[1:], b.spin, r * b.nominal_spin_rad_s) for b in self.bodies]
 
     def __call__(self, mbs, t: float) -> bool:
         if self._steady:

@@ -60,6 +60,8 @@ def add_state_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                                                                outputVariableType=ovt.RotationMatrix,
                                                                storeInternal=True))
         if body.flexible:
+            if getattr(body, "basis", None) is not None:
+                raise ValueError(f"state sensors need {name!r} on its modal coordinates (build with superelements)")
             sensors[f"{name}/modal"] = mbs.AddSensor(SensorNode(nodeNumber=body.modal_node,
                                                                 outputVariableType=ovt.Coordinates, storeInternal=True))
             if not getattr(body, "superelement", True):  # no FFRF object: no mesh-node sensor

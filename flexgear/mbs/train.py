@@ -65,8 +65,8 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
             if not body.flexible:
                 continue
             rel = np.asarray(c.point) - body.position
-            values = modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel, c.normal,
-                                                0.5 * c.half_width, radial_band, order)
+            values = body.to_coordinates(modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel,
+                                                                    c.normal, 0.5 * c.half_width, radial_band, order))
             columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
     return columns
 
