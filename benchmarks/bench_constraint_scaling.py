@@ -2,7 +2,7 @@
 
 Run: nice -n 5 python benchmarks/bench_constraint_scaling.py
 
-The gear meshes' linear kinematics (flexgear.mbs.contacts.MeshConstraint) are one such constraint per
+The gear meshes' linear kinematics (flexgear.mbs.mesh_constraint.MeshConstraint) are one such constraint per
 gear pair: 2 rows (helix halves), marker 1 over the two gears' frame (6 + 6) and modal (m + m)
 coordinates, marker 0 on the node that holds all contacts' deflections (20 coordinates). This
 stand-alone system (10 such blocks on linear springs, 2000 steps) prints Exudyn's ``reactionForces``

@@ -21,7 +21,7 @@ from flexgear.study.agreement import signal_agreement
 
 
 class _Blocks:
-    """Stand-in for flexgear.mbs.contacts.MeshConstraint (two gear pairs, rows 0 and 1) and an Exudyn system."""
+    """Stand-in for flexgear.mbs.mesh_constraint.MeshConstraint (two gear pairs, rows 0 and 1) and an Exudyn system."""
 
     def __init__(self):
         self.blocks = [(7, np.array([0]), np.ix_([0], np.arange(0, 24))),

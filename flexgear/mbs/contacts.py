@@ -31,8 +31,9 @@ from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_se
 from flexgear.geometry.pair import _EZ, helix_halves
 from flexgear.laws.contact import ContactLaw, friction_forces, normal_force, periodic_value
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import Body, zero_user_jacobian
+from flexgear.mbs.bodies import Body
 from flexgear.mbs.elements import _keep_alive
+from flexgear.mbs.mesh_constraint import MeshConstraint, contact_pairs
 from flexgear.spec import Contact, ContactAssumed
 
 __all__ = [
@@ -41,7 +42,6 @@ __all__ = [
     "contact_gradients",
     "MeshFriction",
     "StiffnessSchedule",
-    "MeshConstraint",
     "add_gear_contacts",
 ]
 
@@ -100,63 +100,6 @@ def contact_gradients(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarra
     return np.vstack([n1, a1, spin]), np.vstack([n2, a2, -spin])
 
 
-class MeshConstraint:
-    """The contacts' linear kinematics, delta = G (q - q_ref), as one Exudyn constraint per gear pair.
-
-    ``matrix`` G (n_contacts, n_coordinates) acts on the global coordinate vector (frame coordinates
-    of every body in order, then the modal coordinates of the flexible ones at ``modal_offsets``).
-    Exudyn's ``ObjectConnectorCoordinateVector`` multiplies its scaling matrix by the marker's dense
-    identity Jacobian in every Newton iteration, O(rows cols^2): one constraint over all coordinates
-    of model 7 (20 x 162) took half of the run time. Each gear pair's rows therefore get their own
-    constraint whose marker spans only the two gears' coordinates (an empty ``ObjectGenericODE2``
-    over their nodes). :meth:`set` writes a new G (and offset) into the blocks.
-    """
-
-    def __init__(self, mbs, bodies: list[Body], contacts: list[GearContact], aux_node: int, matrix: np.ndarray,
-                 q_ref: np.ndarray, modal_offsets: dict[str, int]):
-        from exudyn.itemInterface import (
-            MarkerNodeCoordinates,
-            MarkerObjectODE2Coordinates,
-            ObjectConnectorCoordinateVector,
-            ObjectGenericODE2,
-        )
-
-        index = {b.name: i for i, b in enumerate(bodies)}
-        by_name = {b.name: b for b in bodies}
-        aux_marker = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=aux_node))
-        self.q_ref = q_ref
-        self.blocks: list[tuple[int, np.ndarray, tuple]] = []  # (constraint, rows, np.ix_(rows, columns))
-        pairs = list(dict.fromkeys((c.body1, c.body2) for c in contacts))
-        for pair in pairs:
-            rows = np.array([i for i, c in enumerate(contacts) if (c.body1, c.body2) == pair])
-            nodes = [by_name[n].node for n in pair]
-            cols = [np.arange(6 * index[n], 6 * index[n] + 6) for n in pair]
-            for n in pair:
-                if by_name[n].flexible:
-                    nodes += by_name[n].modal_nodes  # q~ in node order (FlexibleBody)
-                    cols.append(np.arange(modal_offsets[n], modal_offsets[n] + by_name[n].reduced.n_modes))
-            cols = np.concatenate(cols)
-            span = mbs.AddObject(ObjectGenericODE2(name=f"mesh_span_{pair[0]}_{pair[1]}", nodeNumbers=nodes,
-                                                   jacobianUserFunction=zero_user_jacobian(len(cols))))
-            block = mbs.AddObject(ObjectConnectorCoordinateVector(
-                name=f"mesh_kinematics_{pair[0]}_{pair[1]}",
-                markerNumbers=[aux_marker, mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
-                scalingMarker0=np.eye(len(contacts))[rows], scalingMarker1=matrix[np.ix_(rows, cols)],
-                offset=matrix[rows] @ q_ref))
-            self.blocks.append((block, rows, np.ix_(rows, cols)))
-
-    def blocks_with_rows(self, rows: np.ndarray) -> list[int]:
-        """Indices of the blocks (gear pairs) that hold any of ``rows``."""
-        return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
-
-    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
-        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
-        for block, rows, sub in self.blocks:
-            mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
-            if offset is not None:
-                mbs.SetObjectParameter(block, "offset", offset[rows])
-
-
 def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp_time: float, drive_speed: float,
                       modal_offsets: dict[str, int] | None = None, n_coordinates: int | None = None,
                       residual_markers: dict[int, int] | None = None
@@ -169,8 +112,8 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     at zero and are filled by flexgear.mbs.contact_kinematics). ``residual_markers``: {contact row: marker of its
     residual deflection coordinate} (flexgear.mbs.residual): the law then acts on delta - e, not on delta.
     Returns the spring-damper of every contact (its ``Force`` output is the normal force), the
-    auxiliary node holding the deflections, the constraint, its (frame) gradient matrix and the
-    :class:`StiffnessSchedule` (a pre-step function; None for constant stiffness).
+    auxiliary nodes holding the deflections (one per gear pair, consecutive), the constraint, its (frame)
+    gradient matrix and the :class:`StiffnessSchedule` (a pre-step function; None for constant stiffness).
     """
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
@@ -187,9 +130,12 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     gradient = np.hstack([_assemble_rows(bodies, contacts, row=0), np.zeros((n_c, extra))])
     # the markers measure reference + displacement coordinates: subtract the reference
     q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies] + [np.zeros(extra)])
-    aux = mbs.AddNode(NodeGenericODE2(name="mesh_deflections", numberOfODE2Coordinates=n_c,
-                                      referenceCoordinates=[0.0] * n_c, initialCoordinates=[0.0] * n_c,
-                                      initialCoordinates_t=[0.0] * n_c))
+    # one deflection node per gear pair, added one after the other: their coordinates are one vector
+    pairs = contact_pairs(contacts)
+    aux = [mbs.AddNode(NodeGenericODE2(name=f"mesh_deflections_{a}_{b}", numberOfODE2Coordinates=len(rows),
+                                       referenceCoordinates=[0.0] * len(rows), initialCoordinates=[0.0] * len(rows),
+                                       initialCoordinates_t=[0.0] * len(rows))) for (a, b), rows in pairs]
+    slot = {int(i): (node, k) for node, (_, rows) in zip(aux, pairs, strict=True) for k, i in enumerate(rows)}
     constraint = MeshConstraint(mbs, bodies, contacts, aux, gradient, q_ref, modal_offsets or {})
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
     springs, laws = [], []
@@ -198,7 +144,8 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     for i, c in enumerate(contacts):
         spring = mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=c.name, markerNumbers=[(residual_markers or {}).get(i, m_ground),
-                                        mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=aux, coordinate=i))]))
+                                        mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=slot[i][0],
+                                                                           coordinate=slot[i][1]))]))
         key = _schedule_key(c)
         if varying and key not in shared:
             shared[key] = (esym.Real(f"mesh_stiffness_factor_{id(mbs)}_{spring}", 1.0), c)
@@ -301,7 +248,7 @@ class MeshFriction:
     ``forceVector`` of the frame-element container: Q = -(A f_slide + B f_spin).
     """
 
-    def __init__(self, mbs, bodies: list[Body], container: int, aux_node: int, contacts: list[GearContact],
+    def __init__(self, mbs, bodies: list[Body], container: int, aux_nodes: list[int], contacts: list[GearContact],
                  ramp_time: float, drive_speed: float, residual: tuple[int, np.ndarray] | None = None):
         self.mbs, self.container, self.contacts = mbs, container, contacts
         self.residual = residual  # (node, contact rows) of the residual deflections e: the law acts on delta - e
@@ -310,7 +257,7 @@ class MeshFriction:
         self.sliding_rows = _assemble_rows(bodies, contacts, row=1)
         self.spin_rows = _assemble_rows(bodies, contacts, row=2)
         self.bodies = bodies
-        self.aux_node = aux_node
+        self.aux_nodes = list(aux_nodes)  # the contacts' deflection nodes, one per gear pair, consecutive
         self.mu = np.array([c.friction_coefficient for c in contacts])
         self.reg = np.array([c.friction_regularisation for c in contacts])
         self.offsets = np.array([c.phase_offset for c in contacts])
@@ -350,6 +297,16 @@ class MeshFriction:
             self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows,
             law.kind == "iso6336")
 
+    def deflection_indices(self, mbs) -> np.ndarray:
+        """System indices of the contacts' deflection coordinates (after ``mbs.Assemble()``): one run over the
+        pairs' consecutive nodes (checked)."""
+        first = mbs.GetNodeODE2Index(self.aux_nodes[0])
+        sizes = [len(mbs.GetNode(n)["referenceCoordinates"]) for n in self.aux_nodes]
+        starts = first + np.cumsum([0, *sizes[:-1]])
+        if [mbs.GetNodeODE2Index(n) for n in self.aux_nodes] != starts.tolist():
+            raise RuntimeError("the contacts' deflection nodes do not hold consecutive system coordinates")
+        return np.arange(first, first + sum(sizes), dtype=np.int64)
+
     def tooth_state(self, mbs) -> tuple[np.ndarray, np.ndarray]:
         """The system's coordinates and velocities (copies) with each contact's deflection coordinate
         reduced by its residual deflection e (flexgear.mbs.residual): the tooth deflection the law sees."""
@@ -358,7 +315,7 @@ class MeshFriction:
             if self._tooth_index is None:  # (deflection, residual) coordinate indices, once (a per-step path)
                 node, rows = self.residual
                 first = mbs.GetNodeODE2Index(node)
-                self._tooth_index = (mbs.GetNodeODE2Index(self.aux_node) + rows, np.arange(first, first + len(rows)))
+                self._tooth_index = (self.deflection_indices(mbs)[rows], np.arange(first, first + len(rows)))
             delta, e = self._tooth_index
             q[delta] -= q[e]
             q_t[delta] -= q_t[e]
@@ -368,7 +325,7 @@ class MeshFriction:
         """Pre-step user function: friction from the state at the start of the step."""
         if self._index is None:
             self._index = (
-                np.arange(mbs.GetNodeODE2Index(self.aux_node), mbs.GetNodeODE2Index(self.aux_node) + len(self.mu)),
+                self.deflection_indices(mbs),
                 np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
                                 for b in self.bodies]),
             )

@@ -56,7 +56,7 @@ class GearboxModel:
     contacts: list[GearContact] = field(default_factory=list)
     friction: MeshFriction | None = None
     kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics for flexible gears
-    aux_node: int = -1  # node of the contacts' deflection coordinates
+    aux_nodes: tuple[int, ...] = ()  # nodes of the contacts' deflection coordinates (one per gear pair, in order)
     input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
     output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
     # gear -> its fixed joints to its shaft (separate bodies): (joint, joint point [m] in the gear's frame)
@@ -319,6 +319,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        train.aux_node, ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
+                        tuple(train.aux_nodes), ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
                         train.residual,
                         linear_joints=tuple(linear_gears))

@@ -55,8 +55,7 @@ class MeshUpdates:
     def bind(self, mbs) -> None:
         """Coordinate indices and the force buffer (after ``mbs.Assemble()``; done by the first call)."""
         f = self.friction
-        aux0 = mbs.GetNodeODE2Index(f.aux_node)
-        self._index = (np.arange(aux0, aux0 + len(f.mu), dtype=np.int64),
+        self._index = (f.deflection_indices(mbs),
                        np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
                                        for b in f.bodies]).astype(np.int64))
         self._force = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")))

@@ -170,8 +170,9 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                 sensors[f"joint_{gear}_{k}_force"] = mbs.AddSensor(SensorObject(
                     objectNumber=joint, outputVariableType=ovt.ForceLocal, storeInternal=True))
     if model.kinematics is not None:
-        sensors["deflections"] = mbs.AddSensor(SensorNode(nodeNumber=model.aux_node,
-                                                          outputVariableType=ovt.Coordinates, storeInternal=True))
+        for k, node in enumerate(model.aux_nodes):  # the contacts' deflections, pair by pair (rows in order)
+            sensors[f"deflections/{k}"] = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates,
+                                                                   storeInternal=True))
         if model.residual is not None:
             sensors["residual"] = mbs.AddSensor(SensorNode(nodeNumber=model.residual_node,
                                                            outputVariableType=ovt.Coordinates, storeInternal=True))

@@ -76,7 +76,8 @@ def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], signals: pd
     over the mean penetration delta of the contacts; ``centrifugal_share_{kind}``: the centrifugal part
     likewise (negative: spin growth deepens the penetration).
     """
-    defl = np.asarray(mbs.GetSensorStoredData(sensors["deflections"]))
+    parts = [np.asarray(mbs.GetSensorStoredData(sensors[k])) for k in sensors if k.startswith("deflections/")]
+    defl = np.hstack([parts[0][:, :1], *(d[:, 1:] for d in parts)])  # time, then every contact's deflection
     total = defl[defl[:, 0] >= window_start, 1:]
     w = signals[signals.time_s >= window_start]
     out = {}

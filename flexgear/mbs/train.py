@@ -23,8 +23,9 @@ import numpy as np
 
 from flexgear.mbs.bodies import Body
 from flexgear.mbs.carrier import Carrier, CarrierKinematics
-from flexgear.mbs.contacts import GearContact, MeshConstraint, MeshFriction, add_gear_contacts
+from flexgear.mbs.contacts import GearContact, MeshFriction, add_gear_contacts
 from flexgear.mbs.elements import add_linear_elements
+from flexgear.mbs.mesh_constraint import MeshConstraint
 
 __all__ = ["GearTrain", "add_gear_train", "modal_columns"]
 
@@ -36,7 +37,7 @@ class GearTrain:
     bodies: dict[str, Body]
     contacts: list[GearContact]
     springs: list[int]  # per contact: spring-damper whose Force output is the normal force [N]
-    aux_node: int  # node of the contacts' deflection coordinates
+    aux_nodes: list[int]  # nodes of the contacts' deflection coordinates, one per gear pair, consecutive
     constraint: MeshConstraint  # the linear mesh kinematics (one Exudyn constraint per gear pair)
     frame_elements: int  # ObjectGenericODE2 of the bushings
     coordinates_marker: int
