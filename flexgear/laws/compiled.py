@@ -129,20 +129,17 @@ def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi
 
 
 @njit(cache=True)
-def turn_columns(buffer, rows, spin, dest, theta):  # pragma: no cover - compiled
-    """Write blockdiag(R_z(spin_j theta), R_z(spin_j theta)) rows[:, j] into buffer[:, dest_j] for every column j.
+def turn_columns(buffer, const, cos_part, sin_part, spin, theta):  # pragma: no cover - compiled
+    """Write const[:, j] + cos(spin_j theta) cos_part[:, j] + sin(spin_j theta) sin_part[:, j] into buffer[:, j]
+    for every column j: coefficients that turn with a spin angle (``theta`` [rad]).
 
-    Compiled twin of flexgear.mbs.joints.TurningBlocks.turned (``rows`` (6, W), ``spin`` (W,), ``theta`` [rad]).
+    Compiled twin of flexgear.mbs.joints.TurningBlocks.turned (arrays (6, W), ``spin`` (W,)).
     """
-    for j in range(rows.shape[1]):
+    for j in range(const.shape[1]):
         c = math.cos(spin[j] * theta)
         s = math.sin(spin[j] * theta)
-        k = dest[j]
-        for r in (0, 3):
-            buffer[r, k] = c * rows[r, j] - s * rows[r + 1, j]
-            buffer[r + 1, k] = s * rows[r, j] + c * rows[r + 1, j]
-        buffer[2, k] = rows[2, j]
-        buffer[5, k] = rows[5, j]
+        for r in range(const.shape[0]):
+            buffer[r, j] = const[r, j] + c * cos_part[r, j] + s * sin_part[r, j]
 
 
 @njit(cache=True)

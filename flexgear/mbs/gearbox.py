@@ -132,10 +132,10 @@ GEARS = ("sun", "planet", "ring")
 """Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
 
 
-def _linear_joints(spec: GearboxSpec, points) -> bool:
-    """Whether a gear's joints to its shaft at ``points`` [m] are linear constraints (flexgear.mbs.joints): as
-    configured, and only when every joint point lies on the axis."""
-    return spec.joints_assumed.joint_equations == "linear" and all(np.hypot(p[0], p[1]) < 1e-9 for p in points)
+def _linear_joints(spec: GearboxSpec) -> bool:
+    """Whether the gears' joints to their shafts are linear constraints (flexgear.mbs.joints), on the axis or off
+    it (bolt patches): ``[joints_assumed] joint_equations``."""
+    return spec.joints_assumed.joint_equations == "linear"
 
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
@@ -162,7 +162,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     markers = support is not None and spec.supports_assumed.seat_equations == "markers"
     points = {support.interface: support_points(support)} if markers else None
     coordinates = []  # interfaces of linear joints and seats: on their own coordinates if so configured
-    if _linear_joints(spec, (joints or {}).values()):
+    if joints and _linear_joints(spec):
         coordinates += list(joints or {})
         joints = {}  # linear joints (flexgear.mbs.joints) need no interface markers
     if support is not None and not markers:
@@ -267,10 +267,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     linear_gears = []  # gears whose joints are linear constraints
     for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
-        if _linear_joints(spec, [p for _, _, p in found]):
+        if _linear_joints(spec):
             from flexgear.mbs.joints import LinearInterfaceJoint
 
-            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label) for a, b, p in found]
+            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""))
+                    for k, (a, b, p) in enumerate(found)]
             linear_gears.append(lead.name)
             turning += [e for j in made for e in j.turning()]
             joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]

@@ -18,8 +18,8 @@ coordinate, flexgear.fe.cms.ReducedBody.interface_motion). A fixed joint makes b
 with R_n. They are one ``ObjectConnectorCoordinateVector`` over the two bodies' coordinates, rewritten
 before each step (:meth:`LinearInterfaceJoint.__call__`), one marker per body; its multipliers lambda
 (``Force`` output) are the joint's force [N] (ground x, y, z) and moment [N m] (ground x, y, z) on the second body.
-The joint point must lie on the axis (x = y = 0: the sun's bore, the ring's bolt-circle RBE3); a joint
-off the axis (the ring on bolt patches) keeps ``ObjectJointGeneric``.
+On the axis (the sun's bore, the ring's bolt-circle RBE3) the frame columns are constant; off the axis (the
+ring's bolts on bolt patches) the lever R_n p of the frame rotations turns as well (:func:`frame_form`).
 
 A bearing at a flexible body's seat (flexgear.geometry.supports: three springs on the axis) acts on the seat
 interface's motion s = (translation at the bearing centre, rotation) in ground, the same first-order
@@ -36,7 +36,8 @@ import numpy as np
 from flexgear.laws.compiled import ramp_state, turn_columns
 from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
 
-__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "interface_rows", "seat_matrices"]
+__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "frame_form", "interface_rows",
+           "seat_matrices", "turning_form"]
 
 
 def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.ndarray:
@@ -48,20 +49,32 @@ def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.nd
     return np.vstack([motion[:3] + np.cross(motion[3:].T, arm).T, motion[3:]])
 
 
+def turning_form(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(C, A, B) with blockdiag(R_z(a), R_z(a)) ``rows`` = C + cos(a) A + sin(a) B: rows (6, w) of ground
+    translation and rotation in the body frame, turned with the spin a."""
+    const, cos_part, sin_part = np.zeros_like(rows), rows.copy(), np.zeros_like(rows)
+    const[[2, 5]], cos_part[[2, 5]] = rows[[2, 5]], 0.0
+    for k in (0, 3):
+        sin_part[k], sin_part[k + 1] = -rows[k + 1], rows[k]
+    return const, cos_part, sin_part
+
+
+def frame_form(point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(C, A, B) (6, 6) of the frame coordinates (u, phi) of a body turned by the spin a: ground translation of
+    its ``point`` p [m] (from the frame origin, reference orientation) and rotation, [I, -(R_z(a) p)~; 0, I] =
+    C + cos(a) A + sin(a) B; constant (C) for a point on the axis."""
+    px, py, pz = (float(v) for v in point)
+    const, cos_part, sin_part = np.eye(6), np.zeros((6, 6)), np.zeros((6, 6))
+    const[0, 4], const[1, 3] = pz, -pz
+    # -(r~) rows (0, r_z, -r_y), (-r_z, 0, r_x), (r_y, -r_x, 0) with r_x = c p_x - s p_y, r_y = s p_x + c p_y
+    cos_part[0, 5], cos_part[1, 5], cos_part[2, 3], cos_part[2, 4] = -py, px, py, -px
+    sin_part[0, 5], sin_part[1, 5], sin_part[2, 3], sin_part[2, 4] = -px, -py, px, py
+    return const, cos_part, sin_part
+
+
 def _frame_rows(local_point: np.ndarray) -> np.ndarray:
     """(6, 6): ground translation at a point on the axis and rotation per frame coordinate (u, phi): [I, -p~; 0, I]."""
-    z = float(local_point[2])
-    out = np.eye(6)
-    out[0, 4], out[1, 3] = z, -z
-    return out
-
-
-def _turned(rows: np.ndarray, c: float, s: float) -> np.ndarray:
-    """blockdiag(R_z, R_z) @ ``rows`` (6, m) for cos, sin of the angle."""
-    out = rows.copy()
-    for k in (0, 3):
-        out[k], out[k + 1] = c * rows[k] - s * rows[k + 1], s * rows[k] + c * rows[k + 1]
-    return out
+    return frame_form(local_point)[0]
 
 
 def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
@@ -78,9 +91,10 @@ def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
 class LinearInterfaceJoint:
     """A fixed joint of ``body`` (interface ``interfaces[0]``) and ``other`` (``interfaces[1]``) at ``point``.
 
-    ``point`` [m, ground frame at the reference] on the z axis; ``spin_per_drive_angle`` the bodies' nominal
-    spin per prescribed drive angle. ``obj`` is the constraint; :meth:`turning` gives its blocks that a
-    :class:`TurningBlocks` pre-step function turns with the spin.
+    ``point`` [m, ground frame at the reference]: on the axis its frame columns are constant; off the axis (a
+    ring's bolt) they turn with the spin as well (:func:`frame_form`). ``spin_per_drive_angle`` the bodies'
+    nominal spin per prescribed drive angle (both turn together). ``obj`` is the constraint; :meth:`turning`
+    gives its blocks that a :class:`TurningBlocks` pre-step function turns with the spin.
     """
 
     def __init__(self, mbs, body: Body, other: Body, interfaces: tuple[str, str], point, spin_per_drive_angle: float,
@@ -92,57 +106,47 @@ class LinearInterfaceJoint:
         )
 
         point = np.asarray(point, float)
-        if np.hypot(point[0], point[1]) > 1e-9:
-            raise ValueError(f"LinearInterfaceJoint {name!r}: the joint point must lie on the z axis, got {point}")
         self.spin = float(spin_per_drive_angle)
-        parts, q_ref, markers = [], [], []
+        forms, q_ref, markers = [], [], []
         for b, itf, sign in ((body, interfaces[0], -1.0), (other, interfaces[1], 1.0)):
             nodes = [b.node]
             local = point - b.position
             q_ref.append(np.concatenate([b.position, np.zeros(3)]))
-            modal = np.zeros((6, 0))
+            parts = [frame_form(local)]
             if b.flexible:  # on the interface's own coordinates when the body has them (FlexibleBody.span)
                 modal_nodes, modal = b.span(interface_rows(b, itf, local))
                 nodes += modal_nodes
                 q_ref.append(np.zeros(modal.shape[1]))
-            parts.append((sign, local, modal))
+                parts.append(turning_form(modal))
+            forms.append(tuple(sign * np.hstack([f[k] for f in parts]) for k in range(3)))
             # one marker per body: Exudyn's constraint costs rows x columns^2 per marker (its dense Jacobian)
+            width = forms[-1][0].shape[1]
             span = mbs.AddObject(ObjectGenericODE2(name=f"{name}_{b.name}_span", nodeNumbers=nodes,
-                                                   jacobianUserFunction=zero_user_jacobian(6 + modal.shape[1])))
+                                                   jacobianUserFunction=zero_user_jacobian(width)))
             markers.append(mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)))
-        self.parts = parts
+        self.forms = forms  # per body (C, A, B), signed: body 2 minus body 1
         self.q_ref = np.concatenate(q_ref)
-        self._split = 6 + parts[0][2].shape[1]  # columns of the first body
+        split = forms[0][0].shape[1]  # columns of the first body
         c = self.matrix_at(0.0)
         # Exudyn's equation: scalingMarker1 q_1 - scalingMarker0 q_0 - offset = 0
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
-            name=name, markerNumbers=markers, scalingMarker0=-c[:, :self._split], scalingMarker1=c[:, self._split:],
+            name=name, markerNumbers=markers, scalingMarker0=-c[:, :split], scalingMarker1=c[:, split:],
             offset=c @ self.q_ref))
-        self._moving = [k for k, (_, _, modal) in enumerate(parts) if modal.shape[1]]  # blocks that turn
 
     def matrix_at(self, phi: float) -> np.ndarray:
         """C (6, columns) at the spin angle ``phi`` [rad]: rows ground translation x, y, z and rotation x, y, z of
         body 2 minus body 1."""
-        return self._matrix(np.cos(phi), np.sin(phi))
-
-    def _matrix(self, c: float, s: float) -> np.ndarray:
-        blocks = []
-        for sign, local, modal in self.parts:
-            blocks.append(sign * _frame_rows(local))
-            if modal.shape[1]:
-                blocks.append(sign * _turned(modal, c, s))
-        return np.hstack(blocks)
+        c, s = np.cos(phi), np.sin(phi)
+        return np.hstack([f[0] + c * f[1] + s * f[2] for f in self.forms])
 
     def turning(self) -> list[tuple]:
-        """The marker blocks whose modal columns turn with the spin (:class:`TurningBlocks` entries): the point
-        on the axis, a rigid body's block and the offset C q_ref are constant, written at construction."""
+        """The markers whose coefficients turn with the spin (:class:`TurningBlocks` entries); the offset C q_ref
+        stays constant (the frames' rotation coordinates are zero at the reference)."""
         out = []
-        for k, param in ((0, "scalingMarker0"), (1, "scalingMarker1")):
-            if k not in self._moving:
-                continue
-            sign, local, modal = self.parts[k]
-            template = np.hstack([_frame_rows(local), np.zeros_like(modal)])  # marker 0 carries -C_a = +rows
-            out.append((self.obj, param, template, np.arange(6, 6 + modal.shape[1]), modal, self.spin))
+        for k, param, sign in ((0, "scalingMarker0", -1.0), (1, "scalingMarker1", 1.0)):
+            const, cos_part, sin_part = (sign * f for f in self.forms[k])
+            if np.any(cos_part) or np.any(sin_part):
+                out.append((self.obj, param, const, cos_part, sin_part, self.spin))
         return out
 
 
@@ -188,40 +192,35 @@ class LinearSeat:
 
     def turning(self) -> list[tuple]:
         """The seat tie's modal block, which turns with the spin (:class:`TurningBlocks` entry)."""
-        return [(self.obj, "scalingMarker1", np.zeros_like(self.rows), np.arange(self.rows.shape[1]), self.rows,
-                 self.spin)]
+        return [(self.obj, "scalingMarker1", *turning_form(self.rows), self.spin)]
 
 
 class TurningBlocks:
-    """Pre-step function: the modal blocks R_n(t) Psi of the linear joints' and seats' constraints (``entries``:
-    their :meth:`turning` lists), phi_n = spin x the prescribed drive angle (STEP ramp ``ramp_time`` [s] to
-    ``drive_speed`` [rad/s]). Every entry's matrix is a slice of one buffer, its turning columns written by one
-    compiled call (flexgear.laws.compiled.turn_columns), then each matrix handed to its constraint."""
+    """Pre-step function: the constraint coefficients of the linear joints and seats that turn with the spin
+    (``entries``: their :meth:`turning` lists, (constraint, parameter, C, A, B, spin per drive angle)), each matrix
+    C + cos(phi_n) A + sin(phi_n) B with phi_n = spin x the prescribed drive angle (STEP ramp ``ramp_time`` [s] to
+    ``drive_speed`` [rad/s]). Every entry's matrix is a slice of one buffer, written by one compiled call
+    (flexgear.laws.compiled.turn_columns), then handed to its constraint."""
 
     def __init__(self, entries: list[tuple], ramp_time: float, drive_speed: float):
         self.ramp_time, self.drive_speed = float(ramp_time), float(drive_speed)
-        self.rows = np.ascontiguousarray(np.hstack([e[4] for e in entries]))  # (6, W)
-        self.spin = np.concatenate([np.full(e[4].shape[1], e[5]) for e in entries])
-        widths = [e[2].shape[1] for e in entries]
-        starts = np.cumsum([0, *widths])
-        self.buffer = np.hstack([e[2] for e in entries]).astype(float)  # the templates side by side
-        self.dest = np.concatenate([a + e[3] for e, a in zip(entries, starts[:-1], strict=True)]).astype(np.int64)
+        self.const, self.cos_part, self.sin_part = (np.ascontiguousarray(np.hstack([e[k] for e in entries]))
+                                                    for k in (2, 3, 4))
+        self.spin = np.concatenate([np.full(e[2].shape[1], e[5]) for e in entries])
+        starts = np.cumsum([0, *(e[2].shape[1] for e in entries)])
+        self.buffer = np.zeros_like(self.const)
         # views of the buffer, which the kernel rewrites in place
-        self.items = [(e[0], e[1], self.buffer[:, a:b])
-                      for e, a, b in zip(entries, starts[:-1], starts[1:], strict=True)]
+        self.items = [(e[0], e[1], self.buffer[:, a:b]) for e, a, b in zip(entries, starts[:-1], starts[1:],
+                                                                           strict=True)]
 
     def turned(self, t: float) -> np.ndarray:
         """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
         phi = self.spin * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0])
-        c, s = np.cos(phi), np.sin(phi)
-        r = self.rows
-        out = r.copy()
-        for k in (0, 3):
-            out[k], out[k + 1] = c * r[k] - s * r[k + 1], s * r[k] + c * r[k + 1]
-        return out
+        return self.const + np.cos(phi) * self.cos_part + np.sin(phi) * self.sin_part
 
     def __call__(self, mbs, t: float) -> bool:
-        turn_columns(self.buffer, self.rows, self.spin, self.dest, self.drive_speed * ramp_state(t, self.ramp_time)[0])
+        turn_columns(self.buffer, self.const, self.cos_part, self.sin_part, self.spin,
+                     self.drive_speed * ramp_state(t, self.ramp_time)[0])
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:
             set_parameter(obj, param, matrix)

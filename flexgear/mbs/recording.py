@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body
 
 if TYPE_CHECKING:
@@ -201,8 +202,17 @@ def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: s
     total = None
     for k, (_, point) in enumerate(model.joints[gear]):
         data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
-        if gear in model.linear_joints:  # on the axis: the moment multiplier about z is the torque
-            total = data[:, 6] if total is None else total + data[:, 6]
+        if gear in model.linear_joints:  # multipliers on the shaft: ground force F and moment M at the point
+            torque = data[:, 6].copy()  # M_z, plus (X x F)_z at the point's place X = R_z(phi_n) p off the axis
+            if np.hypot(point[0], point[1]) > 0.0:
+                lc = model.spec.load_case
+                th = model.theory  # the gear's spin per drive angle
+                ratio = (th.output_speed if gear == "ring" else th.input_speed) / th.input_speed
+                phi = ratio * drive_angle(data[:, 0], lc.ramp_time_s, lc.input_speed_rad_s)
+                x = np.cos(phi) * point[0] - np.sin(phi) * point[1]
+                y = np.sin(phi) * point[0] + np.cos(phi) * point[1]
+                torque += x * data[:, 2] - y * data[:, 1]
+            total = torque if total is None else total + torque
             continue
         torque = data[:, 3].copy()
         if f"joint_{gear}_{k}_force" in sensors:
