@@ -212,7 +212,8 @@ def test_interface_coordinates_are_an_exact_change_of_coordinates(gearbox):
 def test_interface_coordinates_keep_model7_and_shrink_its_constraints():
     """Model 7, short run, on interface coordinates against modal coordinates: the same equations in other
     coordinates, so the signals agree to the Newton tolerance (mean mesh forces 1e-5, 1x amplitudes 1e-3, the
-    gears' load deflections 1e-4); the ring joint's constraint spans six modal columns per body (was 35-47)."""
+    gears' load deflections 1e-4); the ring joint's constraint spans six modal columns per body (was 35-47), the
+    ring's mesh constraints its sensed coordinates only."""
     import exudyn as exu
 
     from flexgear.mbs.gearbox import build_star_gearbox
@@ -221,9 +222,20 @@ def test_interface_coordinates_keep_model7_and_shrink_its_constraints():
     red = v.gearbox.reduction_assumed
     spec = v.gearbox.with_changes(reduction_assumed=dataclasses.replace(red, modal_coordinates="interface"))
     mbs = exu.SystemContainer().AddSystem()
-    build_star_gearbox(mbs, dataclasses.replace(v, gearbox=spec))
+    model = build_star_gearbox(mbs, dataclasses.replace(v, gearbox=spec))
     joint = mbs.GetObject(mbs.GetObjectNumber("joint_ring_output_shaft"))
     assert np.shape(joint["scalingMarker0"]) == (6, 12) and np.shape(joint["scalingMarker1"]) == (6, 12)
+    # the ring's contacts sense one node: at most 2 x (2 x 8 + 1) coordinates (two helix halves, Fourier order 8);
+    # its contact tables vanish on every other coordinate, so the planet-ring constraint spans 4 + 34 columns
+    ring = model.bodies["ring"]
+    sensed = ring.node_columns(ring.contact_nodes)
+    assert len(sensed) <= 2 * (2 * spec.reduction_assumed.contact_fourier_order + 1) < ring.reduced.n_modes
+    kin = model.kinematics
+    tables = kin.tables[[k for k, b in enumerate(kin.bodies) if b == "ring"]]
+    other = np.setdiff1d(np.arange(ring.reduced.n_modes), sensed)
+    assert np.abs(tables[:, :, other]).max() < 1e-8 * np.abs(tables).max()
+    mesh = mbs.GetObject(mbs.GetObjectNumber("mesh_kinematics_planet1_ring"))
+    assert np.shape(mesh["scalingMarker1"]) == (2, model.bodies["planet1"].reduced.n_modes + len(sensed))
     (ref, new), f_mesh = _short_runs("model7", [{"frame": "linear", "joint": "linear", "seat": "linear",
                                                  "coordinates": c} for c in ("modal", "interface")])
     _assert_same_mesh_signals(ref, new, f_mesh, 1e-5, 1e-3)

@@ -31,7 +31,7 @@ import numpy as np
 from flexgear.fe.attachment import LoadCircle, circle_band, fourier_basis, local_directions
 from flexgear.laws.ramps import drive_angle
 
-__all__ = ["ModalColumn", "modal_contact_coefficients", "ContactKinematics", "PreStepChain"]
+__all__ = ["ModalColumn", "modal_contact_coefficients", "modal_contact_fourier", "ContactKinematics", "PreStepChain"]
 
 
 @dataclass(frozen=True)
@@ -46,10 +46,9 @@ class ModalColumn:
     values: np.ndarray  # (n_grid, n_modes) coefficients at alpha_k = 2 pi k / n_grid [m per modal unit]
 
 
-def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.ndarray, normal: np.ndarray,
-                               half_width: float, radial_band: float, order: int, n_grid: int = 720
-                               ) -> np.ndarray:
-    """c_j(alpha) on a grid of n_grid material angles, shape (n_grid, n_modes).
+def modal_contact_fourier(nodes: np.ndarray, modes: np.ndarray, point: np.ndarray, normal: np.ndarray,
+                          half_width: float, radial_band: float, order: int) -> np.ndarray:
+    """Fourier coefficients (2 order + 1, n_modes) of c_j(alpha): c(alpha) = fourier_basis(alpha, order) @ them.
 
     ``nodes`` (n, 3) and ``modes`` (3n, m) in the body frame (gear centre at the origin, z the axis);
     ``point`` the contact point relative to the gear centre at zero spin; ``normal`` the tooth normal;
@@ -67,7 +66,14 @@ def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.n
     phi = modes.reshape(len(nodes), 3, -1)[sel]  # (k, 3, m)
     samples = np.einsum("kd,kdm->km", local_directions(alpha, local), phi)
     b = fourier_basis(alpha, order)
-    coef = np.linalg.solve(b.T @ b, b.T @ samples)  # least squares by the (2N+1)^2 normal equations: fast
+    return np.linalg.solve(b.T @ b, b.T @ samples)  # least squares by the (2N+1)^2 normal equations: fast
+
+
+def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.ndarray, normal: np.ndarray,
+                               half_width: float, radial_band: float, order: int, n_grid: int = 720
+                               ) -> np.ndarray:
+    """c_j(alpha) on a grid of n_grid material angles, shape (n_grid, n_modes) (:func:`modal_contact_fourier`)."""
+    coef = modal_contact_fourier(nodes, modes, point, normal, half_width, radial_band, order)
     return fourier_basis(2 * np.pi * np.arange(n_grid) / n_grid, order) @ coef
 
 

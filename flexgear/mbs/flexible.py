@@ -46,6 +46,13 @@ class FlexibleBody(Body):
     modal_nodes: tuple[int, ...] = ()
     modal_sizes: tuple[int, ...] = ()
     basis: np.ndarray | None = None
+    contact_nodes: tuple[int, ...] = ()  # the nodes of q~ that the gear contacts sense (all, without a basis)
+
+    def node_columns(self, nodes: tuple[int, ...] | list[int]) -> np.ndarray:
+        """Indices in q~ of the coordinates of ``nodes`` (some of ``modal_nodes``), in order."""
+        starts = dict(zip(self.modal_nodes, np.cumsum([0, *self.modal_sizes[:-1]]), strict=True))
+        sizes = dict(zip(self.modal_nodes, self.modal_sizes, strict=True))
+        return np.concatenate([np.arange(starts[n], starts[n] + sizes[n]) for n in nodes])
 
     def to_coordinates(self, rows: np.ndarray) -> np.ndarray:
         """``rows`` (r, m) over the modal coordinates q as rows over the body's coordinates q~ (rows T)."""
@@ -78,24 +85,28 @@ class FlexibleBody(Body):
         return nodes, np.hstack(blocks)
 
 
-def interface_basis(reduced: ReducedBody, names: tuple[str, ...]) -> np.ndarray | None:
+def interface_basis(reduced: ReducedBody, names: tuple[str, ...], sensing: np.ndarray | None = None
+                    ) -> np.ndarray | None:
     """T (m, m) of modal coordinates q = T q~ whose first 6 k coordinates are the RBE3 motions (translation [m],
-    rotation [rad]) of the k interfaces ``names`` (P q, P the stacked ``reduced.interface_motion`` rows).
+    rotation [rad]) of the k interfaces ``names``, then the r coordinates ``sensing`` q (rows (r, m): a gear's
+    contact sensing, flexgear.mbs.train.contact_sensing_rows); P stacks their rows (``reduced.interface_motion``).
 
     Columns: A = P^T (P P^T)^-1 (the least-norm modal combinations of unit interface motions), then an orthonormal
     basis N of P's null space (the interfaces held). P A = I and P N = 0; with M = I the mass matrix in q~ is
-    blockdiag((P P^T)^-1, I) (:func:`interface_mass`), as sparse as before but for one 6 k block. None when P has
-    rank below 6 k or at least m rows (too few modes to carry the interface motions).
+    blockdiag((P P^T)^-1, I) (:func:`interface_mass`), as sparse as before but for one (6 k + r) block. None when P
+    has rank below its row count or at least m rows (too few modes to carry the interface motions).
     """
-    if not names:
+    rows = [reduced.interface_motion(n) for n in names] + ([sensing] if sensing is not None and len(sensing) else [])
+    if not rows:
         return None
-    p = np.vstack([reduced.interface_motion(n) for n in names])
+    p = np.vstack(rows)
     k, m = p.shape
     if k >= m:
         return None
-    _, sv, vt = np.linalg.svd(p)
+    _, sv, vt = np.linalg.svd(p / np.linalg.norm(p, axis=1)[:, None])  # rank of the rows, whatever their units
     if sv[-1] < 1e-8 * sv[0]:
         return None
+    _, _, vt = np.linalg.svd(p)
     return np.hstack([p.T @ np.linalg.inv(p @ p.T), vt[k:].T])
 
 
@@ -138,7 +149,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
                       point_markers: dict[str, list] | None = None, show: bool = True,
                       floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0,
-                      superelement: bool = True, interface_coordinates: tuple[str, ...] = ()) -> FlexibleBody:
+                      superelement: bool = True, interface_coordinates: tuple[str, ...] = (),
+                      sensing_rows: np.ndarray | None = None) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -157,7 +169,9 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     no mesh-node sensors; its zero mass matrix cost ~7 % of model 7's step); ``obj`` is then the frame's rigid body.
     ``interface_coordinates`` (without superelement): interfaces whose RBE3 motions become coordinates of their own
     six-coordinate node (:func:`interface_basis`; the other coordinates on one more node), for constraints on them
-    (flexgear.mbs.joints); ignored when the basis cannot carry them.
+    (flexgear.mbs.joints); ignored when the basis cannot carry them. ``sensing_rows`` (r, m) with them: the gear
+    contacts' sensed coordinates on one more node (``contact_nodes``; flexgear.mbs.train.contact_sensing_rows), so
+    that a mesh constraint spans r columns, not m.
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -182,14 +196,23 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
     if not superelement and (floating_frame == "ffrf" or interface_markers or point_markers):
         raise ValueError(f"{name}: a body without superelement needs floating_frame 'linear' and no markers")
-    basis = None if superelement else interface_basis(reduced, tuple(interface_coordinates))
-    sizes = (m,) if basis is None else (*[6] * len(interface_coordinates), m - 6 * len(interface_coordinates))
-    labels = ("modes",) if basis is None else (*interface_coordinates, "modes")
+    names = tuple(interface_coordinates)
+    sensing = None if sensing_rows is None or not len(sensing_rows) else np.asarray(sensing_rows, float)
+    basis = None if superelement else interface_basis(reduced, names, sensing)
+    if basis is None and not superelement and sensing is not None:  # too few modes for both: the interfaces
+        sensing = None
+        basis = interface_basis(reduced, names)
+    blocks = [(n, 6) for n in names] + ([("contact", len(sensing))] if sensing is not None else [])
+    if basis is None:
+        blocks = []
+    blocks.append(("modes", m - sum(n for _, n in blocks)))
+    labels, sizes = (tuple(x) for x in zip(*blocks, strict=True))
     modal_nodes = tuple(mbs.AddNode(NodeGenericODE2(name=f"{name}_{label}", numberOfODE2Coordinates=n,
                                                     referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
                                                     initialCoordinates_t=[0.0] * n))
                         for label, n in zip(labels, sizes, strict=True))
     modal = modal_nodes[0] if basis is None else -1
+    contact_nodes = tuple(n for n, label in zip(modal_nodes, labels, strict=True) if label == "contact") or modal_nodes
     if not superelement:
         interface_markers = []
     if interface_markers is None:
@@ -240,7 +263,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         matrices = (np.eye(m), np.diag(reduced.stiffness), np.diag(np.broadcast_to(damping, (m,))))
         if basis is not None:
             spin = transformed(spin, basis)
-            matrices = (interface_mass(basis, 6 * len(interface_coordinates)),
+            matrices = (interface_mass(basis, m - sizes[-1]),
                         *(basis.T @ a @ basis for a in matrices[1:]))
         # at rest: flexgear.mbs.spin.SpinSchedule moves the spin terms with the ramp
         equations = add_linear_modal_equations(mbs, name, modal_nodes, matrices, spin, 0.0)
@@ -260,7 +283,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
                         modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s),
                         modal_equations=equations, superelement=superelement, modal_matrices=matrices,
-                        modal_nodes=modal_nodes, modal_sizes=sizes, basis=basis)
+                        modal_nodes=modal_nodes, modal_sizes=sizes, basis=basis, contact_nodes=contact_nodes)
 
 
 

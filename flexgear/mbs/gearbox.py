@@ -142,7 +142,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
                    cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
-                   superelement: bool = True) -> Body:
+                   superelement: bool = True, contacts: list[GearContact] = ()) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
@@ -151,7 +151,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     static compliance the contacts carry (flexgear.mbs.residual); ``dropped``: those per geometry, shared by
     the bodies of one build (the five planets compute them once); ``spin_rad_s``: the nominal spin about the
     body's z axis [rad/s] (the linear floating frame's spin terms, flexgear.mbs.spin); ``superelement``: whether a
-    flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible).
+    flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible);
+    ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node.
     """
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position)
@@ -177,13 +178,20 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
     truncate = cutoff_hz > 0 and geometry in GEARS and not (geometry == "ring" and bolt_patches(spec))
     keep = max(1, full.modes_below(cutoff_hz)) if truncate else full.n_modes
-    body = add_flexible_body(mbs, name, full.truncated(keep) if keep < full.n_modes else full, position,
+    kept = full.truncated(keep) if keep < full.n_modes else full
+    sensing = None
+    if coordinates and geometry in GEARS:
+        from flexgear.mbs.train import contact_sensing_rows
+
+        sensing = contact_sensing_rows(kept, name, position, list(contacts),
+                                       spec.reduction_assumed.contact_fourier_order, spec.gears.normal_module_m)
+    body = add_flexible_body(mbs, name, kept, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=joints or [], point_markers=points,
                              show=False, floating_frame=spec.reduction_assumed.floating_frame,
                              nominal_spin_rad_s=spin_rad_s, superelement=superelement or bool(joints or points)
                              or spec.reduction_assumed.floating_frame == "ffrf",
-                             interface_coordinates=tuple(dict.fromkeys(coordinates)))
+                             interface_coordinates=tuple(dict.fromkeys(coordinates)), sensing_rows=sensing)
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes
@@ -237,6 +245,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
     supports = gearbox_supports(spec)
+    contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     bodies: list[Body] = []
     pairs = []
     ends = {}
@@ -249,7 +258,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
                                   {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin,
-                                  superelement=superelements)
+                                  superelement=superelements, contacts=contacts)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
                                    {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin,
                                    superelement=superelements)
@@ -261,7 +270,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"] if seats else None,
                                      cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed,
-                                     superelement=superelements))
+                                     superelement=superelements, contacts=contacts))
     by_body = {bd.name: bd for bd in bodies}
     joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
     linear_gears = []  # gears whose joints are linear constraints
@@ -293,7 +302,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                 turning += LinearSeat(mbs, by_body[body], supports[key], spin).turning()
                 continue
             add_support(mbs, by_body[body], supports[key])
-    contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     if turning:
         from flexgear.mbs.joints import TurningBlocks
 

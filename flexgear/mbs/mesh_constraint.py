@@ -67,12 +67,13 @@ class MeshConstraint:
             label = f"{pair[0]}_{pair[1]}"
             frames = np.concatenate([np.arange(6 * index[n], 6 * index[n] + 6) for n in pair])
             flexible = [by_name[n] for n in pair if by_name[n].flexible]
-            modal = [np.arange(modal_offsets[b.name], modal_offsets[b.name] + b.reduced.n_modes) for b in flexible]
+            # the modal coordinates the contacts sense (a gear's contact node on interface coordinates, else all)
+            modal = [modal_offsets[b.name] + b.node_columns(b.contact_nodes) for b in flexible]
             g = matrix[rows]
             if modal:
                 modal = np.concatenate(modal)
                 marker0 = span(f"mesh_frames_{label}", [aux, *(by_name[n].node for n in pair)], len(rows) + 12)
-                nodes = [n for b in flexible for n in b.modal_nodes]
+                nodes = [n for b in flexible for n in b.contact_nodes]
                 marker1 = (mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=nodes[0])) if len(nodes) == 1 else
                            span(f"mesh_modes_{label}", nodes, len(modal)))
                 scaling0 = np.hstack([np.eye(len(rows)), -g[:, frames]])

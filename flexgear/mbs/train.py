@@ -27,7 +27,7 @@ from flexgear.mbs.contacts import GearContact, MeshFriction, add_gear_contacts
 from flexgear.mbs.elements import add_linear_elements
 from flexgear.mbs.mesh_constraint import MeshConstraint
 
-__all__ = ["GearTrain", "add_gear_train", "modal_columns"]
+__all__ = ["GearTrain", "add_gear_train", "contact_sensing_rows", "modal_columns"]
 
 
 @dataclass
@@ -70,6 +70,24 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
                                                                     c.normal, 0.5 * c.half_width, radial_band, order))
             columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
     return columns
+
+
+def contact_sensing_rows(reduced, name: str, position: np.ndarray, contacts: list[GearContact], order: int,
+                         radial_band: float) -> np.ndarray:
+    """Orthonormal rows (r, m) spanning the Fourier coefficients (flexgear.mbs.contact_kinematics.
+    modal_contact_fourier) of every contact of body ``name`` (a flexgear.fe.cms.ReducedBody at ``position``
+    [m]): each contact's deflection c(alpha) . q is then a combination of these r sensed coordinates only
+    (flexgear.mbs.flexible.interface_basis). r <= 2 (2 order + 1) per distinct band and normal (the planets'
+    contacts on a ring are turned copies). Singular values below 1e-9 of the largest are round-off."""
+    from flexgear.mbs.contact_kinematics import modal_contact_fourier
+
+    coefs = [modal_contact_fourier(reduced.nodes, reduced.modes, np.asarray(c.point) - position, c.normal,
+                                   0.5 * c.half_width, radial_band, order)
+             for c in contacts if name in (c.body1, c.body2)]
+    if not coefs:
+        return np.zeros((0, reduced.n_modes))
+    _, sv, vt = np.linalg.svd(np.vstack(coefs), full_matrices=False)
+    return vt[:int(np.count_nonzero(sv > 1e-9 * sv[0]))]
 
 
 def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearContact], ramp_time: float,
