@@ -53,26 +53,31 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
     return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)
 
 
-def matrix_container(a: np.ndarray):
-    """A dense (n, n) array as Exudyn's sparse ``MatrixContainer`` (its zeros dropped)."""
+def matrix_container(a: np.ndarray, dense: bool = False):
+    """An (n, n) array as Exudyn's ``MatrixContainer``: sparse triplets (its zeros dropped) or, ``dense``, a dense
+    matrix (for a filled block: Exudyn's triplet product then costs several times the dense one)."""
     import exudyn as exu
 
     mc = exu.MatrixContainer()
-    mc.SetWithDenseMatrix(np.asarray(a, float), useDenseMatrix=False)
+    mc.SetWithDenseMatrix(np.asarray(a, float), useDenseMatrix=bool(dense))
     return mc
 
 
-def zero_user_jacobian(n: int):
+def zero_user_jacobian(n: int, dense: bool = False):
     """A ``jacobianUserFunction`` for an ``ObjectGenericODE2`` of ``n`` coordinates without user forces.
 
     Exudyn differentiates an ``ObjectGenericODE2`` numerically (n evaluations of its equations per
     Jacobian) unless it has this function; its constant stiffness and damping matrices (sparse) are then
-    added to the Jacobian exactly. Returns the function (it returns an all-zero sparse matrix).
+    added to the Jacobian exactly. Returns the function (it returns an all-zero matrix, ``dense`` as the
+    object's matrices: Exudyn requires the same format).
     """
     import exudyn as exu
 
     zero = exu.MatrixContainer()
-    zero.SetWithSparseMatrixCSR(n, n, np.zeros((0, 3)), useDenseMatrix=False)
+    if dense:
+        zero.SetWithDenseMatrix(np.zeros((n, n)), useDenseMatrix=True)
+    else:
+        zero.SetWithSparseMatrixCSR(n, n, np.zeros((0, 3)), useDenseMatrix=False)
 
     def jacobian(mbs, t, item, q, q_t, f_ode2, f_ode2_t):  # noqa: ARG001 (Exudyn's signature)
         return zero

@@ -67,6 +67,13 @@ def spin_terms(stiffness: np.ndarray, damping: np.ndarray, spin: SpinMatrices, s
     return stiffness - w * w * spin.softening, damping + 2.0 * w * spin.gyroscopic
 
 
+def dense_modal_matrices(matrices: tuple, spin: SpinMatrices) -> bool:
+    """Whether a body's K(Omega) and D(Omega) (:func:`spin_terms`) fill more than half of their entries: Exudyn then
+    gets them as dense matrices (the same format for the whole run, :class:`SpinSchedule`)."""
+    k, d = spin_terms(*matrices[1:], spin, 1.0)
+    return bool(np.count_nonzero(k) + np.count_nonzero(d) > k.size)
+
+
 def add_linear_modal_equations(mbs, name: str, modal_nodes: tuple[int, ...], matrices: tuple, spin: SpinMatrices,
                                spin_rad_s: float) -> int:
     """The modal equations as one ``ObjectGenericODE2`` on ``modal_nodes``: ``matrices`` (M, K, D) at rest (M = I,
@@ -76,10 +83,12 @@ def add_linear_modal_equations(mbs, name: str, modal_nodes: tuple[int, ...], mat
 
     mass, stiffness, damping = matrices
     k, d = spin_terms(stiffness, damping, spin, spin_rad_s)
+    dense = dense_modal_matrices(matrices, spin)
     return mbs.AddObject(ObjectGenericODE2(name=f"{name}_modal_equations", nodeNumbers=list(modal_nodes),
                                            massMatrix=matrix_container(mass),
-                                           stiffnessMatrix=matrix_container(k), dampingMatrix=matrix_container(d),
-                                           jacobianUserFunction=zero_user_jacobian(len(mass))))
+                                           stiffnessMatrix=matrix_container(k, dense),
+                                           dampingMatrix=matrix_container(d, dense),
+                                           jacobianUserFunction=zero_user_jacobian(len(mass), dense)))
 
 
 class SpinSchedule:
@@ -105,6 +114,7 @@ class SpinSchedule:
         self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=nodes,
                                                    forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
         self.cent = np.concatenate([b.nominal_spin_rad_s ** 2 * b.spin.centrifugal for b in bodies])  # Omega_n^2 c
+        self._dense = [dense_modal_matrices(b.modal_matrices, b.spin) for b in bodies]  # each body's format
         self._next = 0.0  # time of the next matrix update
         self._steady = False
 
@@ -123,9 +133,9 @@ class SpinSchedule:
         mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
         last = t >= self.ramp_time
         if t >= self._next or last:
-            for b, (k, d) in zip(self.bodies, self.matrices(t), strict=True):
-                mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", matrix_container(k))
-                mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", matrix_container(d))
+            for b, (k, d), dense in zip(self.bodies, self.matrices(t), self._dense, strict=True):
+                mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", matrix_container(k, dense))
+                mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", matrix_container(d, dense))
             self._next = t + self.interval
         self._steady = last
         return True
