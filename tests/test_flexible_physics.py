@@ -29,7 +29,10 @@ T_END, WINDOW = 0.06, 0.03
 
 
 def _run(name: str, step: float = 1e-5):
-    v = load_variant(VARIANTS / f"{name}.toml")
+    return _run_spec(load_variant(VARIANTS / f"{name}.toml"), step)
+
+
+def _run_spec(v, step: float = 1e-5):
     gb = v.gearbox
     gb = gb.with_changes(contact=dataclasses.replace(gb.contact, law="iso6336"),
                          load_case=dataclasses.replace(gb.load_case, ramp_time_s=0.02, end_time_s=T_END,
@@ -64,38 +67,64 @@ def test_flexible_sun_and_ring_change_the_inner_ripple(runs):
     assert abs(change) > 10.0 * step, r
 
 
-@pytest.mark.slow
-def test_load_deflection_equals_static_compliance_times_mesh_forces(runs):
+def _measured_and_predicted(gb, result, gear: str, kind: str) -> tuple[np.ndarray, np.ndarray]:
+    """Per mesh (5,), averaged over 13 times of the window: the load-induced deflection the run reports and
+    static_compliance (the gear held as the multibody model holds it: the sun at its bore, the ring at each of its
+    joints to the output shaft, the bolt circle or every bolt patch; the contact kernel's loads) times the mesh
+    forces split equally over the helix halves."""
     from flexgear.fe.compliance import static_compliance
-    from flexgear.fe.reduced import component_load_circles, component_reduced_body, gear_seat
+    from flexgear.fe.reduced import component_load_circles, component_reduced_body
+    from flexgear.mbs.deflection import held_interfaces
     from flexgear.mbs.gearbox import mesh_contacts
 
-    gb, result = runs["model4", 1e-5]
-    contacts = mesh_contacts(gb)
     s = result.signals
-    times = np.linspace(WINDOW, T_END, 13)
-    rows = [int(np.argmin(np.abs(s.time_s.to_numpy() - t))) for t in times]
+    rows = [int(np.argmin(np.abs(s.time_s.to_numpy() - t))) for t in np.linspace(WINDOW, T_END, 13)]
     lc = gb.load_case
+    red = component_reduced_body(gb, gear, "coarse")
+    circles = component_load_circles(gb, gear, gb.reduction_assumed.contact_fourier_order)
+    mine = [c for c in mesh_contacts(gb) if c.name.startswith(kind)]
+    predicted, measured = [], []
+    for row in rows:
+        t = float(s.time_s.iloc[row])
+        spin = mine[0].spin_per_drive_angle[0 if gear == "sun" else 1]
+        ang = spin * float(drive_angle(t, lc.ramp_time_s, lc.input_speed_rad_s))
+        rot = np.array([[np.cos(ang), np.sin(ang), 0.0], [-np.sin(ang), np.cos(ang), 0.0], [0.0, 0.0, 1.0]])
+        points = np.array([rot @ np.asarray(c.point) for c in mine])
+        normals = np.array([rot @ np.asarray(c.normal) for c in mine])
+        comp = static_compliance(red, points, normals, held_interfaces(gb, gear), kernel=circles)
+        forces = np.repeat([s[f"{kind}_mesh_force_{i}_n"].iloc[row] for i in range(1, 6)], 2) / 2.0
+        predicted.append((comp @ forces).reshape(5, 2).mean(1))
+        measured.append([s[f"{kind}_deflection_load_{i}_m"].iloc[row] for i in range(1, 6)])
+    return np.mean(measured, 0), np.mean(predicted, 0)
+
+
+@pytest.mark.slow
+def test_load_deflection_equals_static_compliance_times_mesh_forces(runs):
+    gb, result = runs["model4", 1e-5]
     for gear, kind in (("sun", "outer"), ("ring", "inner")):
-        red = component_reduced_body(gb, gear, "coarse")
-        circles = component_load_circles(gb, gear, gb.reduction_assumed.contact_fourier_order)
-        mine = [c for c in contacts if c.name.startswith(kind)]
-        predicted, measured = [], []
-        for row in rows:
-            t = float(s.time_s.iloc[row])
-            c = mine[0]
-            spin = c.spin_per_drive_angle[0 if gear == "sun" else 1]
-            ang = spin * float(drive_angle(t, lc.ramp_time_s, lc.input_speed_rad_s))
-            rot = np.array([[np.cos(ang), np.sin(ang), 0.0], [-np.sin(ang), np.cos(ang), 0.0], [0.0, 0.0, 1.0]])
-            points = np.array([rot @ np.asarray(c.point) for c in mine])
-            normals = np.array([rot @ np.asarray(c.normal) for c in mine])
-            comp = static_compliance(red, points, normals, gear_seat(gb, red, gear), kernel=circles)
-            # helix-half forces: the mesh force split by the halves' shares (equal halves)
-            forces = np.repeat([s[f"{kind}_mesh_force_{i}_n"].iloc[row] for i in range(1, 6)], 2) / 2.0
-            per_contact = comp @ forces
-            predicted.append(per_contact.reshape(5, 2).mean(1))
-            measured.append([s[f"{kind}_deflection_load_{i}_m"].iloc[row] for i in range(1, 6)])
-        predicted, measured = np.mean(predicted, 0), np.mean(measured, 0)
+        measured, predicted = _measured_and_predicted(gb, result, gear, kind)
         assert measured.mean() == pytest.approx(predicted.mean(), rel=0.10), (gear, measured, predicted)
         if gear == "sun":
             np.testing.assert_allclose(measured, predicted, rtol=0.10)
+
+
+@pytest.mark.heavy
+def test_bolt_patched_ring_deflects_by_its_static_compliance():
+    """Model 4 with the ring on bolt patches (each patch held by the output shaft), two load torques (Table 5's
+    and 50 N m): the ring's load deflection grows with the mesh forces by static_compliance with every patch held
+    (within 5 %; measured 1.001). Its absolute value does not (measured 1.05 um against 0.77 um at Table 5's
+    torque, 0.36 against 0.07 um at 50 N m): a load-free 0.28 um that Exudyn's FFRF bodies with generic joints
+    show as well, which the static centrifugal split (flexgear.mbs.deflection.centrifugal_response, patches held)
+    does not account for; the reason the bolt patches are not yet the default. About 2 min."""
+    v = load_variant(VARIANTS / "model4.toml")
+    joints = dataclasses.replace(v.gearbox.joints_assumed, ring_output_shaft="bolt_patches")
+    pairs = []
+    for torque in (None, 50.0):
+        gb = v.gearbox.with_changes(joints_assumed=joints)
+        if torque is not None:
+            gb = gb.with_changes(load_case=dataclasses.replace(gb.load_case, load_torque_nm=torque))
+        gb, result = _run_spec(dataclasses.replace(v, gearbox=gb))
+        pairs.append(_measured_and_predicted(gb, result, "ring", "inner"))
+    (m_full, p_full), (m_low, p_low) = pairs
+    slope = (m_full.mean() - m_low.mean()) / (p_full.mean() - p_low.mean())
+    assert slope == pytest.approx(1.0, rel=0.05), pairs

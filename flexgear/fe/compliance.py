@@ -88,16 +88,18 @@ def _held(model: FEModel | ReducedBody, held: Interface | str) -> Interface:
     return interface(model, held)
 
 
-def static_compliance(model: FEModel | ReducedBody, points, directions, held: Interface | str,
+def static_compliance(model: FEModel | ReducedBody, points, directions,
+                      held: Interface | str | Sequence[Interface | str],
                       spread_radius_m: float | None = None, *,
                       kernel: LoadCircle | Sequence[LoadCircle] | None = None) -> np.ndarray:
     """Compliance matrix (p, p) [m/N] of ``model`` for unit forces at ``points`` along ``directions``.
 
     ``model``: a full FE model (flexgear.fe.fem.FEModel) or a reduced body (flexgear.fe.cms.ReducedBody) of
     the same mesh; ``held``: the interface (or its name: a reduced body's interface, a full model's
-    named boundary region) whose RBE3 motion is held; ``spread_radius_m`` [m]: each force is spread
-    area-weighted over the surface nodes within it (default: the nearest surface node); ``kernel``:
-    load circles whose contact-kernel loads replace the spread forces (see the module docstring).
+    named boundary region) whose RBE3 motion is held, or several (a ring's bolt patches, each held);
+    ``spread_radius_m`` [m]: each force is spread area-weighted over the surface nodes within it (default: the
+    nearest surface node); ``kernel``: load circles whose contact-kernel loads replace the spread forces (see the
+    module docstring).
     """
     nodes = model.nodes
     if kernel is not None:
@@ -105,17 +107,32 @@ def static_compliance(model: FEModel | ReducedBody, points, directions, held: In
         f = _kernel_loads(nodes, circles, points, directions)
     else:
         f = point_loads(nodes, model.surface_triangles, points, directions, spread_radius_m)
-    itf = _held(model, held)
+    parts = [held] if isinstance(held, (Interface, str)) else list(held)
+    itfs = [_held(model, h) for h in parts]
     if isinstance(model, ReducedBody):
-        rows = rbe3_weights(nodes, itf)  # (k, 6, 3)
-        phi = model.modes.reshape(len(nodes), 3, -1)[itf.nodes]
-        rig = rigid_body_modes(nodes).reshape(len(nodes), 3, 6)[itf.nodes]
-        c_phi, c_r = np.einsum("idc,icm->dm", rows, phi), np.einsum("idc,icm->dm", rows, rig)
-        ft_phi = f.T @ model.modes - (f.T @ rigid_body_modes(nodes)) @ np.linalg.solve(c_r, c_phi)
-        return (ft_phi / model.stiffness) @ ft_phi.T
+        # u = Phi q + R r; each held interface i: C_i (Phi q + R r) = 0. The first eliminates the rigid motion r,
+        # the others constrain q (D q = 0): C = G (L - L D^T (D L D^T)^-1 D L) G^T with L = Lambda^-1
+        c_phi, c_r = [], []
+        rig_all = rigid_body_modes(nodes)
+        for itf in itfs:
+            rows = rbe3_weights(nodes, itf)  # (k, 6, 3)
+            phi = model.modes.reshape(len(nodes), 3, -1)[itf.nodes]
+            rig = rig_all.reshape(len(nodes), 3, 6)[itf.nodes]
+            c_phi.append(np.einsum("idc,icm->dm", rows, phi))
+            c_r.append(np.einsum("idc,icm->dm", rows, rig))
+        elim = np.linalg.solve(c_r[0], c_phi[0])  # r = -elim q
+        g = f.T @ model.modes - (f.T @ rig_all) @ elim
+        flex = 1.0 / model.stiffness
+        out = (g * flex) @ g.T
+        if len(itfs) > 1:
+            d = np.vstack([cp - cr @ elim for cp, cr in zip(c_phi[1:], c_r[1:], strict=True)])
+            gd = (g * flex) @ d.T
+            out -= gd @ np.linalg.solve((d * flex) @ d.T, gd.T)
+        return 0.5 * (out + out.T)
     if not isinstance(model, FEModel):
         raise TypeError(f"static_compliance: model must be an FEModel or a ReducedBody, got {type(model).__name__}")
-    con = free_body_solver(model).constrained(sp.csr_matrix(_rbe3_rows(model, itf)))
-    u = con.solve(f, np.zeros((6, f.shape[1])))
+    rows = sp.vstack([sp.csr_matrix(_rbe3_rows(model, itf)) for itf in itfs]).tocsr()
+    con = free_body_solver(model).constrained(rows)
+    u = con.solve(f, np.zeros((rows.shape[0], f.shape[1])))
     c = f.T @ u
     return 0.5 * (c + c.T)
