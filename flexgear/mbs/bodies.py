@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
-__all__ = ["Body", "add_rigid_body", "matrix_container", "zero_user_jacobian"]
+__all__ = ["Body", "add_rigid_body", "frame_rows", "matrix_container", "zero_user_jacobian"]
 
 
 @dataclass(frozen=True)
@@ -51,6 +51,15 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)
+
+
+def frame_rows(point: np.ndarray) -> np.ndarray:
+    """(6, 6): translation at ``point`` [m] and rotation of a body per frame translation and small rotation
+    (u, phi), [I, -p~; 0, I] (u + phi x p, phi)."""
+    x, y, z = (float(v) for v in point)
+    out = np.eye(6)
+    out[:3, 3:] = -np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
+    return out
 
 
 def matrix_container(a: np.ndarray, dense: bool = False):

@@ -29,6 +29,7 @@ import numpy as np
 from flexgear.fe.reduced import gear_seat, gear_shaft_joints
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.laws.ramps import drive_angle
+from flexgear.mbs.bodies import frame_rows
 from flexgear.spec import COMPONENT_GEOMETRY
 
 __all__ = ["transmission_error", "centrifugal_modal_load", "centrifugal_response", "held_interfaces",
@@ -51,12 +52,29 @@ def centrifugal_modal_load(reduced) -> np.ndarray:
     return inv[2, 2::3].copy()
 
 
-def centrifugal_response(reduced, held: np.ndarray) -> np.ndarray:
-    """q_c per (rad/s)^2 (m,): K_r q = Q_c - G^T mu with G q = 0 (``held`` G (r, m), the held interfaces' motions)."""
-    flex = 1.0 / reduced.stiffness
-    free = centrifugal_modal_load(reduced) * flex
-    mu = np.linalg.lstsq((held * flex) @ held.T, held @ free, rcond=None)[0]
-    return free - flex * (held.T @ mu)
+def centrifugal_response(reduced, held: list[str]) -> np.ndarray:
+    """q_c per (rad/s)^2 (m,): the static response to spinning with the interfaces ``held`` following one common
+    rigid motion r (as their joints to a shaft hold them), free of the mean-axis frame:
+
+        Lambda q = Q_c - P^T mu,   P q + R r = 0,   R^T mu = 0
+
+    (P the interfaces' RBE3 motions per mode, ``reduced.interface_motion``; R = [I, -p~; 0, I] their motions per
+    frame translation and rotation at their points p). One interface: the free-free deformation (a
+    self-equilibrated load on a statically determinate hold). Several (a ring's twelve bolt patches): they may
+    shift and turn together against the mean axes; holding each at zero (r = 0) missed a load-free 0.28 um of the
+    bolt-patched ring's deflection at the meshes, which the multibody model (FFRF or linear) shows.
+    """
+    p = np.vstack([reduced.interface_motion(n) for n in held])
+    r = np.vstack([frame_rows(reduced.interface(n).point) for n in held])
+    m, k = reduced.n_modes, p.shape[0]
+    a = np.zeros((m + 6 + k, m + 6 + k))
+    a[:m, :m] = np.diag(reduced.stiffness)
+    a[:m, m + 6:] = p.T
+    a[m:m + 6, m + 6:] = r.T
+    a[m + 6:, :m] = p
+    a[m + 6:, m:m + 6] = r
+    rhs = np.concatenate([centrifugal_modal_load(reduced), np.zeros(6 + k)])
+    return np.linalg.solve(a, rhs)[:m]
 
 
 def held_interfaces(spec, geometry: str) -> list[str]:
@@ -99,7 +117,7 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
                 joints = held_interfaces(model.spec, geometry)
                 dropped = getattr(body, "dropped", None)  # truncated: the whole basis' answer (flexgear.mbs.residual)
                 q_c_unit = (dropped.centrifugal_held[:red.n_modes] if dropped is not None else
-                            centrifugal_response(red, np.vstack([red.interface_motion(n) for n in joints])))
+                            centrifugal_response(red, joints))
                 seat = gear_seat(model.spec, red, geometry)
                 # in the body's coordinates q~, as the contact tables and the recorded coordinates
                 offsets[body_name] = (body.to_coordinates(red.interface_motion(seat)), seat.point,

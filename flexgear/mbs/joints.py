@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexgear.laws.compiled import ramp_state, turn_columns
-from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
+from flexgear.mbs.bodies import Body, frame_rows, matrix_container, zero_user_jacobian
 
 __all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "frame_form", "interface_rows",
            "seat_matrices", "turning_form"]
@@ -72,18 +72,13 @@ def frame_form(point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return const, cos_part, sin_part
 
 
-def _frame_rows(local_point: np.ndarray) -> np.ndarray:
-    """(6, 6): ground translation at a point on the axis and rotation per frame coordinate (u, phi): [I, -p~; 0, I]."""
-    return frame_form(local_point)[0]
-
-
 def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
     """The bearing's (flexgear.geometry.supports.Support) stiffness and damping on its centre's ground translation
     and rotation (6, 6): sum over its springs at z_k of B_k^T diag(k) B_k, B_k = [I, d_k (e_y, -e_x, 0) columns],
     d_k = z_k - centre_z; damping = damping_per_stiffness x stiffness."""
     k6 = np.zeros((6, 6))
     for z, stiffness in support.spring_points():
-        b = _frame_rows(np.array([0.0, 0.0, z - support.centre_z]))[:3]
+        b = frame_rows(np.array([0.0, 0.0, z - support.centre_z]))[:3]
         k6 += b.T @ np.diag(stiffness) @ b
     return k6, support.damping_per_stiffness * k6
 
@@ -168,7 +163,7 @@ class LinearSeat:
         self.spin = float(spin_per_drive_angle)
         centre = np.array([0.0, 0.0, support.centre_z])
         modal_nodes, self.rows = body.span(interface_rows(body, support.interface, centre))
-        frame = _frame_rows(centre)
+        frame = frame_rows(centre)
         self.node = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_seat", numberOfODE2Coordinates=6,
                                                 referenceCoordinates=[0.0] * 6, initialCoordinates=[0.0] * 6,
                                                 initialCoordinates_t=[0.0] * 6))

@@ -64,7 +64,7 @@ def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
 
     seat = gear_seat(spec, full, geometry)
     held = held_interfaces(spec, geometry)
-    whole = centrifugal_response(full, np.vstack([full.interface_motion(n) for n in held]))
+    whole = centrifugal_response(full, held)
     free = centrifugal_modal_load(full) / full.stiffness
     free[:keep] = 0.0
     return DroppedModes(full.modes, full.stiffness, keep, full.interface_motion(seat), np.asarray(seat.point, float),
