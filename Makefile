@@ -19,7 +19,7 @@ RESULTS ?= results
 .PHONY: quick install venv test test-heavy lint meshes matrix report lpm bench clean distclean
 
 quick: install
-	$(PY) -m flexgear.cli meshes --level coarse
+	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
 	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width

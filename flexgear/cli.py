@@ -114,19 +114,25 @@ def _args_lpm(p: argparse.ArgumentParser) -> None:
                    help="results folder; the run goes to OUT/lumped/ (default: %(default)s)")
 
 
-def cmd_lpm(a: argparse.Namespace) -> int:
+def _gearbox_or_variant(path: str):
+    """The gearbox of a gearbox file, or of a variant file (its gearbox with its overrides)."""
     import tomllib
 
-    from flexgear.lumped.run import run_lumped
-    from flexgear.results import save_result
     from flexgear.spec import SpecError, load_gearbox, load_variant
 
     try:
-        with open(a.gearbox, "rb") as fh:  # a gearbox file, or a variant file (its gearbox with its overrides)
+        with open(path, "rb") as fh:
             is_variant = "components" in tomllib.load(fh)
     except (OSError, tomllib.TOMLDecodeError) as exc:
-        raise SpecError(a.gearbox, "<file>", f"cannot be read as TOML ({exc.__class__.__name__})") from None
-    spec = load_variant(a.gearbox).gearbox if is_variant else load_gearbox(a.gearbox)
+        raise SpecError(path, "<file>", f"cannot be read as TOML ({exc.__class__.__name__})") from None
+    return load_variant(path).gearbox if is_variant else load_gearbox(path)
+
+
+def cmd_lpm(a: argparse.Namespace) -> int:
+    from flexgear.lumped.run import run_lumped
+    from flexgear.results import save_result
+
+    spec = _gearbox_or_variant(a.gearbox)
     result = run_lumped(spec, t_end_s=a.t_end, progress=True)
     out = save_result(result, Path(a.out) / "lumped", inputs={Path(spec.source).name: Path(spec.source).read_bytes()})
     print(f"lumped: {result.meta['status']} in {result.meta.get('wall_time_s', 0):.2f} s -> {out}")
@@ -226,7 +232,7 @@ def cmd_animate(a: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- meshes
 def _args_meshes(p: argparse.ArgumentParser) -> None:
     p.add_argument("gearbox", nargs="?", default="model_variants/gearbox.toml",
-                   help="gearbox file (default: %(default)s)")
+                   help="gearbox file, or a variant file (its gearbox with its overrides) (default: %(default)s)")
     p.add_argument("--level", default="coarse", help="mesh level of gearbox.toml [meshing_assumed] (default: coarse)")
     p.add_argument("--no-reduce", action="store_true", help="meshes only, no reduced flexible bodies")
     p.add_argument("--workers", type=int, default=2, metavar="N",
@@ -235,9 +241,9 @@ def _args_meshes(p: argparse.ArgumentParser) -> None:
 
 def cmd_meshes(a: argparse.Namespace) -> int:
     from flexgear.fe.build import build_components
-    from flexgear.spec import GEOMETRY_COMPONENTS, SpecError, load_gearbox
+    from flexgear.spec import GEOMETRY_COMPONENTS, SpecError
 
-    spec = load_gearbox(a.gearbox)
+    spec = _gearbox_or_variant(a.gearbox)
     if a.level not in spec.meshing_assumed:
         raise SpecError(a.gearbox, "meshing_assumed", f"has no level {a.level!r}; levels: "
                         f"{', '.join(sorted(spec.meshing_assumed))}")
