@@ -6,20 +6,16 @@ delta = G (q - q_ref): each contact's deflection coordinate (``aux``) tied to th
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from flexgear.mbs.bodies import Body, zero_user_jacobian
 
-if TYPE_CHECKING:
-    from flexgear.mbs.contacts import GearContact
-
 __all__ = ["MeshConstraint", "contact_pairs"]
 
 
-def contact_pairs(contacts: list[GearContact]) -> list[tuple[tuple[str, str], np.ndarray]]:
-    """The gear pairs in order of first appearance with their contact rows; each pair's rows must be one
+def contact_pairs(contacts: list) -> list[tuple[tuple[str, str], np.ndarray]]:
+    """The gear pairs (``body1``, ``body2`` of each flexgear.mbs.contacts.GearContact) in order of first appearance
+    with their contact rows; each pair's rows must be one
     ascending run, pair after pair (their deflection coordinates are then consecutive nodes, as one vector)."""
     pairs = list(dict.fromkeys((c.body1, c.body2) for c in contacts))
     out = [(pair, np.array([i for i, c in enumerate(contacts) if (c.body1, c.body2) == pair])) for pair in pairs]
@@ -44,7 +40,7 @@ class MeshConstraint:
     np.ix_(rows, columns of marker 1)); :meth:`set` writes a new G (and offset) into them.
     """
 
-    def __init__(self, mbs, bodies: list[Body], contacts: list[GearContact], aux_nodes: list[int],
+    def __init__(self, mbs, bodies: list[Body], contacts: list, aux_nodes: list[int],
                  matrix: np.ndarray, q_ref: np.ndarray, modal_offsets: dict[str, int]):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
