@@ -62,10 +62,6 @@ class FlexibleBody(Body):
         """q~ of modal coordinates ``q`` (m,) (T^-1 q)."""
         return q if self.basis is None else np.linalg.solve(self.basis, q)
 
-    def modes_of(self, coordinates: np.ndarray) -> np.ndarray:
-        """Modal coordinates q (..., m) of the body's coordinates q~ (..., m) (q = T q~, row by row)."""
-        return coordinates if self.basis is None else coordinates @ self.basis.T
-
     def span(self, rows: np.ndarray) -> tuple[list[int], np.ndarray]:
         """``rows`` (r, m) over q as rows over the body's coordinates, kept only on the nodes they touch: (nodes,
         rows over those nodes' coordinates). An interface's rows then span its own six coordinates: a constraint on
@@ -103,10 +99,10 @@ def interface_basis(reduced: ReducedBody, names: tuple[str, ...], sensing: np.nd
     k, m = p.shape
     if k >= m:
         return None
-    _, sv, vt = np.linalg.svd(p / np.linalg.norm(p, axis=1)[:, None])  # rank of the rows, whatever their units
+    # rank of the rows whatever their units; scaling rows keeps the null space, the last m - k right vectors
+    _, sv, vt = np.linalg.svd(p / np.linalg.norm(p, axis=1)[:, None])
     if sv[-1] < 1e-8 * sv[0]:
         return None
-    _, _, vt = np.linalg.svd(p)
     return np.hstack([p.T @ np.linalg.inv(p @ p.T), vt[k:].T])
 
 

@@ -180,7 +180,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     keep = max(1, full.modes_below(cutoff_hz)) if truncate else full.n_modes
     kept = full.truncated(keep) if keep < full.n_modes else full
     sensing = None
-    if coordinates and geometry in GEARS:
+    if coordinates and geometry in GEARS and kept.n_modes > 6 * len(coordinates):  # room beside the interfaces
         from flexgear.mbs.train import contact_sensing_rows
 
         sensing = contact_sensing_rows(kept, name, position, list(contacts),

@@ -63,13 +63,12 @@ def frame_form(point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(C, A, B) (6, 6) of the frame coordinates (u, phi) of a body turned by the spin a: ground translation of
     its ``point`` p [m] (from the frame origin, reference orientation) and rotation, [I, -(R_z(a) p)~; 0, I] =
     C + cos(a) A + sin(a) B; constant (C) for a point on the axis."""
-    px, py, pz = (float(v) for v in point)
-    const, cos_part, sin_part = np.eye(6), np.zeros((6, 6)), np.zeros((6, 6))
-    const[0, 4], const[1, 3] = pz, -pz
+    px, py, _ = (float(v) for v in point)
+    cos_part, sin_part = np.zeros((6, 6)), np.zeros((6, 6))
     # -(r~) rows (0, r_z, -r_y), (-r_z, 0, r_x), (r_y, -r_x, 0) with r_x = c p_x - s p_y, r_y = s p_x + c p_y
     cos_part[0, 5], cos_part[1, 5], cos_part[2, 3], cos_part[2, 4] = -py, px, py, -px
     sin_part[0, 5], sin_part[1, 5], sin_part[2, 3], sin_part[2, 4] = -px, -py, px, py
-    return const, cos_part, sin_part
+    return frame_rows(point) - cos_part, cos_part, sin_part  # at a = 0: frame_rows(p)
 
 
 def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
