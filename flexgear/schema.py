@@ -15,34 +15,11 @@ from pathlib import Path
 from typing import Any
 
 __all__ = [
-    "SpecError",
-    "GearSet",
-    "GearSetAssumed",
-    "Material",
-    "ComponentsAssumed",
-    "JointsAssumed",
-    "Bearing",
-    "Bearings",
-    "Contact",
-    "ContactAssumed",
-    "SupportsAssumed",
-    "JointsAssumed",
-    "LoadCase",
-    "SolverSettings",
-    "MeshingSettings",
-    "ReductionSettings",
-    "IndicatorWeights",
-    "IndicatorTolerance",
-    "ReferenceIndicators",
-    "ScreeningSettings",
-    "LumpedAssumed",
-    "GearboxSpec",
-    "Variant",
-    "COMPONENTS",
-    "GEAR_COMPONENTS",
-    "SHAFT_COMPONENTS",
-    "GEOMETRY_COMPONENTS",
-    "COMPONENT_GEOMETRY",
+    "SpecError", "GearSet", "GearSetAssumed", "Material", "ComponentsAssumed", "Bearing", "Bearings", "Contact",
+    "ContactAssumed", "SupportsAssumed", "JointsAssumed", "LoadCase", "SolverSettings", "MeshingSettings",
+    "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "ReferenceIndicators", "ScreeningSettings",
+    "LumpedAssumed", "GearboxSpec", "Variant", "COMPONENTS", "GEAR_COMPONENTS", "SHAFT_COMPONENTS",
+    "GEOMETRY_COMPONENTS", "COMPONENT_GEOMETRY",
 ]
 COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
 """Component names of Table 3, in its column order (a variant sets each rigid or flexible)."""
@@ -252,6 +229,13 @@ class SolverSettings:
     runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
     # linear floating frame: interval [s] of the spin-term updates in the ramp (flexgear.mbs.spin.SpinSchedule)
     spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
+    # body frames' inertia: "exact" Exudyn's ObjectRigidBody; "linear" constant matrices about the prescribed spin
+    # (flexgear.mbs.bodies.add_linear_frame), for bodies axisymmetric within frame_axisymmetry_tolerance
+    frame_equations: str = _choice("exact", "linear", default="exact")
+    frame_axisymmetry_tolerance: float = _num(0.0, 1.0, default=1e-4)
+    # "sparse": Eigen's SparseLU orders the Jacobian anew at each factorization or reuses the ordering of the last
+    # one while its pattern holds (Exudyn's reuseAnalyzedPattern)
+    sparse_ordering: str = _choice("per_jacobian", "reused", default="per_jacobian")
 
 
 @dataclass(frozen=True)

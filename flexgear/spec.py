@@ -217,6 +217,9 @@ def _check_consistency(spec: GearboxSpec) -> None:
     if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
         raise SpecError(p, "screening.window_end_s", "expected a value > window_start_s",
                         spec.screening.window_end_s)
+    if spec.solver_assumed.frame_equations == "linear" and spec.joints_assumed.joint_equations != "linear":
+        raise SpecError(p, "solver_assumed.frame_equations", "'linear' needs [joints_assumed] joint_equations = "
+                        "'linear' (generic joints need Exudyn's rigid bodies)", "linear")
     lc = spec.load_case
     if lc.step_size_s >= min(lc.end_time_s, lc.ramp_time_s):
         raise SpecError(p, "load_case.step_size_s", "expected < ramp_time_s and < end_time_s", lc.step_size_s)

@@ -103,7 +103,10 @@ def _short_runs(case: str, configs: list[dict]):
                                   modal_coordinates=cfg.get("coordinates", g.reduction_assumed.modal_coordinates))
         joints = dataclasses.replace(g.joints_assumed, joint_equations=cfg["joint"])
         seats = dataclasses.replace(g.supports_assumed, seat_equations=cfg["seat"])
-        spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints, supports_assumed=seats)
+        solver = dataclasses.replace(g.solver_assumed, frame_equations=cfg.get("frames",
+                                                                               g.solver_assumed.frame_equations))
+        spec = g.with_changes(load_case=lc, reduction_assumed=red, joints_assumed=joints, supports_assumed=seats,
+                              solver_assumed=solver)
         run = run_variant(dataclasses.replace(v, gearbox=spec))
         assert run.ok, run.meta.get("reason")
         runs.append(run.signals[run.signals.time_s >= 2 * lc.ramp_time_s])
@@ -124,11 +127,12 @@ def _assert_same_mesh_signals(ref, new, f_mesh: float, mean_rel: float, amp_rel:
 
 @pytest.mark.parametrize("case", ["model4", "model7"])
 def test_linear_forms_keep_the_reference_signals(case):
-    """Exudyn's FFRF bodies, generic joints and seat springs on virtual nodes (the reference) against the linear
-    floating frame, joints and seat bearings,
+    """Exudyn's FFRF bodies and rigid bodies, generic joints and seat springs on virtual nodes (the reference) against
+    the linear floating frame, body frames, joints and seat bearings,
     study's law, 6-18 ms after the ramps: mean mesh forces within 0.1 %, their 1x mesh amplitudes within 2 %."""
-    (ref, new), f_mesh = _short_runs(case, [{"frame": "ffrf", "joint": "generic", "seat": "markers"},
-                                            {"frame": "linear", "joint": "linear", "seat": "linear"}])
+    (ref, new), f_mesh = _short_runs(case, [{"frame": "ffrf", "joint": "generic", "seat": "markers", "frames": "exact"},
+                                            {"frame": "linear", "joint": "linear", "seat": "linear",
+                                             "frames": "linear"}])
     _assert_same_mesh_signals(ref, new, f_mesh, 1e-3, 0.02)
 
 

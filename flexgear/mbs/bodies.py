@@ -5,6 +5,19 @@ at the gear centre with the z axis along the rotation axis. Coordinates of that 
 (u_x, u_y, u_z, phi_x, phi_y, phi_z); phi_z is the unwrapped spin angle and, for small tilts,
 phi_x and phi_y are the tilt angles in the ground frame (R = R_x(phi_x) R_y(phi_y) R_z(phi_z)).
 Bushings, drives and gear contacts act on these frame coordinates, whatever the body's form.
+
+The frame's inertia is Exudyn's ``ObjectRigidBody`` (exact; its mass matrix depends on the angles, so Exudyn
+rebuilds the whole system's mass matrix in every Newton iteration) or, ``[solver_assumed] frame_equations =
+"linear"``, :func:`add_linear_frame`: the same body to first order in the tilts about its prescribed spin Omega,
+
+    M q'' + Omega J_p E q' = Q,    E = e_phix e_phiy^T - e_phiy e_phix^T,
+
+M (6 x 6, constant) the mass matrix of the axisymmetric body at the reference, [m I, -m c~; m c~, J_O]
+(c = (0, 0, c_z) the centre of mass on the axis, J_O = diag(J_t, J_t, J_p) about the frame origin), and the
+gyroscopic term of a body spinning at Omega about its tilted axis (kinetic energy of R = R_x R_y R_z to second
+order: 1/2 J_t (phi_x'^2 + phi_y'^2) + 1/2 J_p phi_z'^2 + J_p phi_y phi_x' phi_z'). Every body's mass matrix is then
+constant and Exudyn computes it once per run. Left out: the lateral centre-of-mass offset and the inertia's
+asymmetry of the meshed body (< ``frame_axisymmetry_tolerance``, checked), terms of second order in the tilts.
 """
 
 from __future__ import annotations
@@ -15,7 +28,23 @@ import numpy as np
 
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
-__all__ = ["Body", "add_rigid_body", "frame_rows", "matrix_container", "zero_user_jacobian"]
+__all__ = ["Body", "LinearFrame", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass", "frame_rows",
+           "matrix_container", "zero_user_jacobian"]
+
+
+@dataclass(frozen=True)
+class LinearFrame:
+    """A body frame's inertia as constant matrices (:func:`add_linear_frame`)."""
+
+    obj: int  # its ObjectGenericODE2 on the frame node
+    polar_inertia: float  # J_p about the spin axis [kg m^2]
+    spin_rad_s: float  # nominal spin Omega_n [rad/s]
+
+    def gyroscopic(self, spin_rad_s: float) -> np.ndarray:
+        """(6, 6) Omega J_p E at the spin ``spin_rad_s`` [rad/s] (module docstring)."""
+        out = np.zeros((6, 6))
+        out[3, 4], out[4, 3] = spin_rad_s * self.polar_inertia, -spin_rad_s * self.polar_inertia
+        return out
 
 
 @dataclass(frozen=True)
@@ -30,13 +59,17 @@ class Body:
     position: np.ndarray  # reference position of the frame [m]
     props: MassProperties
     flexible: bool = False
+    frame: LinearFrame | None = None  # frame_equations = "linear": the frame's constant inertia
 
 
-def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) -> Body:
+def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray, linear_spin_rad_s: float | None = None,
+                   tolerance: float = 0.0) -> Body:
     """Add a rigid body whose frame sits at ``position`` (ground frame axes) [m].
 
     ``props`` is given in the body frame; Exudyn's ``ObjectRigidBody`` takes the inertia about
-    the frame origin and the centre-of-mass offset, so no approximation is involved.
+    the frame origin and the centre-of-mass offset, so no approximation is involved. With
+    ``linear_spin_rad_s`` (its nominal spin [rad/s]) the frame is :func:`add_linear_frame` instead
+    (``tolerance``: its axisymmetry check).
     """
     import exudyn as exu  # noqa: F401  (imported for side effects of the item interface)
     from exudyn.itemInterface import MarkerNodeCoordinates, MarkerNodeRigid, NodeRigidBodyRxyz, ObjectRigidBody
@@ -44,13 +77,51 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray) 
 
     node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{name}_node", referenceCoordinates=[*position, 0.0, 0.0, 0.0]))
     j_ref = inertia_about_point(props)
-    obj = mbs.AddObject(ObjectRigidBody(
-        name=name, mass=props.mass, inertia=InertiaTensor2Inertia6D(j_ref),
-        centerOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
-    ))
+    frame = None
+    if linear_spin_rad_s is None:
+        obj = mbs.AddObject(ObjectRigidBody(
+            name=name, mass=props.mass, inertia=InertiaTensor2Inertia6D(j_ref),
+            centerOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
+        ))
+    else:
+        frame = add_linear_frame(mbs, name, node, props.mass, props.com, j_ref, linear_spin_rad_s, tolerance)
+        obj = frame.obj
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
-    return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props)
+    return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props, frame=frame)
+
+
+def axisymmetric_frame_mass(mass: float, com, inertia, tolerance: float, name: str = "body"
+                            ) -> tuple[np.ndarray, float]:
+    """(M (6, 6), J_p) of the module docstring from ``mass`` [kg], ``com`` [m] and ``inertia`` [kg m^2] about the
+    frame origin (body axes): the axisymmetric part. Raises ValueError when the dropped part exceeds ``tolerance``:
+    the lateral centre-of-mass offset relative to the radius of gyration sqrt(J_p/m), or an off-diagonal or
+    J_xx - J_yy relative to J_p."""
+    c, j = np.asarray(com, float), np.asarray(inertia, float)
+    polar = float(j[2, 2])
+    defect = max(float(np.hypot(c[0], c[1])) / np.sqrt(polar / mass), abs(j[0, 0] - j[1, 1]) / polar,
+                 *(abs(j[a, b]) / polar for a, b in ((0, 1), (0, 2), (1, 2))))
+    if defect > tolerance:
+        raise ValueError(f"{name}: a linear frame needs an axisymmetric body; its asymmetry {defect:.2e} exceeds "
+                         f"[solver_assumed] frame_axisymmetry_tolerance = {tolerance:g}")
+    b = frame_rows(np.array([0.0, 0.0, c[2]]))[:3]
+    out = mass * b.T @ b
+    out[3:, 3:] = np.diag([0.5 * (j[0, 0] + j[1, 1])] * 2 + [polar])
+    return out, polar
+
+
+def add_linear_frame(mbs, name: str, node: int, mass: float, com, inertia, spin_rad_s: float,
+                     tolerance: float) -> LinearFrame:
+    """The frame's inertia on ``node`` as one ``ObjectGenericODE2`` (module docstring): constant mass
+    (:func:`axisymmetric_frame_mass`), the gyroscopic term at rest (flexgear.mbs.spin.SpinSchedule moves it
+    with the ramp); ``spin_rad_s`` the nominal spin [rad/s]."""
+    from exudyn.itemInterface import ObjectGenericODE2
+
+    m6, polar = axisymmetric_frame_mass(mass, com, inertia, tolerance, name)
+    obj = mbs.AddObject(ObjectGenericODE2(name=f"{name}_frame", nodeNumbers=[node], massMatrix=matrix_container(m6),
+                                          dampingMatrix=matrix_container(np.zeros((6, 6))),
+                                          jacobianUserFunction=zero_user_jacobian(6)))
+    return LinearFrame(obj, polar, float(spin_rad_s))
 
 
 def frame_rows(point: np.ndarray) -> np.ndarray:

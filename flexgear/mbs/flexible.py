@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.fe.cms import ReducedBody
-from flexgear.mbs.bodies import Body, matrix_container
+from flexgear.mbs.bodies import Body, add_linear_frame, matrix_container
 
 __all__ = ["FlexibleBody", "add_flexible_body", "interface_basis", "interface_virtual_nodes", "interface_point_modes"]
 
@@ -146,7 +146,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       point_markers: dict[str, list] | None = None, show: bool = True,
                       floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0,
                       superelement: bool = True, interface_coordinates: tuple[str, ...] = (),
-                      sensing_rows: np.ndarray | None = None) -> FlexibleBody:
+                      sensing_rows: np.ndarray | None = None, linear_frame_tolerance: float | None = None
+                      ) -> FlexibleBody:
     """Add ``reduced`` as an ``ObjectFFRFreducedOrder`` whose frame node sits at ``position`` [m].
 
     ``rotation_matrix`` (3, 3) body-to-ground (default identity); ``velocity`` [m/s] and
@@ -167,7 +168,9 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     six-coordinate node (:func:`interface_basis`; the other coordinates on one more node), for constraints on them
     (flexgear.mbs.joints); ignored when the basis cannot carry them. ``sensing_rows`` (r, m) with them: the gear
     contacts' sensed coordinates on one more node (``contact_nodes``; flexgear.mbs.train.contact_sensing_rows), so
-    that a mesh constraint spans r columns, not m.
+    that a mesh constraint spans r columns, not m. ``linear_frame_tolerance`` ("linear" only; None: Exudyn's
+    ``ObjectRigidBody``): the frame's inertia as constant matrices (flexgear.mbs.bodies.add_linear_frame) with
+    this axisymmetry tolerance.
     """
     import exudyn as exu
     from exudyn.itemInterface import (
@@ -244,7 +247,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         computeFFRFterms=floating_frame == "ffrf",
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
-    spin, equations, matrices = None, -1, None
+    spin, equations, matrices, linear_frame = None, -1, None, None
     if floating_frame == "linear":
         from exudyn.itemInterface import ObjectRigidBody
         from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
@@ -252,9 +255,14 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices, transformed
 
         # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body (exact mass properties)
-        frame = mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
-                                      inertia=InertiaTensor2Inertia6D(inv["inertia"]),
-                                      centerOfMass=list(map(float, inv["centerOfMass"]))))
+        if linear_frame_tolerance is None:
+            frame = mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
+                                                  inertia=InertiaTensor2Inertia6D(inv["inertia"]),
+                                                  centerOfMass=list(map(float, inv["centerOfMass"]))))
+        else:
+            linear_frame = add_linear_frame(mbs, name, node, float(inv["mass"]), inv["centerOfMass"],
+                                            inv["inertia"], nominal_spin_rad_s, linear_frame_tolerance)
+            frame = linear_frame.obj
         spin = spin_matrices(reduced)
         matrices = (np.eye(m), np.diag(reduced.stiffness), np.diag(np.broadcast_to(damping, (m,))))
         if basis is not None:
@@ -277,9 +285,10 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return FlexibleBody(name, node, obj, m_rigid, m_coords, np.asarray(position, float), reduced.props, True,
-                        modal, markers, reduced, points, spin=spin, nominal_spin_rad_s=float(nominal_spin_rad_s),
-                        modal_equations=equations, superelement=superelement, modal_matrices=matrices,
-                        modal_nodes=modal_nodes, modal_sizes=sizes, basis=basis, contact_nodes=contact_nodes)
+                        linear_frame, modal, markers, reduced, points, spin=spin,
+                        nominal_spin_rad_s=float(nominal_spin_rad_s), modal_equations=equations,
+                        superelement=superelement, modal_matrices=matrices, modal_nodes=modal_nodes,
+                        modal_sizes=sizes, basis=basis, contact_nodes=contact_nodes)
 
 
 

@@ -138,6 +138,13 @@ def _linear_joints(spec: GearboxSpec) -> bool:
     return spec.joints_assumed.joint_equations == "linear"
 
 
+def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
+    """The axisymmetry tolerance of linear body frames, None for Exudyn's ``ObjectRigidBody``
+    (``[solver_assumed] frame_equations``, flexgear.mbs.bodies.add_linear_frame)."""
+    sv = spec.solver_assumed
+    return sv.frame_axisymmetry_tolerance if sv.frame_equations == "linear" else None
+
+
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
@@ -154,8 +161,10 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible);
     ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node.
     """
+    frame_tol = _linear_frame_tolerance(spec)
     if form == "rigid":
-        return add_rigid_body(mbs, name, props(spec, geometry), position)
+        return add_rigid_body(mbs, name, props(spec, geometry), position, None if frame_tol is None else spin_rad_s,
+                              frame_tol or 0.0)
     from dataclasses import replace
 
     from flexgear.mbs.flexible import add_flexible_body
@@ -191,7 +200,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
                              show=False, floating_frame=spec.reduction_assumed.floating_frame,
                              nominal_spin_rad_s=spin_rad_s, superelement=superelement or bool(joints or points)
                              or spec.reduction_assumed.floating_frame == "ffrf",
-                             interface_coordinates=tuple(dict.fromkeys(coordinates)), sensing_rows=sensing)
+                             interface_coordinates=tuple(dict.fromkeys(coordinates)), sensing_rows=sensing,
+                             linear_frame_tolerance=frame_tol)
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes
@@ -252,7 +262,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     for gear, shaft, spin in (("sun", "input_shaft", th.input_speed), ("ring", "output_shaft", th.output_speed)):
         if form[gear] == "rigid" and form[shaft] == "rigid":
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
-            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3)))
+            tol = _linear_frame_tolerance(spec)
+            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), None if tol is None else spin, tol or 0.0))
             ends[gear] = gear
         else:
             joints = gear_shaft_joints(spec, gear)
@@ -307,10 +318,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
         extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
     linear = [bd for bd in bodies if getattr(bd, "spin", None) is not None]
-    if linear:
+    frames = [bd.frame for bd in bodies if bd.frame is not None]
+    if linear or frames:
         from flexgear.mbs.spin import SpinSchedule
 
-        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s))
+        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s, frames))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
     train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,

@@ -102,18 +102,20 @@ class SpinSchedule:
     ``update_interval`` / T.
     """
 
-    def __init__(self, mbs, bodies: list, ramp_time: float, update_interval: float):
+    def __init__(self, mbs, bodies: list, ramp_time: float, update_interval: float, frames: list = ()):
         """``bodies``: flexible bodies with ``floating_frame = "linear"`` (flexgear.mbs.flexible.FlexibleBody:
-        ``modal_nodes``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_matrices``)."""
+        ``modal_nodes``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_matrices``);
+        ``frames``: linear body frames (flexgear.mbs.bodies.LinearFrame), whose gyroscopic term moves likewise."""
         from exudyn.itemInterface import ObjectGenericODE2
 
         self.ramp_time, self.interval = float(ramp_time), float(update_interval)
-        self.bodies = bodies
+        self.bodies, self.frames = bodies, list(frames)
         n = sum(b.reduced.n_modes for b in bodies)
         nodes = [node for b in bodies for node in b.modal_nodes]
-        self.obj = mbs.AddObject(ObjectGenericODE2(name="spin_schedule", nodeNumbers=nodes,
-                                                   forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
-        self.cent = np.concatenate([b.nominal_spin_rad_s ** 2 * b.spin.centrifugal for b in bodies])  # Omega_n^2 c
+        self.obj = -1 if not bodies else mbs.AddObject(ObjectGenericODE2(
+            name="spin_schedule", nodeNumbers=nodes, forceVector=np.zeros(n),
+            jacobianUserFunction=zero_user_jacobian(n)))
+        self.cent = np.array([b.nominal_spin_rad_s ** 2 * c for b in bodies for c in b.spin.centrifugal])  # Omega_n^2 c
         self._dense = [dense_modal_matrices(b.modal_matrices, b.spin) for b in bodies]  # each body's format
         self._next = 0.0  # time of the next matrix update
         self._steady = False
@@ -130,12 +132,16 @@ class SpinSchedule:
     def __call__(self, mbs, t: float) -> bool:
         if self._steady:
             return True
-        mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        if self.bodies:
+            mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
         last = t >= self.ramp_time
         if t >= self._next or last:
             for b, (k, d), dense in zip(self.bodies, self.matrices(t), self._dense, strict=True):
                 mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", matrix_container(k, dense))
                 mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", matrix_container(d, dense))
+            r = ramp_state(float(t), self.ramp_time)[1]
+            for f in self.frames:
+                mbs.SetObjectParameter(f.obj, "dampingMatrix", matrix_container(f.gyroscopic(r * f.spin_rad_s)))
             self._next = t + self.interval
         self._steady = last
         return True
