@@ -13,7 +13,7 @@ import pytest
 import scipy.sparse.linalg as sla
 
 from flexgear.fe.cms import _FreeBodySolver, _rbe3_rows, full_free_modes, interface, reduce
-from flexgear.fe.fem import fe_model
+from flexgear.fe.fem import fe_model, kron3_operator
 from flexgear.fe.reduced import cached_reduced_body
 from flexgear.mbs.flexible import add_flexible_body
 from flexgear.spec import Material
@@ -108,6 +108,29 @@ def test_reduced_frequencies_match_full_fe_and_rigid_patches_stiffen(ring_fe):
     assert np.allclose(body.modes.T @ (m @ body.modes), np.eye(body.n_modes), atol=1e-8)
     stiff = reduce(ring_fe, pads, 20, kind="rbe2", n_compare=0)
     assert stiff.frequencies_hz[0] > 1.01 * body.frequencies_hz[0]  # rigid pads stiffen the ring
+
+
+def test_mass_operator_equals_the_assembled_mass_matrix(coarse_ring_fe):
+    """M as an operator (Ms (x) I_3 on the nodes' rows) gives the assembled M's products, of the whole body and
+    of a subset of its nodes, for one vector and for a block."""
+    fe = coarse_ring_fe
+    rng = np.random.default_rng(3)
+    x = rng.standard_normal((fe.n_dof, 5))
+    m = fe.M
+    for got, want in ((fe.mass_operator() @ x, m @ x), (fe.mass_operator() @ x[:, 0], m @ x[:, 0])):
+        np.testing.assert_allclose(got, want, rtol=1e-14, atol=1e-14 * np.abs(want).max())
+    nodes = np.arange(0, fe.n_nodes, 3)
+    dofs = (3 * nodes[:, None] + np.arange(3)).ravel()
+    want = m[dofs][:, dofs] @ x[dofs]
+    np.testing.assert_allclose(fe.mass_operator(nodes) @ x[dofs], want, rtol=1e-14, atol=1e-14 * np.abs(want).max())
+    assert kron3_operator(fe.mass_scalar).shape == m.shape
+
+
+def test_constrained_solve_without_load_equals_a_zero_load(coarse_ring_fe):
+    """solve(None, e) skips the K_ff solve of a zero load and returns the very same displacements."""
+    con = _FreeBodySolver(coarse_ring_fe).constrained(_rbe3_rows(coarse_ring_fe, interface(coarse_ring_fe, "top")))
+    e = np.random.default_rng(4).standard_normal((6, 10))
+    np.testing.assert_array_equal(con.solve(None, e), con.solve(np.zeros((coarse_ring_fe.n_dof, 10)), e))
 
 
 def test_reduced_mass_properties_equal_exact_annulus(coarse_ring_fe):

@@ -29,6 +29,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.linalg as la
 import scipy.sparse as sp
+import scipy.sparse.linalg as sla
 
 __all__ = ["LoadCircle", "fourier_basis", "circle_band", "local_directions", "load_patterns", "kernel_load",
            "modal_basis"]
@@ -150,9 +151,11 @@ def kernel_load(nodes: np.ndarray, circle: LoadCircle, angle: float, direction=N
     return _spread(len(nodes), sel, w[:, None], local_directions(alpha, local))[:, 0]
 
 
-def modal_basis(basis: np.ndarray, stiffness: sp.spmatrix, mass: sp.spmatrix, rel_tol: float = 1e-10,
-                n_rigid: int = 6) -> tuple[np.ndarray, np.ndarray, int]:
+def modal_basis(basis: np.ndarray, stiffness: sp.spmatrix, mass: sp.spmatrix | sla.LinearOperator,
+                rel_tol: float = 1e-10, n_rigid: int = 6) -> tuple[np.ndarray, np.ndarray, int]:
     """Free-free modes spanned by ``basis`` (3n, p): mass-orthonormalise, then the reduced eigenproblem.
+
+    ``mass``: M [kg], a matrix or an operator (flexgear.fe.fem.FEModel.mass_operator).
 
     Columns are scaled to unit mass norm; the eigenvectors of T^T M T with eigenvalue below
     ``rel_tol`` times the largest are numerically dependent directions and dropped (one Cholesky pass

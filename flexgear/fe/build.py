@@ -6,8 +6,8 @@ then the reduced body (flexgear.fe.reduced, cached like any other call). The com
 so the results are those of the serial build (same cache entries). Longest tasks are started first
 (:data:`COLD_BUILD_ORDER`) so that two workers finish together. Memory: each worker holds one
 component at a time, and its large arrays go back to the system when freed (flexgear.heap); at the coarse
-level the largest process (the ring's) peaks at 1.2 GB and the whole process tree at 1.75 GB (sum of
-proportional set sizes, 1.93 GB with glibc's rising mmap threshold; benchmarks/bench_cold.py measures both).
+level with the default bolt-patch joint the largest process (the ring's) peaks at 1.45 GB and the whole
+process tree at 2.06 GB (sum of proportional set sizes; benchmarks/bench_cold.py measures both).
 """
 
 from __future__ import annotations

@@ -169,31 +169,36 @@ class _Constrained:
         self.lu_small = la.lu_factor(big)
         self.p = p
 
-    def solve(self, g: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
-        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k), e (p, k).
+    def solve(self, g: np.ndarray | None, e: np.ndarray | None = None) -> np.ndarray:
+        """u minimising 1/2 u^T K u - g^T u with C u = e; g (3n, k) (None: no load, e (p, k) given), e (p, k).
 
         Columns are solved in blocks of ``_SOLVE_BLOCK``: each is independent, and the work arrays stay small.
+        Without a load no K_ff solve is needed: u is the constraint part alone.
         """
-        g = np.atleast_2d(g.T).T
-        if g.shape[1] <= _SOLVE_BLOCK:
+        k = e.shape[1] if g is None else np.atleast_2d(g.T).shape[0]
+        g = None if g is None else np.atleast_2d(g.T).T
+        if k <= _SOLVE_BLOCK:
             return self._solve(g, e)
-        u = np.empty(g.shape)
-        for j in range(0, g.shape[1], _SOLVE_BLOCK):
+        u = np.empty((self.s.n, k))
+        for j in range(0, k, _SOLVE_BLOCK):
             cols = slice(j, j + _SOLVE_BLOCK)
-            u[:, cols] = self._solve(g[:, cols], None if e is None else e[:, cols])
+            u[:, cols] = self._solve(None if g is None else g[:, cols], None if e is None else e[:, cols])
         return u
 
-    def _solve(self, g: np.ndarray, e: np.ndarray | None) -> np.ndarray:
+    def _solve(self, g: np.ndarray | None, e: np.ndarray | None) -> np.ndarray:
         s, p = self.s, self.p
-        y = s.solve_ff(g[s.free])
-        rhs = np.vstack([np.asarray(self.c_f @ y) - (0.0 if e is None else e), s.R.T @ g])
+        if g is None:  # K_ff^-1 0 = 0: the same numbers as the solve, without it
+            y, rg = np.zeros((len(s.free), e.shape[1])), np.zeros((6, e.shape[1]))
+        else:
+            y, rg = s.solve_ff(g[s.free]), s.R.T @ g
+        rhs = np.vstack([np.asarray(self.c_f @ y) - (0.0 if e is None else e), rg])
         sol = la.lu_solve(self.lu_small, rhs)
         lam, a = sol[:p], sol[p:]
         u = s.R @ a
         u[s.free] += y - self.z @ lam
         return u
 
-    def eigen(self, fe: FEModel, k: int, m: sp.csr_matrix) -> tuple[np.ndarray, np.ndarray]:
+    def eigen(self, fe: FEModel, k: int, m: sp.spmatrix | sla.LinearOperator) -> tuple[np.ndarray, np.ndarray]:
         """Lowest k eigenpairs of K phi = omega^2 M phi on {C phi = 0} (shift-invert at 0, ARPACK)."""
         op = sla.LinearOperator((self.s.n, self.s.n), matvec=lambda f: self.solve(f)[:, 0], dtype=float)
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
@@ -207,7 +212,7 @@ class _Constrained:
 def full_free_modes(fe: FEModel, k: int, solver: _FreeBodySolver | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Lowest k flexible free-free modes of the full FE model: frequencies [Hz] and shapes (3n, k)."""
     solver = solver or _FreeBodySolver(fe)
-    m = fe.M
+    m = fe.mass_operator()
     lam, vec = solver.constrained((m @ solver.R).T).eigen(fe, k, m)
     return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), vec
 
@@ -324,15 +329,16 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     mask = np.ones(fe.n_dof, bool)
     mask[bdofs] = False
     idofs = np.flatnonzero(mask)
-    k_ii = fe.K[idofs][:, idofs].tocsc()
-    lu = sla.splu(k_ii, permc_spec="MMD_AT_PLUS_A", options={"SymmetricMode": True})
+    # K_ii's lower triangle, all the factorisation reads (the rows and columns kept are ascending)
+    chol = SparseCholesky(sp.tril(fe.K, format="csr")[idofs][:, idofs])
     soft = [i for i in interfaces if i.name not in rigid]
     c = sp.vstack([_rbe3_rows(fe, i) for i in soft]).tocsc()[:, idofs] if soft else sp.csc_matrix((0, len(idofs)))
-    z = lu.solve(np.ascontiguousarray(c.T.toarray())) if soft else np.zeros((len(idofs), 0))
+    z = chol.solve(c.T.toarray()) if soft else np.zeros((len(idofs), 0))
     schur = la.lu_factor(c @ z) if soft else None
 
-    def solve(g: np.ndarray, e: np.ndarray | None = None) -> np.ndarray:
-        y = lu.solve(np.ascontiguousarray(g))
+    def solve(g: np.ndarray | None, e: np.ndarray | None = None) -> np.ndarray:
+        """Interior response to loads ``g`` (None: no load, e given) with the soft interfaces at ``e``."""
+        y = chol.solve(g) if g is not None else np.zeros((len(idofs), e.shape[1]))
         if soft:
             lam = la.lu_solve(schur, c @ y - (0.0 if e is None else e))
             y = y - z @ lam
@@ -345,20 +351,23 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
                                                                                           centre=itf.point)
     static = np.zeros((fe.n_dof, ub.shape[1] + 6 * len(soft)))
     static[bdofs, :ub.shape[1]] = ub
-    static[idofs, :ub.shape[1]] = solve(-np.asarray(fe.K[idofs][:, bdofs] @ ub))
+    # K_ib = K_bi^T (K symmetric): a few rows sliced instead of nearly all
+    static[idofs, :ub.shape[1]] = solve(-np.asarray(fe.K[bdofs][:, idofs].T @ ub))
     if soft:
-        static[idofs, ub.shape[1]:] = solve(np.zeros((len(idofs), c.shape[0])), np.eye(c.shape[0]))
+        static[idofs, ub.shape[1]:] = solve(None, np.eye(c.shape[0]))
     fixed = np.zeros((fe.n_dof, n_modes))
     if n_modes:
-        op = sla.LinearOperator(k_ii.shape, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
-        m_ii = fe.M[idofs][:, idofs]
+        shape = (len(idofs), len(idofs))
+        op = sla.LinearOperator(shape, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
+        m_ii = fe.mass_operator(np.setdiff1d(np.arange(fe.n_nodes), bnodes))  # rows and columns idofs
         v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
-        lam, vec = sla.eigsh(k_ii, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
+        # shift-invert about 0 reads K_ii only through OPinv (ARPACK mode 3): op stands for it
+        lam, vec = sla.eigsh(op, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
         fixed[idofs] = vec[:, np.argsort(lam)]
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
         attached[idofs] = solve(patterns[idofs])
-    return static, fixed, attached, 12 * (lu.L.nnz + lu.U.nnz)  # bytes: a float64 value and an int32 index each
+    return static, fixed, attached, chol.factor_bytes
 
 
 @dataclass
@@ -388,8 +397,8 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
         return BasisParts(*_rigid_patch_basis(fe, itfs, rigid_set, n_modes, patterns))
     solver = solver or _FreeBodySolver(fe)
     con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
-    static = con.solve(np.zeros((fe.n_dof, con.p)), np.eye(con.p))
-    fixed = con.eigen(fe, n_modes, fe.M)[1] if n_modes else np.zeros((fe.n_dof, 0))
+    static = con.solve(None, np.eye(con.p))
+    fixed = con.eigen(fe, n_modes, fe.mass_operator())[1] if n_modes else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
     return BasisParts(static, fixed, attached, solver.factor_bytes, solver)
 
@@ -426,7 +435,7 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
     n_attached, factor_bytes = parts.attached.shape[1], parts.factor_bytes
     basis = np.hstack([parts.static, parts.fixed, parts.attached])
     del parts  # the factor and the blocks: the peak memory is the factor's or the basis's, not both
-    modes, lam, dropped = modal_basis(basis, fe.K, fe.M)
+    modes, lam, dropped = modal_basis(basis, fe.K, fe.mass_operator())
     del basis
     if keep_modes is not None:
         modes, lam = modes[:, :keep_modes], lam[:keep_modes]

@@ -25,11 +25,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.sparse as sp
+import scipy.sparse.linalg as sla
 
 from flexgear.geometry.massprops import MassProperties
 from flexgear.spec import Material
 
-__all__ = ["FEModel", "fe_model", "rigid_body_modes", "lame_parameters", "surface_faces"]
+__all__ = ["FEModel", "fe_model", "rigid_body_modes", "lame_parameters", "surface_faces", "kron3_operator"]
 
 
 def lame_parameters(material: Material) -> tuple[float, float]:
@@ -74,6 +75,12 @@ class FEModel:
         """Consistent mass matrix (3n, 3n) [kg], interleaved coordinates."""
         return sp.kron(self.mass_scalar, sp.identity(3), format="csr")
 
+    def mass_operator(self, nodes: np.ndarray | None = None) -> sla.LinearOperator:
+        """M [kg] (or its rows and columns of the coordinates of ``nodes``, ascending node indices) as a linear
+        operator, without the assembled matrix (:func:`kron3_operator`)."""
+        ms = self.mass_scalar if nodes is None else self.mass_scalar[nodes][:, nodes]
+        return kron3_operator(ms)
+
     def mass_properties(self) -> MassProperties:
         """Mass, centre of mass and inertia about it, exact for the meshed (curved) geometry.
 
@@ -110,6 +117,24 @@ def rigid_body_modes(nodes: np.ndarray, centre: np.ndarray | None = None) -> np.
         axis[k] = 1.0
         modes[:, :, 3 + k] = np.cross(axis, r)
     return modes.reshape(3 * n, 6)
+
+
+def kron3_operator(scalar: sp.spmatrix) -> sla.LinearOperator:
+    """The operator ``scalar (x) I_3`` (3n, 3n) on interleaved coordinates, without assembling it.
+
+    x (3n, k) is read as the (n, 3 k) array of its node rows: ``scalar @ x.reshape(n, 3 k)`` forms the same
+    sums, term by term in the same order, as the assembled Kronecker product would, with a third of its
+    index reads and no (3n, 3n) matrix in memory.
+    """
+    scalar = sp.csr_matrix(scalar)
+    n = scalar.shape[0]
+
+    def matmat(x: np.ndarray) -> np.ndarray:
+        x = np.asarray(x, float)
+        k = x.shape[1] if x.ndim == 2 else 1
+        return (scalar @ np.ascontiguousarray(x).reshape(n, 3 * k)).reshape(x.shape)
+
+    return sla.LinearOperator((3 * n, 3 * n), matvec=matmat, matmat=matmat, dtype=float)
 
 
 def _to_scipy(mat, n: int, position: np.ndarray | None = None) -> sp.csr_matrix:
