@@ -17,7 +17,8 @@ Exudyn uses) are
 
 with Omega(t) the body's prescribed spin (the drive's STEP ramp times the body's nominal speed,
 flexgear.theory). The frame itself is an ``ObjectRigidBody`` with the body's exact mass properties on the
-same node. Left out (second order): the inertia tensor's change with q, the terms in the tilt rates and in
+same node, or its linear form (flexgear.mbs.bodies.add_linear_frame, ``[solver_assumed] frame_equations``).
+Left out (second order): the inertia tensor's change with q, the terms in the tilt rates and in
 the angular acceleration. One ``ObjectGenericODE2`` per body carries M, K(Omega), D(Omega) (constant
 Jacobian); :class:`SpinSchedule` moves K and D with the ramp and writes the centrifugal load.
 """
