@@ -175,8 +175,8 @@ class _Constrained:
         Columns are solved in blocks of ``_SOLVE_BLOCK``: each is independent, and the work arrays stay small.
         Without a load no K_ff solve is needed: u is the constraint part alone.
         """
-        k = e.shape[1] if g is None else np.atleast_2d(g.T).shape[0]
         g = None if g is None else np.atleast_2d(g.T).T
+        k = e.shape[1] if g is None else g.shape[1]
         if k <= _SOLVE_BLOCK:
             return self._solve(g, e)
         u = np.empty((self.s.n, k))

@@ -28,8 +28,8 @@ import numpy as np
 
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
-__all__ = ["Body", "LinearFrame", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass", "frame_rows",
-           "matrix_container", "zero_user_jacobian"]
+__all__ = ["Body", "LinearFrame", "add_frame_inertia", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass",
+           "frame_rows", "matrix_container", "zero_user_jacobian"]
 
 
 @dataclass(frozen=True)
@@ -62,33 +62,39 @@ class Body:
     frame: LinearFrame | None = None  # frame_equations = "linear": the frame's constant inertia
 
 
-def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray, linear_spin_rad_s: float | None = None,
-                   tolerance: float = 0.0) -> Body:
+def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray, spin_rad_s: float = 0.0,
+                   linear_frame_tolerance: float | None = None) -> Body:
     """Add a rigid body whose frame sits at ``position`` (ground frame axes) [m].
 
-    ``props`` is given in the body frame; Exudyn's ``ObjectRigidBody`` takes the inertia about
-    the frame origin and the centre-of-mass offset, so no approximation is involved. With
-    ``linear_spin_rad_s`` (its nominal spin [rad/s]) the frame is :func:`add_linear_frame` instead
-    (``tolerance``: its axisymmetry check).
+    ``props`` is given in the body frame; its inertia about the frame origin and centre-of-mass offset go to
+    :func:`add_frame_inertia` (``spin_rad_s`` the nominal spin [rad/s], ``linear_frame_tolerance`` its choice).
     """
     import exudyn as exu  # noqa: F401  (imported for side effects of the item interface)
-    from exudyn.itemInterface import MarkerNodeCoordinates, MarkerNodeRigid, NodeRigidBodyRxyz, ObjectRigidBody
-    from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
+    from exudyn.itemInterface import MarkerNodeCoordinates, MarkerNodeRigid, NodeRigidBodyRxyz
 
     node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{name}_node", referenceCoordinates=[*position, 0.0, 0.0, 0.0]))
-    j_ref = inertia_about_point(props)
-    frame = None
-    if linear_spin_rad_s is None:
-        obj = mbs.AddObject(ObjectRigidBody(
-            name=name, mass=props.mass, inertia=InertiaTensor2Inertia6D(j_ref),
-            centerOfMass=list(np.asarray(props.com, float)), nodeNumber=node,
-        ))
-    else:
-        frame = add_linear_frame(mbs, name, node, props.mass, props.com, j_ref, linear_spin_rad_s, tolerance)
-        obj = frame.obj
+    obj, frame = add_frame_inertia(mbs, name, node, props.mass, props.com, inertia_about_point(props), spin_rad_s,
+                                   linear_frame_tolerance)
     m_rigid = mbs.AddMarker(MarkerNodeRigid(nodeNumber=node))
     m_coords = mbs.AddMarker(MarkerNodeCoordinates(nodeNumber=node))
     return Body(name, node, obj, m_rigid, m_coords, np.asarray(position, float), props, frame=frame)
+
+
+def add_frame_inertia(mbs, label: str, node: int, mass: float, com, inertia, spin_rad_s: float,
+                      linear_frame_tolerance: float | None) -> tuple[int, LinearFrame | None]:
+    """The inertia of a body frame on ``node``: ``mass`` [kg], ``com`` [m] and ``inertia`` [kg m^2] about the frame
+    origin (body axes). ``linear_frame_tolerance`` None: Exudyn's ``ObjectRigidBody`` named ``label`` (exact);
+    else :func:`add_linear_frame` at the nominal spin ``spin_rad_s`` [rad/s] with that axisymmetry tolerance.
+    Returns (object, its LinearFrame or None)."""
+    from exudyn.itemInterface import ObjectRigidBody
+    from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
+
+    if linear_frame_tolerance is None:
+        return mbs.AddObject(ObjectRigidBody(name=label, nodeNumber=node, mass=float(mass),
+                                             inertia=InertiaTensor2Inertia6D(np.asarray(inertia, float)),
+                                             centerOfMass=[float(v) for v in com])), None
+    frame = add_linear_frame(mbs, label, node, mass, com, inertia, spin_rad_s, linear_frame_tolerance)
+    return frame.obj, frame
 
 
 def axisymmetric_frame_mass(mass: float, com, inertia, tolerance: float, name: str = "body"
@@ -112,13 +118,13 @@ def axisymmetric_frame_mass(mass: float, com, inertia, tolerance: float, name: s
 
 def add_linear_frame(mbs, name: str, node: int, mass: float, com, inertia, spin_rad_s: float,
                      tolerance: float) -> LinearFrame:
-    """The frame's inertia on ``node`` as one ``ObjectGenericODE2`` (module docstring): constant mass
+    """The frame's inertia on ``node`` as one ``ObjectGenericODE2`` named ``name`` (module docstring): constant mass
     (:func:`axisymmetric_frame_mass`), the gyroscopic term at rest (flexgear.mbs.spin.SpinSchedule moves it
     with the ramp); ``spin_rad_s`` the nominal spin [rad/s]."""
     from exudyn.itemInterface import ObjectGenericODE2
 
     m6, polar = axisymmetric_frame_mass(mass, com, inertia, tolerance, name)
-    obj = mbs.AddObject(ObjectGenericODE2(name=f"{name}_frame", nodeNumbers=[node], massMatrix=matrix_container(m6),
+    obj = mbs.AddObject(ObjectGenericODE2(name=name, nodeNumbers=[node], massMatrix=matrix_container(m6),
                                           dampingMatrix=matrix_container(np.zeros((6, 6))),
                                           jacobianUserFunction=zero_user_jacobian(6)))
     return LinearFrame(obj, polar, float(spin_rad_s))

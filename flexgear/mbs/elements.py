@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.geometry.supports import Support
 from flexgear.laws.ramps import drive_angle, ramp_fraction
-from flexgear.mbs.bodies import Body, frame_rows, matrix_container, zero_user_jacobian
+from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
 from flexgear.spec import Bearing
 
 
@@ -85,28 +85,23 @@ def add_support(mbs, body: Body, support: Support) -> list[int]:
     to a ``MarkerSuperElementPosition`` on a virtual node moving rigidly with the interface
     ``support.interface`` of a flexible body (``FlexibleBody.point_markers``, placed at the same points) or a
     body-fixed marker of a rigid body (a rigid body on a linear frame, flexgear.mbs.bodies.add_linear_frame: the
-    three springs' sum as one 6 x 6 bearing on its frame coordinates, flexgear.mbs.joints.seat_matrices, exact to
-    first order in the tilts). Points on the axis: the spin does not move them, so the bearing
-    leaves the spin free and damps only translation and tilt. Returns the connectors.
+    three springs' sum as one 6 x 6 bearing on its frame coordinates, flexgear.mbs.joints.add_frame_bearing).
+    Points on the axis: the spin does not move them, so the bearing leaves the spin free and damps only
+    translation and tilt. Returns the connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
         MarkerNodePosition,
         NodePointGround,
         ObjectConnectorCartesianSpringDamper,
-        ObjectGenericODE2,
         VObjectConnectorCartesianSpringDamper,
     )
 
     springs = support.spring_points()
     if body.frame is not None and not body.flexible:  # a linear frame: one linear bearing on its coordinates
-        from flexgear.mbs.joints import seat_matrices
+        from flexgear.mbs.joints import add_frame_bearing
 
-        rows = frame_rows(np.array([0.0, 0.0, support.centre_z]))
-        k6, d6 = (rows.T @ a @ rows for a in seat_matrices(support))
-        return [mbs.AddObject(ObjectGenericODE2(
-            name=f"bearing_{body.name}", nodeNumbers=[body.node], stiffnessMatrix=matrix_container(k6),
-            dampingMatrix=matrix_container(d6), jacobianUserFunction=zero_user_jacobian(6)))]
+        return [add_frame_bearing(mbs, body, support)]
     if body.flexible:
         markers = body.point_markers.get(support.interface, [])
         if len(markers) != len(springs):

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.fe.cms import ReducedBody
-from flexgear.mbs.bodies import Body, add_linear_frame, matrix_container
+from flexgear.mbs.bodies import Body, add_frame_inertia, matrix_container
 
 __all__ = ["FlexibleBody", "add_flexible_body", "interface_basis", "interface_virtual_nodes", "interface_point_modes"]
 
@@ -249,20 +249,11 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     ))
     spin, equations, matrices, linear_frame = None, -1, None, None
     if floating_frame == "linear":
-        from exudyn.itemInterface import ObjectRigidBody
-        from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
-
         from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices, transformed
 
-        # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body (exact mass properties)
-        if linear_frame_tolerance is None:
-            frame = mbs.AddObject(ObjectRigidBody(name=f"{name}_frame", nodeNumber=node, mass=float(inv["mass"]),
-                                                  inertia=InertiaTensor2Inertia6D(inv["inertia"]),
-                                                  centerOfMass=list(map(float, inv["centerOfMass"]))))
-        else:
-            linear_frame = add_linear_frame(mbs, name, node, float(inv["mass"]), inv["centerOfMass"],
-                                            inv["inertia"], nominal_spin_rad_s, linear_frame_tolerance)
-            frame = linear_frame.obj
+        # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body
+        frame, linear_frame = add_frame_inertia(mbs, f"{name}_frame", node, float(inv["mass"]), inv["centerOfMass"],
+                                                inv["inertia"], nominal_spin_rad_s, linear_frame_tolerance)
         spin = spin_matrices(reduced)
         matrices = (np.eye(m), np.diag(reduced.stiffness), np.diag(np.broadcast_to(damping, (m,))))
         if basis is not None:

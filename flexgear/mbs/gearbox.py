@@ -163,8 +163,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     """
     frame_tol = _linear_frame_tolerance(spec)
     if form == "rigid":
-        return add_rigid_body(mbs, name, props(spec, geometry), position, None if frame_tol is None else spin_rad_s,
-                              frame_tol or 0.0)
+        return add_rigid_body(mbs, name, props(spec, geometry), position, spin_rad_s, frame_tol)
     from dataclasses import replace
 
     from flexgear.mbs.flexible import add_flexible_body
@@ -262,8 +261,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     for gear, shaft, spin in (("sun", "input_shaft", th.input_speed), ("ring", "output_shaft", th.output_speed)):
         if form[gear] == "rigid" and form[shaft] == "rigid":
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
-            tol = _linear_frame_tolerance(spec)
-            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), None if tol is None else spin, tol or 0.0))
+            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), spin, _linear_frame_tolerance(spec)))
             ends[gear] = gear
         else:
             joints = gear_shaft_joints(spec, gear)

@@ -36,8 +36,8 @@ import numpy as np
 from flexgear.laws.compiled import ramp_state, turn_columns
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, zero_user_jacobian
 
-__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "frame_form", "interface_rows",
-           "seat_matrices", "turning_form"]
+__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "add_frame_bearing", "frame_form",
+           "interface_rows", "linear_bearing", "seat_matrices", "turning_form"]
 
 
 def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.ndarray:
@@ -80,6 +80,25 @@ def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
         b = frame_rows(np.array([0.0, 0.0, z - support.centre_z]))[:3]
         k6 += b.T @ np.diag(stiffness) @ b
     return k6, support.damping_per_stiffness * k6
+
+
+def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np.ndarray) -> int:
+    """A constant 6 x 6 ``stiffness`` and ``damping`` on the six coordinates of ``node`` to ground (one
+    ``ObjectGenericODE2``, its Jacobian exact): a seat's bearing (:class:`LinearSeat`) or a rigid body's on its
+    linear frame (:func:`add_frame_bearing`)."""
+    from exudyn.itemInterface import ObjectGenericODE2
+
+    return mbs.AddObject(ObjectGenericODE2(name=name, nodeNumbers=[node], stiffnessMatrix=matrix_container(stiffness),
+                                           dampingMatrix=matrix_container(damping),
+                                           jacobianUserFunction=zero_user_jacobian(6)))
+
+
+def add_frame_bearing(mbs, body: Body, support) -> int:
+    """The bearing ``support`` of a rigid ``body`` on its frame coordinates: :func:`seat_matrices` at the bearing
+    centre through [I, -p~; 0, I] (the three springs' sum, exact to first order in the tilts)."""
+    rows = frame_rows(np.array([0.0, 0.0, support.centre_z]))
+    k6, d6 = (rows.T @ a @ rows for a in seat_matrices(support))
+    return linear_bearing(mbs, f"bearing_{body.name}", body.node, k6, d6)
 
 
 class LinearInterfaceJoint:
@@ -166,10 +185,7 @@ class LinearSeat:
         self.node = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_seat", numberOfODE2Coordinates=6,
                                                 referenceCoordinates=[0.0] * 6, initialCoordinates=[0.0] * 6,
                                                 initialCoordinates_t=[0.0] * 6))
-        k6, d6 = seat_matrices(support)
-        mbs.AddObject(ObjectGenericODE2(name=f"bearing_{body.name}", nodeNumbers=[self.node],
-                                        stiffnessMatrix=matrix_container(k6), dampingMatrix=matrix_container(d6),
-                                        jacobianUserFunction=zero_user_jacobian(6)))
+        linear_bearing(mbs, f"bearing_{body.name}", self.node, *seat_matrices(support))
         span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],
                                                jacobianUserFunction=zero_user_jacobian(12)))
         # Exudyn's equation: scalingMarker1 q - scalingMarker0 (s, frame) - offset = 0, i.e.
