@@ -129,37 +129,68 @@ def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi
 
 
 @njit(cache=True)
-def turn_columns(buffer, const, cos_part, sin_part, spin, theta):  # pragma: no cover - compiled
-    """Write const[:, j] + cos(spin_j theta) cos_part[:, j] + sin(spin_j theta) sin_part[:, j] into buffer[:, j]
-    for every column j: coefficients that turn with a spin angle (``theta`` [rad]).
+def turn_columns(buffer, const, cos_part, sin_part, spin_index, spins, target, theta):  # pragma: no cover - compiled
+    """Write const[:, j] + cos(a_j) cos_part[:, j] + sin(a_j) sin_part[:, j], a_j = spins[spin_index[j]] theta, into
+    ``buffer[target[:, j]]`` for every column j: coefficients that turn with a spin angle (``theta`` [rad]).
 
-    Compiled twin of flexgear.mbs.joints.TurningBlocks.turned (arrays (6, W), ``spin`` (W,)).
+    ``const``, ``cos_part``, ``sin_part`` (6, W); the few distinct spins per drive angle ``spins`` give one
+    cosine and sine each; ``target`` (6, W) places every entry in the flat ``buffer`` (each constraint's block
+    contiguous there). Compiled twin of flexgear.mbs.joints.TurningBlocks.turned.
     """
+    cos_a = np.empty(spins.size)
+    sin_a = np.empty(spins.size)
+    for k in range(spins.size):
+        cos_a[k] = math.cos(spins[k] * theta)
+        sin_a[k] = math.sin(spins[k] * theta)
     for j in range(const.shape[1]):
-        c = math.cos(spin[j] * theta)
-        s = math.sin(spin[j] * theta)
+        c = cos_a[spin_index[j]]
+        s = sin_a[spin_index[j]]
         for r in range(const.shape[0]):
-            buffer[r, j] = const[r, j] + c * cos_part[r, j] + s * sin_part[r, j]
+            buffer[target[r, j]] = const[r, j] + c * cos_part[r, j] + s * sin_part[r, j]
 
 
 @njit(cache=True)
 def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law, means, cos_c, sin_c,  # noqa: PLR0913
-              sliding_rows, spin_rows, factor_rows, force, linear=False):  # pragma: no cover - compiled
-    """One step's mesh updates in one call: stiffness factors s(phi) of the contacts ``factor_rows``
-    (returned) and the friction forces on the frame coordinates (written into ``force[:frames.size]``).
+              columns, sliding, spin, factor_rows, force, factors, work, linear=False):  # pragma: no cover
+    """One step's mesh updates in one call, without temporaries: stiffness factors s(phi) of the contacts
+    ``factor_rows`` (written into ``factors``; ``work``: one entry per contact) and the friction forces on the
+    frame coordinates (written into ``force[:frames.size]``).
 
     phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
     (:func:`ramp_state`); ``q``, ``q_t``: all ODE2 coordinates and rates, ``aux``: the contacts'
     deflection coordinates, ``frames``: the bodies' frame coordinates; ``law`` rows: stiffness,
-    exponent, damping_max, penetration depth, mu, v_reg. Same numbers as :func:`periodic_values` plus
-    :func:`mesh_friction_forces`.
+    exponent, damping_max, penetration depth, mu, v_reg. The sliding and spin rows of contact i are sparse
+    (each touches the 12 frame coordinates of its two gears): ``sliding[i, k]``, ``spin[i, k]`` are their
+    entries at frame coordinate ``columns[i, k]`` (-1: padding). Same numbers as :func:`periodic_values` plus
+    :func:`mesh_friction_forces` with the dense rows.
     """
     theta = drive_speed * ramp_state(t, ramp_time)[0]
-    phase = rate * theta - offset
-    q_frames = np.empty(frames.size)
+    n_c, n_h = cos_c.shape[1], cos_c.shape[2]
     for j in range(frames.size):
-        q_frames[j] = q_t[frames[j]]
-    friction = mesh_friction_forces(phase, q[aux], q_t[aux], q_frames, law[0], law[1], law[2], law[3], means,
-                                    cos_c, sin_c, law[4], law[5], sliding_rows, spin_rows, linear)
-    force[:frames.size] = friction
-    return periodic_values(phase[factor_rows], means[0][factor_rows], cos_c[0][factor_rows], sin_c[0][factor_rows])
+        force[j] = 0.0
+    for i in range(n_c):
+        x = 2.0 * math.pi * (rate[i] * theta - offset[i])
+        c1, s1 = math.cos(x), math.sin(x)
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
+        v0, v1, v2 = means[0, i], means[1, i], means[2, i]
+        for h in range(n_h):
+            v0 += cos_c[0, i, h] * ch + sin_c[0, i, h] * sh
+            v1 += cos_c[1, i, h] * ch + sin_c[1, i, h] * sh
+            v2 += cos_c[2, i, h] * ch + sin_c[2, i, h] * sh
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
+        work[i] = v0
+        d, d_t = q[aux[i]], q_t[aux[i]]
+        if linear:
+            normal = linear_normal_force(d, d_t, law[0, i] * v0, law[2, i])
+        else:
+            normal = impact_normal_force(d, d_t, law[0, i] * v0, law[1, i], law[2, i], law[3, i])
+        spin_rate = 0.0
+        for k in range(columns.shape[1]):
+            if columns[i, k] >= 0:
+                spin_rate += spin[i, k] * q_t[frames[columns[i, k]]]
+        f = law[4, i] * normal * math.tanh(spin_rate * means[2, i] / law[5, i])
+        for k in range(columns.shape[1]):
+            if columns[i, k] >= 0:
+                force[columns[i, k]] -= sliding[i, k] * (f * v1) + spin[i, k] * (f * v2)
+    for k in range(factor_rows.size):
+        factors[k] = work[factor_rows[k]]

@@ -209,19 +209,25 @@ class TurningBlocks:
     """Pre-step function: the constraint coefficients of the linear joints and seats that turn with the spin
     (``entries``: their :meth:`turning` lists, (constraint, parameter, C, A, B, spin per drive angle)), each matrix
     C + cos(phi_n) A + sin(phi_n) B with phi_n = spin x the prescribed drive angle (STEP ramp ``ramp_time`` [s] to
-    ``drive_speed`` [rad/s]). Every entry's matrix is a slice of one buffer, written by one compiled call
-    (flexgear.laws.compiled.turn_columns), then handed to its constraint."""
+    ``drive_speed`` [rad/s]). Every entry's matrix is a contiguous block of one buffer, written by one compiled
+    call (flexgear.laws.compiled.turn_columns: one cosine and sine per distinct spin), then handed to its
+    constraint."""
 
     def __init__(self, entries: list[tuple], ramp_time: float, drive_speed: float):
         self.ramp_time, self.drive_speed = float(ramp_time), float(drive_speed)
         self.const, self.cos_part, self.sin_part = (np.ascontiguousarray(np.hstack([e[k] for e in entries]))
                                                     for k in (2, 3, 4))
         self.spin = np.concatenate([np.full(e[2].shape[1], e[5]) for e in entries])
-        starts = np.cumsum([0, *(e[2].shape[1] for e in entries)])
-        self.buffer = np.zeros_like(self.const)
-        # views of the buffer, which the kernel rewrites in place
-        self.items = [(e[0], e[1], self.buffer[:, a:b]) for e, a, b in zip(entries, starts[:-1], starts[1:],
-                                                                           strict=True)]
+        self.spins, self.spin_index = np.unique(self.spin, return_inverse=True)
+        rows, starts = self.const.shape[0], np.cumsum([0, *(e[2].shape[1] for e in entries)])
+        self.buffer = np.zeros(self.const.size)
+        # column j of entry e (its columns a..b) goes to row r of e's block: rows * a + r (b - a) + (j - a)
+        self.target = np.zeros(self.const.shape, dtype=np.int64)
+        self.items = []
+        for e, a, b in zip(entries, starts[:-1], starts[1:], strict=True):
+            cols = np.arange(a, b)
+            self.target[:, a:b] = rows * a + np.arange(rows)[:, None] * (b - a) + (cols - a)[None, :]
+            self.items.append((e[0], e[1], self.buffer[rows * a:rows * b].reshape(rows, b - a)))
 
     def turned(self, t: float) -> np.ndarray:
         """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
@@ -229,7 +235,7 @@ class TurningBlocks:
         return self.const + np.cos(phi) * self.cos_part + np.sin(phi) * self.sin_part
 
     def __call__(self, mbs, t: float) -> bool:
-        turn_columns(self.buffer, self.const, self.cos_part, self.sin_part, self.spin,
+        turn_columns(self.buffer, self.const, self.cos_part, self.sin_part, self.spin_index, self.spins, self.target,
                      self.drive_speed * ramp_state(t, self.ramp_time)[0])
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:

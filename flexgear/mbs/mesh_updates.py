@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.mbs.contacts import MeshFriction, StiffnessSchedule
 
-__all__ = ["MeshUpdates"]
+__all__ = ["MeshUpdates", "sparse_rows"]
 
 
 class MeshUpdates:
@@ -40,10 +40,11 @@ class MeshUpdates:
         self._force: np.ndarray | None = None
 
     def values_and_forces(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Stiffness factors of the schedule's variables and friction forces on the frames (compiled)."""
+        """Stiffness factors of the schedule's variables and friction forces on the frames (compiled; the
+        arrays are overwritten by the next call)."""
         head, tail = self._args
-        factors = self._kernel(float(t), *head, q, q_t, *tail)
-        return factors, self._force[:self._index[1].size]
+        self._kernel(float(t), *head, q, q_t, *tail)
+        return self._factors, self._force[:self._index[1].size]
 
     def reference(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Same as :meth:`values_and_forces` with the two parts' numpy reference implementations."""
@@ -59,19 +60,38 @@ class MeshUpdates:
                        np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
                                        for b in f.bodies]).astype(np.int64))
         self._force = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")))
+        self._factors = np.zeros(self.factor_rows.size)
+        columns, sliding, spin = sparse_rows(f.sliding_rows, f.spin_rows)
         from flexgear.laws.compiled import mesh_step
 
         # the kernel and its arguments, looked up once (this runs every step)
         self._kernel = mesh_step
         self._args = ((f.ramp_time, f.drive_speed, f.phase_rate, f.offsets),
-                      (*self._index, self.law, f._means, f._cos, f._sin, f.sliding_rows, f.spin_rows,
-                       self.factor_rows, self._force, f.law.kind == "iso6336"))
+                      (*self._index, self.law, f._means, f._cos, f._sin, columns, sliding, spin,
+                       self.factor_rows, self._force, self._factors, np.zeros(len(f.mu)), f.law.kind == "iso6336"))
+        self._set = [var.SetValue for var in self.schedule.variables]
 
     def __call__(self, mbs, t: float) -> bool:
         if self._index is None:
             self.bind(mbs)
-        factors, _ = self.values_and_forces(t, *self.friction.tooth_state(mbs))
-        for var, value in zip(self.schedule.variables, factors.tolist(), strict=True):
-            var.SetValue(value)
+        head, tail = self._args
+        self._kernel(t, *head, *self.friction.tooth_state(mbs), *tail)
+        for set_value, value in zip(self._set, self._factors.tolist(), strict=True):
+            set_value(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
         return True
+
+
+def sparse_rows(*rows: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The union of the nonzero columns of each row of the (n, m) matrices ``rows``, padded with -1, and every
+    matrix's entries there: ``columns`` (n, w) int64 and one (n, w) array per matrix (zero at the padding)."""
+    nonzero = np.any([r != 0.0 for r in rows], axis=0)
+    width = max(1, int(nonzero.sum(axis=1).max()))
+    columns = np.full((nonzero.shape[0], width), -1, dtype=np.int64)
+    values = [np.zeros((nonzero.shape[0], width)) for _ in rows]
+    for i, row in enumerate(nonzero):
+        cols = np.flatnonzero(row)
+        columns[i, :cols.size] = cols
+        for v, r in zip(values, rows, strict=True):
+            v[i, :cols.size] = r[i, cols]
+    return (columns, *values)
