@@ -100,6 +100,27 @@ def test_rigid_and_flexible_twins_carry_identical_mass_properties():
     assert np.abs(j_f - j_r).max() < 1e-9 * np.abs(j_r).max()
 
 
+def test_rigid_twins_read_the_cached_bodies_mass_properties():
+    """With the project's own (cached) reduced bodies a rigid component reads only its body's mass properties
+    from the cache file (no modes loaded): the same numbers as the whole body's, and the rigid planet of model 1
+    carries them."""
+    import exudyn as exu
+
+    from flexgear.fe.reduced import component_mass_properties, component_reduced_body
+    from flexgear.mbs.gearbox import build_star_gearbox
+
+    v = load_variant(VARIANTS / "model1.toml")
+    assert v.rigid_mass_properties == "mesh"
+    whole = component_reduced_body(v.gearbox, "planets", v.mesh_level).props
+    alone = component_mass_properties(v.gearbox, "planets", v.mesh_level)
+    assert alone.mass == whole.mass and np.array_equal(alone.com, whole.com)
+    assert np.array_equal(alone.inertia, whole.inertia)
+    mbs = exu.SystemContainer().AddSystem()
+    planet = build_star_gearbox(mbs, v).bodies["planet1"]
+    assert not planet.flexible and planet.props.mass == pytest.approx(whole.mass, rel=1e-12)
+    assert np.abs(planet.props.inertia - whole.inertia).max() <= 1e-12 * np.abs(whole.inertia).max()
+
+
 def test_generic_bolt_joints_beside_a_linear_sun_joint():
     """Model 4 with the ring on bolt patches: the sun's joint on the axis is linear (flexgear.mbs.joints), the
     ring's twelve bolt joints off the axis stay ObjectJointGeneric. Each gear's joints carry its shaft's torque:

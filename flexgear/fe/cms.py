@@ -39,6 +39,7 @@ from __future__ import annotations
 import io
 import time
 from dataclasses import dataclass, field, replace
+from pathlib import Path
 
 import numpy as np
 import scipy.linalg as la
@@ -299,6 +300,13 @@ class ReducedBody:
         buf = io.BytesIO()
         np.savez(buf, **arrays)
         return buf.getvalue()
+
+    @staticmethod
+    def load_mass_properties(path: str | Path) -> MassProperties:
+        """The mass properties of a body saved by :meth:`save`, read alone from its file (``np.load`` reads an
+        ``.npz`` member only when asked: a rigid twin needs three small arrays, not the modes)."""
+        with np.load(path, allow_pickle=False) as z:
+            return MassProperties(float(z["mass"]), z["com"], z["inertia"])
 
     @classmethod
     def load(cls, data: bytes | str) -> ReducedBody:

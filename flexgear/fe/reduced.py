@@ -33,11 +33,13 @@ from flexgear.fe.bolted import bolt_axes, clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.geometry.involute import gear_set_geometry, helix_halves, tooth_normal_local
 from flexgear.geometry.layout import component_layout, geometry_hash
+from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints", "gear_seat", "bolt_patches"]
+           "component_mass_properties", "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints",
+           "gear_seat", "bolt_patches"]
 
 """Variant component name -> geometry component name."""
 
@@ -204,8 +206,27 @@ def gear_seat(spec: GearboxSpec, body: ReducedBody, gear: str) -> Interface:
 def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",
                            progress: bool = False) -> ReducedBody:
     """The reduced flexible body of a component (cached): ``component`` as in Table 3 or the geometry."""
-    from flexgear.fe.reduced import cached_reduced_body
+    key, build = _component_reduction(spec, component, level, progress)
+    return cached_reduced_body(key, build)
 
+
+def component_mass_properties(spec: GearboxSpec, component: str, level: str = "coarse",
+                              progress: bool = False) -> MassProperties:
+    """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
+    when the body is there (a rigid twin needs no modes), else from the body built and cached."""
+    key, build = _component_reduction(spec, component, level, progress)
+    path = reduced_cache_path(key)
+    if path.exists():
+        try:
+            return ReducedBody.load_mass_properties(path)
+        except (OSError, ValueError, KeyError):
+            pass  # damaged entry: cached_reduced_body rebuilds it
+    return cached_reduced_body(key, build).props
+
+
+def _component_reduction(spec: GearboxSpec, component: str, level: str,
+                         progress: bool) -> tuple[str, Callable[[], ReducedBody]]:
+    """Cache key and build function of a component's reduced body (:func:`component_reduced_body`)."""
     name = COMPONENT_GEOMETRY[component]
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
@@ -234,7 +255,7 @@ def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coar
                       keep_modes=red.simulation_modes or None, load_circles=circles,
                       rigid=tuple(i.name for i in itfs if rigid and i.name.startswith("bolt_")))
 
-    return cached_reduced_body(f"{name}-{level}-{key}", build)
+    return f"{name}-{level}-{key}", build
 
 
 CACHE_FORMAT_VERSION = 1  # bump when ReducedBody's content or the reduction changes

@@ -121,10 +121,19 @@ def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
     return component_reduced_body(spec, component, level, progress=True)
 
 
-def _mass_source(variant: Variant, reduced: ReducedSource) -> MassSource:
-    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's."""
+def _default_mass_source(spec: GearboxSpec, component: str, level: str) -> MassProperties:
+    from flexgear.fe.reduced import component_mass_properties
+
+    return component_mass_properties(spec, component, level, progress=True)
+
+
+def _mass_source(variant: Variant, reduced: ReducedSource, default_bodies: bool) -> MassSource:
+    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's.
+    With the default reduced bodies (``default_bodies``) a rigid twin reads only its body's mass properties."""
     if variant.rigid_mass_properties == "exact":
         return _exact_mass_source
+    if default_bodies:
+        return lambda spec, component: _default_mass_source(spec, component, variant.mesh_level)
     return lambda spec, component: reduced(spec, component, variant.mesh_level).props
 
 
@@ -244,7 +253,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             loaded[component, level] = source(spec, component, level)
         return loaded[component, level]
 
-    props = mass_source or _mass_source(variant, reduced)
+    props = mass_source or _mass_source(variant, reduced, reduced_source is None)
     form = variant.components
     th = theory(spec)
     geo = gear_set_geometry(spec)
