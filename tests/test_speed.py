@@ -154,3 +154,35 @@ def test_matrix_orders_runs_by_flexible_bodies():
     counts = {p.stem: _flexible_bodies(load_variant(p)) for p in sorted(VARIANTS.glob("model*.toml"))}
     assert counts["model1"] == 0 and counts["model7"] == 9  # 2 shafts, sun, ring, 5 planets
     assert counts["model2"] == 5 and counts["model3"] == 2
+
+
+def test_matrix_orders_runs_by_their_dynamic_modes(monkeypatch, tmp_path):
+    """With the bodies cached, the matrix orders the runs by the sum over their flexible bodies of (dynamic modes)^2,
+    each count by the rule the build applies: a gear its modes below the cut-off, shafts and the bolted ring every
+    mode (checked against the whole reduced bodies loaded); with a body missing, by the flexible bodies' count."""
+    from flexgear.fe.reduced import bolt_patches, component_reduced_body
+    from flexgear.mbs.gearbox import dynamic_modes, run_cost
+    from flexgear.study.matrix import _run_order
+    from flexgear.theory import theory
+
+    variants = {p.stem: load_variant(p) for p in sorted(VARIANTS.glob("model*.toml"))}
+    spec = variants["model7"].gearbox
+    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * theory(spec).mesh_frequency
+    counts = {}
+    for component in ("input_shaft", "sun", "planets", "ring", "output_shaft"):
+        body = component_reduced_body(spec, component, variants["model7"].mesh_level)
+        geometry = "planet" if component == "planets" else component
+        counts[component] = dynamic_modes(spec, geometry, body.frequencies_hz, cutoff)
+        if component in ("input_shaft", "output_shaft") or (component == "ring" and bolt_patches(spec)):
+            assert counts[component] == body.n_modes
+        elif component in ("sun", "planets"):
+            assert 1 <= counts[component] == body.modes_below(cutoff) < body.n_modes
+    planets = spec.gears.planet_count
+    expected = sum(n * n * (planets if c == "planets" else 1) for c, n in counts.items())
+    assert run_cost(variants["model7"]) == pytest.approx(expected, rel=1e-12)
+    assert run_cost(variants["model1"]) == 0.0
+    order = _run_order(variants)
+    assert order[0] == "model7" and order[-1] == "model1"
+    monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path))  # nothing cached: the count of flexible bodies
+    assert run_cost(variants["model7"]) is None
+    assert _run_order(variants)[:1] == ["model7"] and _run_order(variants)[-1] == "model1"

@@ -308,6 +308,13 @@ class ReducedBody:
         with np.load(path, allow_pickle=False) as z:
             return MassProperties(float(z["mass"]), z["com"], z["inertia"])
 
+    @staticmethod
+    def load_frequencies(path: str | Path) -> np.ndarray:
+        """``frequencies_hz`` of a body saved by :meth:`save`, read alone from its file (see
+        :meth:`load_mass_properties`)."""
+        with np.load(path, allow_pickle=False) as z:
+            return np.asarray(z["frequencies_hz"], float)
+
     @classmethod
     def load(cls, data: bytes | str) -> ReducedBody:
         """Inverse of :meth:`save` (bytes or a file path)."""

@@ -38,8 +38,8 @@ from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "component_mass_properties", "COMPONENT_GEOMETRY", "JOINT_INTERFACES", "joint_point", "gear_shaft_joints",
-           "gear_seat", "bolt_patches"]
+           "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
+           "joint_point", "gear_shaft_joints", "gear_seat", "bolt_patches"]
 
 """Variant component name -> geometry component name."""
 
@@ -215,13 +215,25 @@ def component_mass_properties(spec: GearboxSpec, component: str, level: str = "c
     """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
     when the body is there (a rigid twin needs no modes), else from the body built and cached."""
     key, build = _component_reduction(spec, component, level, progress)
+    props = _read_cached(key, ReducedBody.load_mass_properties)
+    return props if props is not None else cached_reduced_body(key, build).props
+
+
+def cached_component_frequencies(spec: GearboxSpec, component: str, level: str = "coarse") -> np.ndarray | None:
+    """Free-free frequencies [Hz] of :func:`component_reduced_body`, read alone from the cache; None when the
+    body is not cached yet (nothing is built)."""
+    return _read_cached(_component_reduction(spec, component, level, False)[0], ReducedBody.load_frequencies)
+
+
+def _read_cached(key: str, read: Callable[[Path], object]) -> object | None:
+    """``read(path)`` of the reduced body cached under ``key``; None if it is missing or unreadable."""
     path = reduced_cache_path(key)
-    if path.exists():
-        try:
-            return ReducedBody.load_mass_properties(path)
-        except (OSError, ValueError, KeyError):
-            pass  # damaged entry: cached_reduced_body rebuilds it
-    return cached_reduced_body(key, build).props
+    if not path.exists():
+        return None
+    try:
+        return read(path)
+    except (OSError, ValueError, KeyError):
+        return None  # damaged entry: cached_reduced_body rebuilds it
 
 
 def _component_reduction(spec: GearboxSpec, component: str, level: str,

@@ -36,10 +36,10 @@ from flexgear.mbs.elements import (
     support_points,
 )
 from flexgear.mbs.train import add_gear_train
-from flexgear.spec import GearboxSpec, Variant
+from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory, theory
 
-__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"]
+__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "dynamic_modes", "run_cost"]
 
 
 @dataclass
@@ -141,6 +141,41 @@ GEARS = ("sun", "planet", "ring")
 """Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
 
 
+def dynamic_modes(spec: GearboxSpec, geometry: str, frequencies_hz: np.ndarray, cutoff_hz: float) -> int:
+    """How many of a component's modes (free-free ``frequencies_hz``, ascending) the time integration keeps: a gear
+    its modes below ``cutoff_hz`` (> 0; the rest return as residual compliance, flexgear.mbs.residual), at least
+    one (the floating-frame object needs one); a shaft, and a ring on bolt patches, every mode (the ring's twelve
+    6-DOF joints need the patches' static modes: on the modes below the cut-off they are redundant and the solver
+    fails)."""
+    from flexgear.fe.reduced import bolt_patches
+
+    n = len(frequencies_hz)
+    if cutoff_hz <= 0 or geometry not in GEARS or (geometry == "ring" and bolt_patches(spec)):
+        return n
+    return max(1, int(np.count_nonzero(np.asarray(frequencies_hz) < cutoff_hz)))
+
+
+def run_cost(variant: Variant) -> float | None:
+    """An estimate of a variant's run time in arbitrary units, to order the runs of a matrix longest first: the sum
+    over its flexible bodies of (dynamic modes)^2 (each body's dense modal matrices and the constraint columns it
+    feeds grow with it), from the cached reduced bodies' frequencies; None if one of them is not cached yet."""
+    from flexgear.fe.reduced import cached_component_frequencies
+
+    spec = variant.gearbox
+    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * theory(spec).mesh_frequency
+    cost = 0.0
+    for component, form in variant.components.items():
+        if form != "flexible":
+            continue
+        frequencies = cached_component_frequencies(spec, component, variant.mesh_level)
+        if frequencies is None:
+            return None
+        geometry = COMPONENT_GEOMETRY[component]
+        count = spec.gears.planet_count if component == "planets" else 1
+        cost += count * float(dynamic_modes(spec, geometry, frequencies, cutoff)) ** 2
+    return cost
+
+
 def _linear_joints(spec: GearboxSpec) -> bool:
     """Whether the gears' joints to their shafts are linear constraints (flexgear.mbs.joints), on the axis or off
     it (bolt patches): ``[joints_assumed] joint_equations``."""
@@ -188,13 +223,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if spec.reduction_assumed.modal_coordinates != "interface":
         coordinates = []
     full = reduced(spec, geometry, level)
-    # a ring on bolt patches keeps its whole basis: its twelve 6-DOF joints need the patches' static modes (on
-    # the modes below the cut-off they are redundant and the solver fails); at least one dynamic mode: the
-    # floating-frame object needs one
-    from flexgear.fe.reduced import bolt_patches
-
-    truncate = cutoff_hz > 0 and geometry in GEARS and not (geometry == "ring" and bolt_patches(spec))
-    keep = max(1, full.modes_below(cutoff_hz)) if truncate else full.n_modes
+    keep = dynamic_modes(spec, geometry, full.frequencies_hz, cutoff_hz)
     kept = full.truncated(keep) if keep < full.n_modes else full
     sensing = None
     if coordinates and geometry in GEARS and kept.n_modes > 6 * len(coordinates):  # room beside the interfaces

@@ -243,9 +243,22 @@ def _check_reference(reference: str, names: Sequence[str]) -> None:
 
 
 def _flexible_bodies(variant: Variant) -> int:
-    """Flexible bodies of a variant (planets count each): the measure of its run time used to order the runs."""
+    """Flexible bodies of a variant (planets count each): the measure of its run time used to order the runs
+    when their reduced bodies are not cached yet (:func:`_run_order`)."""
     planets = variant.gearbox.gears.planet_count
     return sum((planets if c == "planets" else 1) for c, form in variant.components.items() if form == "flexible")
+
+
+def _run_order(variants: dict[str, Variant]) -> list[str]:
+    """Names longest run first (the last runs then overlap): by flexgear.mbs.gearbox.run_cost (the flexible
+    bodies' dynamic modes, squared and summed) when every variant's bodies are cached, else by the count of
+    flexible bodies. Stable for ties."""
+    from flexgear.mbs.gearbox import run_cost
+
+    costs = {name: run_cost(v) for name, v in variants.items()}
+    if any(c is None for c in costs.values()):
+        costs = {name: float(_flexible_bodies(v)) for name, v in variants.items()}
+    return sorted(variants, key=lambda name: -costs[name])
 
 
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
@@ -269,7 +282,7 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     metas: dict[str, dict] = {}
     resumed: set[str] = set()
     tasks: list[RunTask] = []
-    cost: dict[str, int] = {}
+    pending: dict[str, Variant] = {}
     settings: ScreeningSettings | None = None
     for path in map(Path, variant_paths):
         try:
@@ -298,8 +311,9 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
                 _say(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
                 continue
         tasks.append(task)
-        cost[name] = _flexible_bodies(variant)
-    tasks.sort(key=lambda t: -cost[t.name])  # longest first: the last runs overlap (stable for ties)
+        pending[name] = variant
+    order = {name: k for k, name in enumerate(_run_order(pending))}
+    tasks.sort(key=lambda t: order[t.name])
     _check_reference(reference if reference is not None else (settings.reference if settings else ""), names)
     metas.update(_execute(tasks, workers, scheduler, runner, out_dir, progress))
     table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])
