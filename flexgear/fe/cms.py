@@ -316,7 +316,7 @@ class ReducedBody:
             return np.asarray(z["frequencies_hz"], float)
 
     @classmethod
-    def load(cls, data: bytes | str) -> ReducedBody:
+    def load(cls, data: bytes | str | Path) -> ReducedBody:
         """Inverse of :meth:`save` (bytes or a file path)."""
         with np.load(io.BytesIO(data) if isinstance(data, bytes) else data, allow_pickle=False) as z:
             itfs = [Interface(str(nm), z[f"itf{k}_nodes"], z[f"itf{k}_weights"], z[f"itf{k}_point"])

@@ -288,7 +288,7 @@ def cached_reduced_body(key: str, build: Callable[[], ReducedBody],
     path = reduced_cache_path(key, directory)
     if path.exists():
         try:
-            return ReducedBody.load(path.read_bytes())
+            return ReducedBody.load(path)  # np.load reads each member from the file: no copy of the whole file
         except (OSError, ValueError, KeyError):
             pass  # damaged entry: rebuild and overwrite
     body = build()

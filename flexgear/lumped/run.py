@@ -134,12 +134,31 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
 
 
 # --------------------------------------------------------------------------- compiled kernel
+_TANH_SATURATION = 19.1
+"""|x| beyond which tanh(x) rounds to +-1 in double precision (1 - tanh(19.1) = 5e-17 < 2^-53)."""
+
+
 @numba.njit(cache=True)
-def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef, harm, pcentre,
-              pidx, pcoefm, poff,
-              backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal, movable, q, qd, acc, f, forces,
-              out):
-    """Accelerations ``acc`` (all coordinates, rotating frame), forces and the recorded signals ``out``."""
+def _tanh(x: float) -> float:  # pragma: no cover - compiled
+    """tanh(x), exact in double precision, without the call where it saturates (the friction direction at speed)."""
+    if x > _TANH_SATURATION:
+        return 1.0
+    if x < -_TANH_SATURATION:
+        return -1.0
+    return math.tanh(x)
+
+
+@numba.njit(cache=True, inline="always")  # inlined into _integrate's RK4 stages (no 35-array call per stage)
+def _evaluate(t, y, model, work):
+    """Accelerations ``acc`` (all coordinates, rotating frame), forces and the recorded signals ``out``.
+
+    ``model``: the arrays of :func:`_kernel_args`; ``work``: (q, qd, acc, f, forces, out), written. Two tuples, not
+    35 arguments: a call of more than 30 arguments compiles to a star-args call, which numba cannot inline.
+    """
+    (fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef, harm, pcentre, pidx, pcoefm,
+     poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal, movable, group, gidx_q, grate,
+     rot_b) = model
+    q, qd, acc, f, forces, out, trig = work
     n = mass.size
     nf = free.size
     th_in, s, sd, sdd = ramp_state(t, fp[_T_RAMP])
@@ -167,6 +186,9 @@ def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm
     f[ip[_OUT_SPIN]] += fp[_LOAD_SIGN] * fp[_T_LOAD] * s
     mu = fp[_MU]
     npts = tables.shape[1]
+    for k in range(grate.size):  # A_g of each phase group (_phase_groups)
+        a = 2.0 * math.pi * grate[k] * q[gidx_q[k]]
+        trig[0, k], trig[1, k] = math.cos(a), math.sin(a)
     for m in range(km.size):
         d = 0.0
         dd = 0.0
@@ -175,24 +197,30 @@ def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm
             dd += gval[m, k] * qd[gidx[m, k]]
         phase = pcoefm[m] * q[pidx[m]] + poff[m]
         kf = 1.0
+        ca, sa = trig[0, group[m]], trig[1, group[m]]  # x = 2 pi (phase - centre) = A_g + B_m
+        c1, s1 = ca * rot_b[0, m] - sa * rot_b[1, m], sa * rot_b[0, m] + ca * rot_b[1, m]
+        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence
         for h in range(harm.shape[1]):
-            kf += harm[m, h] * math.cos(2.0 * math.pi * (h + 1) * (phase - pcentre[m]))
+            kf += harm[m, h] * ch
+            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
         F = backlash_linear_force(d, dd, km[m] * kf, cm[m], backlash[m])
         forces[m] = F
         for k in range(gidx.shape[1]):
             f[gidx[m, k]] -= F * gval[m, k]
         if mu > 0.0 and F > 0.0:
-            ph = (phase - math.floor(phase)) * npts
-            i0 = int(ph) % npts
-            i1 = (i0 + 1) % npts
-            wt = ph - math.floor(ph)
+            ph = (phase - math.floor(phase)) * npts  # in [0, npts]: the table's periodic index without a division
+            i0 = int(ph)
+            wt = ph - i0
+            if i0 >= npts:  # phase - floor(phase) rounded to 1
+                i0 -= npts
+            i1 = i0 + 1 if i0 + 1 < npts else 0
             ty = mtype[m]
             fa = tables[ty, i0, 0] * (1.0 - wt) + tables[ty, i1, 0] * wt
             a1 = tables[ty, i0, 1] * (1.0 - wt) + tables[ty, i1, 1] * wt
             a2 = tables[ty, i0, 2] * (1.0 - wt) + tables[ty, i1, 2] * wt
             b1 = 0 if ty == 0 else 3 + m - km.size // 2
             b2 = 3 + m if ty == 0 else 1
-            ff = mu * F * math.tanh(g1[m] * qd[3 * b1 + 2] * fscale[m])
+            ff = mu * F * _tanh(g1[m] * qd[3 * b1 + 2] * fscale[m])
             f[3 * b2] += ff * fa * tau[m, 0]
             f[3 * b2 + 1] += ff * fa * tau[m, 1]
             f[3 * b1] -= ff * fa * tau[m, 0]
@@ -227,17 +255,13 @@ def _evaluate(t, y, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm
 
 
 @numba.njit(cache=True)
-def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free,
-               presc, pcoef, harm,
-               pcentre, pidx, pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
-               movable):
+def _integrate(y, t0, h_out, n_out, substeps, rec, model):
     """RK4 from t0 over n_out recorded steps; rec[k] = signals at t0 + k h_out. Returns the final state."""
-    n = mass.size
+    n, nm, free = model[2].size, model[9].size, model[11]
     nf = free.size
-    nm = km.size
-    q, qd, acc, f = np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n)
-    forces = np.zeros(nm)
-    out = np.zeros(7)
+    work = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(nm), np.zeros(7),
+            np.zeros((2, model[31].size)))  # as _work(model)
+    acc, forces, out = work[2], work[4], work[5]
     kk = np.zeros((4, 2 * nf))
     ytmp = np.zeros(2 * nf)
     h = h_out / substeps
@@ -252,20 +276,17 @@ def _integrate(y, t0, h_out, n_out, substeps, rec, fp, ip, mass, sp_ptr, sp_idx,
                     ts = t + (h if stage == 3 else 0.5 * h)
                     fac = h if stage == 3 else 0.5 * h
                     for i in range(2 * nf):
-                        ytmp[i] = y[i] + fac * kk[stage - 1][i]
-                _evaluate(ts, ytmp, fp, ip, mass, sp_ptr, sp_idx, sp_k, sp_c, gidx, gval, km, cm, free, presc, pcoef,
-                          harm, pcentre, pidx,
-                          pcoefm, poff, backlash, tables, mtype, tau, g1, fscale, ground, spin_support, nominal,
-                          movable, q, qd, acc, f, forces, out)
+                        ytmp[i] = y[i] + fac * kk[stage - 1, i]
+                _evaluate(ts, ytmp, model, work)
                 if stage == 0 and sub == 0:
                     rec[step, 0:3] = out[0:3]
                     rec[step, 3:3 + nm] = forces
                     rec[step, 3 + nm:7 + nm] = out[3:7]
                 for i in range(nf):
-                    kk[stage][i] = ytmp[nf + i]
-                    kk[stage][nf + i] = acc[free[i]]
+                    kk[stage, i] = ytmp[nf + i]
+                    kk[stage, nf + i] = acc[free[i]]
             for i in range(2 * nf):
-                y[i] += h / 6.0 * (kk[0][i] + 2.0 * kk[1][i] + 2.0 * kk[2][i] + kk[3][i])
+                y[i] += h / 6.0 * (kk[0, i] + 2.0 * kk[1, i] + 2.0 * kk[2, i] + kk[3, i])
     return y
 
 
@@ -288,6 +309,20 @@ def _sparse_mesh_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return idx, val
 
 
+def _phase_groups(model: LumpedModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The meshes' stiffness-series angle x_m = 2 pi (c_m q[i_m] + offset_m - centre_m) split as A_g + B_m: A_g =
+    2 pi c q[i] shared by the meshes g with the same coordinate i and rate c (the star's five sun-planet meshes),
+    B_m constant. Returns the group of each mesh, each group's (coordinate, rate) and cos B_m, sin B_m: the kernel
+    then takes one cosine and sine per group, not per mesh (angle addition)."""
+    keys = list(zip(model.phase_index.tolist(), model.phase_coef.tolist(), strict=True))
+    unique = list(dict.fromkeys(keys))
+    group = np.array([unique.index(k) for k in keys], dtype=np.int64)
+    index = np.array([k[0] for k in unique], dtype=np.int64)
+    rate = np.array([k[1] for k in unique], dtype=float)
+    b = 2.0 * np.pi * (model.phase_offset - model.phase_centre)
+    return group, np.ascontiguousarray(index), rate, np.ascontiguousarray(np.stack([np.cos(b), np.sin(b)]))
+
+
 def _kernel_args(model: LumpedModel) -> tuple:
     s = model.system
     return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
@@ -295,7 +330,14 @@ def _kernel_args(model: LumpedModel) -> tuple:
             s.mesh_damping, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
             model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
             model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
-            s.nominal_position, s.free & (s.mass > 0.0))
+            s.nominal_position, s.free & (s.mass > 0.0), *_phase_groups(model))
+
+
+def _work(model: LumpedModel) -> tuple:
+    """The kernel's work arrays (q, qd, acc, f, forces, out, each phase group's cos and sin): :func:`_evaluate`."""
+    n, nm = model.system.mass.size, model.system.mesh_stiffness.size
+    groups = len(set(zip(model.phase_index.tolist(), model.phase_coef.tolist(), strict=True)))
+    return (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(nm), np.zeros(7), np.zeros((2, groups)))
 
 
 def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, progress: bool) -> np.ndarray:
@@ -310,10 +352,10 @@ def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, pro
     with Progress(t_end, "lumped", "s", enabled=progress, fmt="{:.4g}") as bar:
         while done < n_steps:
             k = min(chunk, n_steps - done)
-            y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], *args)
+            y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], args)
             done += k
             bar.update_to(done * h_out)
-    _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], *args)  # record the final state
+    _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], args)  # record the final state
     return rec
 
 
@@ -372,12 +414,11 @@ class LumpedRHS:
     def __init__(self, model: LumpedModel, kernel: Callable | None = None):
         self.model, self.args = model, _kernel_args(model)
         self.kernel = _evaluate if kernel is None else kernel
-        n, nm = model.system.mass.size, model.system.mesh_stiffness.size
         self.nf = model.free.size
-        self._work = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(nm), np.zeros(7))
+        self._work = _work(model)
 
     def _eval(self, t: float, y: np.ndarray) -> None:
-        self.kernel(float(t), np.ascontiguousarray(y, dtype=float), *self.args, *self._work)
+        self.kernel(float(t), np.ascontiguousarray(y, dtype=float), self.args, self._work)
 
     def __call__(self, t: float, y: np.ndarray) -> np.ndarray:
         self._eval(t, y)
