@@ -301,20 +301,6 @@ class ReducedBody:
         np.savez(buf, **arrays)
         return buf.getvalue()
 
-    @staticmethod
-    def load_mass_properties(path: str | Path) -> MassProperties:
-        """The mass properties of a body saved by :meth:`save`, read alone from its file (``np.load`` reads an
-        ``.npz`` member only when asked: a rigid twin needs three small arrays, not the modes)."""
-        with np.load(path, allow_pickle=False) as z:
-            return MassProperties(float(z["mass"]), z["com"], z["inertia"])
-
-    @staticmethod
-    def load_frequencies(path: str | Path) -> np.ndarray:
-        """``frequencies_hz`` of a body saved by :meth:`save`, read alone from its file (see
-        :meth:`load_mass_properties`)."""
-        with np.load(path, allow_pickle=False) as z:
-            return np.asarray(z["frequencies_hz"], float)
-
     @classmethod
     def load(cls, data: bytes | str | Path) -> ReducedBody:
         """Inverse of :meth:`save` (bytes or a file path)."""

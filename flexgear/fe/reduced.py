@@ -215,14 +215,27 @@ def component_mass_properties(spec: GearboxSpec, component: str, level: str = "c
     """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
     when the body is there (a rigid twin needs no modes), else from the body built and cached."""
     key, build = _component_reduction(spec, component, level, progress)
-    props = _read_cached(key, ReducedBody.load_mass_properties)
+    props = _read_cached(key, _load_mass_properties)
     return props if props is not None else cached_reduced_body(key, build).props
 
 
 def cached_component_frequencies(spec: GearboxSpec, component: str, level: str = "coarse") -> np.ndarray | None:
     """Free-free frequencies [Hz] of :func:`component_reduced_body`, read alone from the cache; None when the
     body is not cached yet (nothing is built)."""
-    return _read_cached(_component_reduction(spec, component, level, False)[0], ReducedBody.load_frequencies)
+    return _read_cached(_component_reduction(spec, component, level, False)[0], _load_frequencies)
+
+
+def _load_mass_properties(path: Path) -> MassProperties:
+    """The mass properties of a body saved by ReducedBody.save, read alone from its file (``np.load`` reads an
+    ``.npz`` member only when asked: a rigid twin needs three small arrays, not the modes)."""
+    with np.load(path, allow_pickle=False) as z:
+        return MassProperties(float(z["mass"]), z["com"], z["inertia"])
+
+
+def _load_frequencies(path: Path) -> np.ndarray:
+    """``frequencies_hz`` of a body saved by ReducedBody.save, read alone from its file."""
+    with np.load(path, allow_pickle=False) as z:
+        return np.asarray(z["frequencies_hz"], float)
 
 
 def _read_cached(key: str, read: Callable[[Path], object]) -> object | None:
