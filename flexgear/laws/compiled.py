@@ -12,7 +12,7 @@ import numpy as np
 from numba import njit
 
 __all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces",
-           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step"]
+           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step", "padded_sparse_rows"]
 
 
 @njit(cache=True)
@@ -161,8 +161,8 @@ def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law,
     deflection coordinates, ``frames``: the bodies' frame coordinates; ``law`` rows: stiffness,
     exponent, damping_max, penetration depth, mu, v_reg. The sliding and spin rows of contact i are sparse
     (each touches the 12 frame coordinates of its two gears): ``sliding[i, k]``, ``spin[i, k]`` are their
-    entries at frame coordinate ``columns[i, k]`` (-1: padding). Same numbers as :func:`periodic_values` plus
-    :func:`mesh_friction_forces` with the dense rows.
+    entries at frame coordinate ``columns[i, k]`` (:func:`padded_sparse_rows`). Same numbers as
+    :func:`periodic_values` plus :func:`mesh_friction_forces` with the dense rows.
     """
     theta = drive_speed * ramp_state(t, ramp_time)[0]
     n_c, n_h = cos_c.shape[1], cos_c.shape[2]
@@ -186,11 +186,25 @@ def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law,
             normal = impact_normal_force(d, d_t, law[0, i] * v0, law[1, i], law[2, i], law[3, i])
         spin_rate = 0.0
         for k in range(columns.shape[1]):
-            if columns[i, k] >= 0:
-                spin_rate += spin[i, k] * q_t[frames[columns[i, k]]]
+            spin_rate += spin[i, k] * q_t[frames[columns[i, k]]]
         f = law[4, i] * normal * math.tanh(spin_rate * means[2, i] / law[5, i])
         for k in range(columns.shape[1]):
-            if columns[i, k] >= 0:
-                force[columns[i, k]] -= sliding[i, k] * (f * v1) + spin[i, k] * (f * v2)
+            force[columns[i, k]] -= sliding[i, k] * (f * v1) + spin[i, k] * (f * v2)
     for k in range(factor_rows.size):
         factors[k] = work[factor_rows[k]]
+
+
+def padded_sparse_rows(*rows: np.ndarray) -> tuple[np.ndarray, ...]:
+    """The kernels' layout of sparse rows: for (n, m) matrices ``rows`` of one pattern, the union of each row's
+    nonzero columns, padded (column 0, value 0: a padded entry adds exactly nothing) to equal width, and each
+    matrix's entries there. Returns ``columns`` (n, w) int64 and one (n, w) array per matrix."""
+    nonzero = np.any([r != 0.0 for r in rows], axis=0)
+    width = max(1, int(nonzero.sum(axis=1).max()))
+    columns = np.zeros((nonzero.shape[0], width), dtype=np.int64)
+    values = [np.zeros((nonzero.shape[0], width)) for _ in rows]
+    for i, row in enumerate(nonzero):
+        cols = np.flatnonzero(row)
+        columns[i, :cols.size] = cols
+        for v, r in zip(values, rows, strict=True):
+            v[i, :cols.size] = r[i, cols]
+    return (columns, *values)

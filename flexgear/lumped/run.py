@@ -38,7 +38,7 @@ import numpy as np
 import pandas as pd
 
 from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
-from flexgear.laws.compiled import backlash_linear_force, ramp_state
+from flexgear.laws.compiled import backlash_linear_force, padded_sparse_rows, ramp_state
 from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
@@ -255,13 +255,12 @@ def _evaluate(t, y, model, work):
 
 
 @numba.njit(cache=True)
-def _integrate(y, t0, h_out, n_out, substeps, rec, model):
+def _integrate(y, t0, h_out, n_out, substeps, rec, model, work):
     """RK4 from t0 over n_out recorded steps; rec[k] = signals at t0 + k h_out. Returns the final state."""
-    n, nm, free = model[2].size, model[9].size, model[11]
+    free = model[11]
     nf = free.size
-    work = (np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(n), np.zeros(nm), np.zeros(7),
-            np.zeros((2, model[31].size)))  # as _work(model)
-    acc, forces, out = work[2], work[4], work[5]
+    acc, forces, out = work[2], work[4], work[5]  # work: _work(model)
+    nm = forces.size
     kk = np.zeros((4, 2 * nf))
     ytmp = np.zeros(2 * nf)
     h = h_out / substeps
@@ -298,17 +297,6 @@ def _sparse_rows(*mats: np.ndarray) -> tuple[np.ndarray, ...]:
     return (ptr, cols.astype(np.int64), *[np.ascontiguousarray(m[rows, cols]) for m in mats])
 
 
-def _sparse_mesh_rows(G: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Non-zero columns of each mesh row, padded (index 0, value 0) to equal length."""
-    width = max(1, int((G != 0.0).sum(1).max()))
-    idx = np.zeros((G.shape[0], width), dtype=np.int64)
-    val = np.zeros((G.shape[0], width))
-    for m, row in enumerate(G):
-        nz = np.flatnonzero(row)
-        idx[m, :nz.size], val[m, :nz.size] = nz, row[nz]
-    return idx, val
-
-
 def _phase_groups(model: LumpedModel) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """The meshes' stiffness-series angle x_m = 2 pi (c_m q[i_m] + offset_m - centre_m) split as A_g + B_m: A_g =
     2 pi c q[i] shared by the meshes g with the same coordinate i and rate c (the star's five sun-planet meshes),
@@ -326,7 +314,7 @@ def _phase_groups(model: LumpedModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
 def _kernel_args(model: LumpedModel) -> tuple:
     s = model.system
     return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
-            *_sparse_mesh_rows(s.mesh_G), s.mesh_stiffness,
+            *padded_sparse_rows(s.mesh_G), s.mesh_stiffness,
             s.mesh_damping, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
             model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
             model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
@@ -346,16 +334,16 @@ def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, pro
     nm = model.system.mesh_stiffness.size
     rec = np.zeros((n_steps + 1, 7 + nm))
     y = np.zeros(2 * model.free.size)
-    args = _kernel_args(model)
+    args, work = _kernel_args(model), _work(model)
     chunk = max(1, n_steps // 20)
     done = 0
     with Progress(t_end, "lumped", "s", enabled=progress, fmt="{:.4g}") as bar:
         while done < n_steps:
             k = min(chunk, n_steps - done)
-            y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], args)
+            y = _integrate(y, done * h_out, h_out, k, substeps, rec[done:done + k], args, work)
             done += k
             bar.update_to(done * h_out)
-    _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], args)  # record the final state
+    _integrate(y, n_steps * h_out, h_out, 1, 1, rec[n_steps:n_steps + 1], args, work)  # record the final state
     return rec
 
 

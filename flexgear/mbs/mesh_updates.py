@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.mbs.contacts import MeshFriction, StiffnessSchedule
 
-__all__ = ["MeshUpdates", "sparse_rows"]
+__all__ = ["MeshUpdates"]
 
 
 class MeshUpdates:
@@ -61,8 +61,9 @@ class MeshUpdates:
                                        for b in f.bodies]).astype(np.int64))
         self._force = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")))
         self._factors = np.zeros(self.factor_rows.size)
-        columns, sliding, spin = sparse_rows(f.sliding_rows, f.spin_rows)
-        from flexgear.laws.compiled import mesh_step
+        from flexgear.laws.compiled import mesh_step, padded_sparse_rows
+
+        columns, sliding, spin = padded_sparse_rows(f.sliding_rows, f.spin_rows)
 
         # the kernel and its arguments, looked up once (this runs every step)
         self._kernel = mesh_step
@@ -81,17 +82,3 @@ class MeshUpdates:
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
         return True
 
-
-def sparse_rows(*rows: np.ndarray) -> tuple[np.ndarray, ...]:
-    """The union of the nonzero columns of each row of the (n, m) matrices ``rows``, padded with -1, and every
-    matrix's entries there: ``columns`` (n, w) int64 and one (n, w) array per matrix (zero at the padding)."""
-    nonzero = np.any([r != 0.0 for r in rows], axis=0)
-    width = max(1, int(nonzero.sum(axis=1).max()))
-    columns = np.full((nonzero.shape[0], width), -1, dtype=np.int64)
-    values = [np.zeros((nonzero.shape[0], width)) for _ in rows]
-    for i, row in enumerate(nonzero):
-        cols = np.flatnonzero(row)
-        columns[i, :cols.size] = cols
-        for v, r in zip(values, rows, strict=True):
-            v[i, :cols.size] = r[i, cols]
-    return (columns, *values)
