@@ -1,11 +1,12 @@
 """Dynamic cut-off and floating-frame formulation against the reference: cost and agreement (issues 13 and 16).
 
 Run: nice -n 5 python benchmarks/bench_residual.py [--case model4] [--cuts 0 4 8] [--frames ffrf linear]
-     [--law impact] [--ramp 0.006] [--t-end 0.024] [--window 0.012] [--step 1e-5]
+     [--seat-loads dynamic quasi_static] [--law impact] [--ramp 0.006] [--t-end 0.024] [--window 0.012] [--step 1e-5]
 
 Each cut-off (gearbox.toml [reduction_assumed] dynamic_cutoff_mesh_orders; 0 = every mode of the converged
 basis dynamic) with each floating frame (``floating_frame``: "ffrf" Exudyn's nonlinear terms, "linear"
-flexgear.mbs.spin) runs the variant on a shortened load case; the first pair is the reference. Printed: the
+flexgear.mbs.spin) and each seat load of the dropped modes (``residual_seat_loads``) runs the variant on a
+shortened load case; the first case is the reference. Printed: the
 dynamic modes per gear, the solve's CPU time, and against the reference the worst relative difference of the
 means and of the 1x mesh amplitudes of every signal over the window (flexgear.study.agreement, issue 16's
 rule: 0.1 % and 2 %), with the worst signals named.
@@ -34,6 +35,7 @@ def main() -> None:
     ap.add_argument("--case", default="model4")
     ap.add_argument("--cuts", type=float, nargs="+", default=[0.0, 4.0, 8.0])
     ap.add_argument("--frames", nargs="+", default=["ffrf"], choices=["ffrf", "linear"])
+    ap.add_argument("--seat-loads", nargs="+", default=["dynamic"], choices=["dynamic", "quasi_static"])
     ap.add_argument("--law", default="impact", choices=["impact", "iso6336"])
     ap.add_argument("--ramp", type=float, default=0.006, help="ramp time [s] of the shortened load case")
     ap.add_argument("--t-end", type=float, default=0.024, help="simulated time [s]")
@@ -48,29 +50,33 @@ def main() -> None:
     print(f"bench_residual: {a.case}, law {a.law}, ramp {a.ramp} s, {a.t_end} s simulated, step {lc.step_size_s} s, "
           f"window from {a.window} s, mesh frequency {f_mesh:.0f} Hz; {load_average()}", flush=True)
     runs = {}
-    cases = [(cut, frame) for cut in a.cuts for frame in a.frames]
-    for cut, frame in cases:
-        red = dataclasses.replace(g.reduction_assumed, dynamic_cutoff_mesh_orders=cut, floating_frame=frame)
+    cases = [(cut, frame, seat) for cut in a.cuts for frame in a.frames for seat in a.seat_loads]
+    for cut, frame, seat in cases:
+        red = dataclasses.replace(g.reduction_assumed, dynamic_cutoff_mesh_orders=cut, floating_frame=frame,
+                                  residual_seat_loads=seat)
         spec = g.with_changes(load_case=lc, reduction_assumed=red, contact=dataclasses.replace(g.contact, law=a.law))
         c0 = time.process_time()
         run = run_variant(dataclasses.replace(v, gearbox=spec))
         cpu = time.process_time() - c0
-        runs[cut, frame] = run
+        runs[cut, frame, seat] = run
         label = "every mode" if cut == 0 else f"below {cut:g} x f_mesh = {cut * f_mesh / 1e3:.1f} kHz"
         bodies = {gear: component_reduced_body(g, gear, v.mesh_level) for gear in ("sun", "planet", "ring")}
         label += ": " + ", ".join(f"{gear} {b.modes_below(cut * f_mesh) if cut else b.n_modes}/{b.n_modes}"
                                   for gear, b in bodies.items())
-        print(f"  cut-off {cut:4g}, {frame} ({label}): {'ok' if run.ok else 'FAILED ' + str(run.meta.get('reason'))}, "
+        print(f"  cut-off {cut:4g}, {frame}, seat loads {seat} ({label}): "
+              f"{'ok' if run.ok else 'FAILED ' + str(run.meta.get('reason'))}, "
               f"cpu {cpu:7.1f} s", flush=True)
     ref = runs[cases[0]]
-    for cut, frame in cases[1:]:
-        if not (ref.ok and runs[cut, frame].ok):
+    for case in cases[1:]:
+        if not (ref.ok and runs[case].ok):
             continue
-        agr = signal_agreement(ref, runs[cut, frame], (a.window, a.t_end), f_mesh)
+        cut, frame, seat = case
+        agr = signal_agreement(ref, runs[case], (a.window, a.t_end), f_mesh)
         t = agr.table
         worst_amp = t["amp_diff"].abs().sort_values(ascending=False).head(3)
         worst_mean = t["mean_diff"].abs().sort_values(ascending=False).head(3)
-        print(f"  cut-off {cut:g}, {frame} vs {cases[0][0]:g}, {cases[0][1]}: worst mean {agr.worst_mean:.2e} "
+        print(f"  cut-off {cut:g}, {frame}, {seat} vs {cases[0][0]:g}, {cases[0][1]}, {cases[0][2]}: "
+              f"worst mean {agr.worst_mean:.2e} "
               f"({', '.join(f'{k} {x:.1e}' for k, x in worst_mean.items())}); worst 1x amplitude "
               f"{agr.worst_amplitude:.2e} ({', '.join(f'{k} {x:.1e}' for k, x in worst_amp.items())}); "
               f"issue 16 rule {'met' if agr.ok() else 'not met'}", flush=True)

@@ -87,14 +87,17 @@ def _body_geometry(name: str) -> str:
 
 
 def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarray],
-                            residual: np.ndarray | None = None) -> dict[str, np.ndarray]:
+                            residual: np.ndarray | None = None,
+                            seat_residual: np.ndarray | None = None) -> dict[str, np.ndarray]:
     """Columns ``{outer,inner}_deflection_{load,centrifugal}_{i}_m`` of the flexible gears (module docstring).
 
     ``modal``: {body name: (n_times, n_modes) modal coordinates}. Gear spin angles are the nominal ones
     (spin per drive angle x prescribed angle), as the contact kinematics uses them. ``residual``: (n_times,
     n) residual deflections e of the contacts ``model.residual.rows`` (flexgear.mbs.residual: the static,
     seat-relative answer of the modes above the dynamic cut-off to the mesh forces and the spin); they add
-    to the load and centrifugal parts.
+    to the load and centrifugal parts. ``seat_residual``: (n_times, 6 n_seats) the seat motions e_s of
+    ``model.residual.seat_bodies`` (ground axes, at their bearing centres), whose gears' e are relative to their
+    frames: their contacts' deflections are taken relative to the seat through the rigid lever (n, (x - c) x n).
     """
     kin = model.kinematics
     lc = model.spec.load_case
@@ -143,6 +146,7 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
         # the residual coordinates carry the dropped modes' free centrifugal yield y; the split takes the whole
         # basis' joint-held answer instead (flexgear.mbs.residual: y')
         centrifugal[:, rows] -= (rate ** 2)[:, None] * model.residual.split_yield_per_drive_speed2[rows][None, :]
+        _seat_relative(model, total, centrifugal, rate, seat_residual)
     out = {}
     for kind in ("outer", "inner"):
         groups: dict[int, list[int]] = {}
@@ -155,6 +159,25 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             out[f"{kind}_deflection_load_{i}_m"] = -total[:, rows].mean(1) - cent
             out[f"{kind}_deflection_centrifugal_{i}_m"] = cent
     return out
+
+
+def _seat_relative(model, total: np.ndarray, centrifugal: np.ndarray, rate: np.ndarray,
+                   seat_residual: np.ndarray | None) -> None:
+    """Subtract the seats' residual motion e_s (seat_bodies' contacts, mesh_deflection_signals) in place."""
+    res = model.residual
+    if not res.seat_bodies:
+        return
+    split = res.split_yield_per_drive_speed2[res.n_contacts:]
+    for s, (name, centre) in enumerate(zip(res.seat_bodies, res.seat_centres, strict=True)):
+        cols = slice(6 * s, 6 * s + 6)
+        for j, contact in enumerate(model.contacts):
+            sign = 1.0 if contact.body1 == name else -1.0 if contact.body2 == name else 0.0
+            if sign == 0.0:
+                continue
+            nrm = np.asarray(contact.normal, float)
+            lever = np.concatenate([nrm, np.cross(np.asarray(contact.point, float) - centre, nrm)])
+            total[:, j] -= sign * seat_residual[:, cols] @ lever
+            centrifugal[:, j] -= sign * (rate ** 2) * (split[cols] @ lever)
 
 
 def _column_row(kin, contact: int, body: str) -> int:

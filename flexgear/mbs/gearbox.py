@@ -66,6 +66,7 @@ class GearboxModel:
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
     # gears whose joints are flexgear.mbs.joints constraints (Force output: ground force, moment)
     linear_joints: tuple[str, ...] = ()
+    seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -180,6 +181,19 @@ def _linear_joints(spec: GearboxSpec) -> bool:
     """Whether the gears' joints to their shafts are linear constraints (flexgear.mbs.joints), on the axis or off
     it (bolt patches): ``[joints_assumed] joint_equations``."""
     return spec.joints_assumed.joint_equations == "linear"
+
+
+def _seat_loads_carried(spec: GearboxSpec, body: Body) -> bool:
+    """Whether ``body``'s dropped modes answer its seat's own reaction (a linear joint's or bearing's) rather than
+    the contacts' quasi-static one: ``[reduction_assumed] residual_seat_loads`` (flexgear.mbs.residual)."""
+    return getattr(body, "dropped", None) is not None and spec.reduction_assumed.residual_seat_loads == "dynamic"
+
+
+def _gear_seat_name(spec: GearboxSpec, body: Body) -> str:
+    """Interface that ``body``'s residual is measured from (flexgear.fe.reduced.gear_seat)."""
+    from flexgear.fe.reduced import gear_seat
+
+    return gear_seat(spec, body.reduced, body.name).name
 
 
 def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
@@ -320,14 +334,20 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      superelement=superelements, contacts=contacts))
     by_body = {bd.name: bd for bd in bodies}
     joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
+    seat_residuals = {}  # gears whose seat's joint or bearing carries their dropped modes' seat motion (residual)
     linear_gears = []  # gears whose joints are linear constraints
     for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
         if _linear_joints(spec):
             from flexgear.mbs.joints import LinearInterfaceJoint
 
-            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""))
-                    for k, (a, b, p) in enumerate(found)]
+            # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
+            carried = (_seat_loads_carried(spec, lead) and len(found) == 1
+                       and _gear_seat_name(spec, lead) == found[0][0])
+            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
+                                         residual=carried) for k, (a, b, p) in enumerate(found)]
+            if carried:
+                seat_residuals[lead.name] = (made[0].residual_node, made[0].centre)
             linear_gears.append(lead.name)
             turning += [e for j in made for e in j.turning()]
             joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]
@@ -346,7 +366,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                 from flexgear.mbs.joints import LinearSeat
 
                 spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
-                turning += LinearSeat(mbs, by_body[body], supports[key], spin).turning()
+                carried = _seat_loads_carried(spec, by_body[body])
+                seat = LinearSeat(mbs, by_body[body], supports[key], spin, residual=carried)
+                turning += seat.turning()
+                if carried:
+                    seat_residuals[body] = (seat.residual_node, seat.centre)
                 continue
             add_support(mbs, by_body[body], supports[key])
     if turning:
@@ -363,8 +387,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
-                           radial_band=spec.gears.normal_module_m)
+                           radial_band=spec.gears.normal_module_m, seat_residuals=seat_residuals)
     springs = train.springs
+    seat_bodies = train.residual.seat_bodies if train.residual is not None else ()
+    if set(seat_residuals) - set(seat_bodies):  # a seat node the residual does not hold would be singular
+        raise ValueError(f"seats {sorted(set(seat_residuals) - set(seat_bodies))} have residual coordinates but no "
+                         "dropped modes at a contact")
     seat = "bearing_seat" if seats else None  # drive and load at the shafts' seats (spline, flange)
     spin_in = interface_spin_marker(mbs, by_body[ends["sun"]], seat)
     spin_out = interface_spin_marker(mbs, by_body[ends["ring"]], seat)
@@ -377,5 +405,5 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         tuple(train.aux_nodes), ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
-                        train.residual,
-                        linear_joints=tuple(linear_gears))
+                        train.residual, linear_joints=tuple(linear_gears),
+                        seat_residual_nodes=tuple(seat_residuals[b][0] for b in seat_bodies))

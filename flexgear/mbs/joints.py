@@ -82,15 +82,19 @@ def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
     return k6, support.damping_per_stiffness * k6
 
 
-def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np.ndarray) -> int:
+def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np.ndarray,
+                   series_node: int | None = None) -> int:
     """A constant 6 x 6 ``stiffness`` and ``damping`` on the six coordinates of ``node`` to ground (one
     ``ObjectGenericODE2``, its Jacobian exact): a seat's bearing (:class:`LinearSeat`) or a rigid body's on its
-    linear frame (:func:`add_frame_bearing`)."""
+    linear frame (:func:`add_frame_bearing`). ``series_node``: six more coordinates added to the bearing's
+    deflection, s + e (the seat's residual motion, flexgear.mbs.residual): [[K, K], [K, K]] on (s, e)."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    return mbs.AddObject(ObjectGenericODE2(name=name, nodeNumbers=[node], stiffnessMatrix=matrix_container(stiffness),
-                                           dampingMatrix=matrix_container(damping),
-                                           jacobianUserFunction=zero_user_jacobian(6)))
+    nodes = [node] if series_node is None else [node, series_node]
+    k, d = (np.kron(np.ones((len(nodes), len(nodes))), a) for a in (stiffness, damping))
+    return mbs.AddObject(ObjectGenericODE2(name=name, nodeNumbers=nodes, stiffnessMatrix=matrix_container(k),
+                                           dampingMatrix=matrix_container(d),
+                                           jacobianUserFunction=zero_user_jacobian(6 * len(nodes))))
 
 
 def add_frame_bearing(mbs, body: Body, support) -> int:
@@ -107,19 +111,24 @@ class LinearInterfaceJoint:
     ``point`` [m, ground frame at the reference]: on the axis its frame columns are constant; off the axis (a
     ring's bolt) they turn with the spin as well (:func:`frame_form`). ``spin_per_drive_angle`` the bodies'
     nominal spin per prescribed drive angle (both turn together). ``obj`` is the constraint; :meth:`turning`
-    gives its blocks that a :class:`TurningBlocks` pre-step function turns with the spin.
+    gives its blocks that a :class:`TurningBlocks` pre-step function turns with the spin. ``residual``: the
+    gear's (``body``) interface moves by six more coordinates, ``residual_node``, its dropped modes' motion e_s
+    of the interface at ``point`` in ground axes (flexgear.mbs.residual: the joint's reaction loads them).
     """
 
     def __init__(self, mbs, body: Body, other: Body, interfaces: tuple[str, str], point, spin_per_drive_angle: float,
-                 name: str = ""):
+                 name: str = "", residual: bool = False):
         from exudyn.itemInterface import (
             MarkerObjectODE2Coordinates,
+            NodeGenericODE2,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
 
         point = np.asarray(point, float)
         self.spin = float(spin_per_drive_angle)
+        self.centre = point - body.position  # the gear's interface point, its body frame at the reference
+        self.residual_node = -1
         forms, q_ref, markers = [], [], []
         for b, itf, sign in ((body, interfaces[0], -1.0), (other, interfaces[1], 1.0)):
             nodes = [b.node]
@@ -131,6 +140,13 @@ class LinearInterfaceJoint:
                 nodes += modal_nodes
                 q_ref.append(np.zeros(modal.shape[1]))
                 parts.append(turning_form(modal))
+            if residual and b is body:
+                self.residual_node = mbs.AddNode(NodeGenericODE2(
+                    name=f"{name}_{b.name}_seat_residual", numberOfODE2Coordinates=6, referenceCoordinates=[0.0] * 6,
+                    initialCoordinates=[0.0] * 6, initialCoordinates_t=[0.0] * 6))
+                nodes.append(self.residual_node)
+                q_ref.append(np.zeros(6))
+                parts.append((np.eye(6), np.zeros((6, 6)), np.zeros((6, 6))))  # ground axes: does not turn
             forms.append(tuple(sign * np.hstack([f[k] for f in parts]) for k in range(3)))
             # one marker per body: Exudyn's constraint costs rows x columns^2 per marker (its dense Jacobian)
             width = forms[-1][0].shape[1]
@@ -167,9 +183,11 @@ class LinearSeat:
     """The bearing ``support`` (flexgear.geometry.supports.Support) at the seat of the flexible ``body`` (module
     docstring). ``spin_per_drive_angle``: the body's nominal spin per prescribed drive angle; ``node``: the six
     seat coordinates; :meth:`turning` gives the block that a :class:`TurningBlocks` pre-step function turns.
+    ``residual``: the seat coordinates are the kept motion plus six more, ``residual_node``, the dropped modes'
+    seat motion e_s (flexgear.mbs.residual: the bearing acts on the seat in series with it).
     """
 
-    def __init__(self, mbs, body: Body, support, spin_per_drive_angle: float):
+    def __init__(self, mbs, body: Body, support, spin_per_drive_angle: float, residual: bool = False):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
@@ -185,7 +203,14 @@ class LinearSeat:
         self.node = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_seat", numberOfODE2Coordinates=6,
                                                 referenceCoordinates=[0.0] * 6, initialCoordinates=[0.0] * 6,
                                                 initialCoordinates_t=[0.0] * 6))
-        linear_bearing(mbs, f"bearing_{body.name}", self.node, *seat_matrices(support))
+        self.centre = centre
+        self.residual_node = -1
+        if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
+            self.residual_node = mbs.AddNode(NodeGenericODE2(
+                name=f"{body.name}_seat_residual", numberOfODE2Coordinates=6, referenceCoordinates=[0.0] * 6,
+                initialCoordinates=[0.0] * 6, initialCoordinates_t=[0.0] * 6))
+        linear_bearing(mbs, f"bearing_{body.name}", self.node, *seat_matrices(support),
+                       series_node=self.residual_node if residual else None)
         span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],
                                                jacobianUserFunction=zero_user_jacobian(12)))
         # Exudyn's equation: scalingMarker1 q - scalingMarker0 (s, frame) - offset = 0, i.e.

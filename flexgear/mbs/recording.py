@@ -179,6 +179,9 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
         if model.residual is not None:
             sensors["residual"] = mbs.AddSensor(SensorNode(nodeNumber=model.residual_node,
                                                            outputVariableType=ovt.Coordinates, storeInternal=True))
+        for k, node in enumerate(model.seat_residual_nodes):  # e_s of residual.seat_bodies, in order
+            sensors[f"seat_residual/{k}"] = mbs.AddSensor(SensorNode(
+                nodeNumber=node, outputVariableType=ovt.Coordinates, storeInternal=True))
         for name, body in model.bodies.items():
             for k, node in enumerate(body.modal_nodes if body.flexible else ()):  # q~ node by node, in order
                 sensors[f"modes_{name}/{k}"] = mbs.AddSensor(SensorNode(

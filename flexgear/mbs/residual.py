@@ -40,6 +40,21 @@ modes' damping as well as their stiffness and Ritz mass, to the same order:
     M_e = K (sum_{j dropped} a_ij a_kj / lambda_j^2) K
 
 (B = beta C when every gear has the same beta, so D_e = beta K: exact for massless dropped modes).
+
+Seats that carry a bearing of their own (``seats``: the planets on their linear seat bearings,
+flexgear.mbs.joints.LinearSeat). Above the bearing's own frequency (planet on its Table 2 bearing: about
+1.6 kHz against the 4.4 kHz mesh frequency) the gear's inertia, not the seat, takes most of a load that
+varies at the mesh frequency, so the quasi-static seat reaction above is wrong at 1x (model 5, planet-ring
+load deflection 1x +26 % against every mode dynamic). Such a gear's dropped modes answer the loads they
+really carry, the contact forces and the bearing's force F_s at the seat, with rows relative to the body frame
+and six more coordinates e_s, the dropped modes' motion of the seat in ground axes (translation at the
+bearing centre, rotation), on which the bearing acts in series (its seat coordinates s = kept motion + e_s):
+
+    b_j = [a_j; -r_j],   a_ij = s_i c_ij(alpha),   r_j = blockdiag(R(phi), R(phi)) Psi_bearing,j
+
+and [e; e_s] = (sum_j b_j b_j^T / lambda_j) [F; F_s] (the mode-acceleration method on every load the gear
+carries; with F_s the quasi-static reaction it equals the seat-relative form above: tests/test_residual.py).
+The gear's inertia loads only its frame: flexible free-free modes are mass-orthogonal to the rigid ones.
 """
 
 from __future__ import annotations
@@ -70,6 +85,12 @@ class DroppedModes:
     centrifugal_held: np.ndarray  # u (m,) [modal units per (rad/s)^2], the whole basis, joints held
     stiffness_damping_s: float = 0.0  # beta of the gear's modal damping D = beta K [s]
 
+    def motion_at(self, point: np.ndarray) -> np.ndarray:
+        """(6, m): the seat's translation [m] at ``point`` (body frame) and rotation [rad] per mode."""
+        arm = np.asarray(point, float) - self.seat_point
+        rot = self.seat_motion[3:]
+        return np.vstack([self.seat_motion[:3] + np.cross(rot.T, arm).T, rot])
+
 
 def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
     """Modes ``keep:`` of gear ``geometry``'s reduced body ``full`` (flexgear.fe.cms.ReducedBody) as dropped."""
@@ -99,22 +120,41 @@ class ResidualCompliance:
     split_yield_per_drive_speed2: np.ndarray | None = None  # y' per (rad/s)^2 of the drive (module docstring)
     mass_moment: np.ndarray | None = None  # sum_j a_ij a_kj / lambda_j^2 [m s^2/N]; C^-1 (this) C^-1: Ritz mass [kg]
     damping_moment: np.ndarray | None = None  # sum_j beta a_ij a_kj / lambda_j [m s/N]; C^-1 (this) C^-1: damping
+    # bodies whose seat has coordinates e_s of its own (module docstring), in order: six rows each after the
+    # contacts', translation at the bearing centre ``seat_centres`` [m] (ground) and rotation, ground axes
+    seat_bodies: tuple[str, ...] = ()
+    seat_centres: np.ndarray | None = None  # (n_seats, 3) [m]
+
+    @property
+    def n_contacts(self) -> int:
+        return self.matrix.shape[0] - 6 * len(self.seat_bodies)
 
     @property
     def rows(self) -> np.ndarray:
-        return np.flatnonzero(np.diag(self.matrix) > 0.0)
+        """Contacts with a residual (the contact part of the coordinates)."""
+        return np.flatnonzero(np.diag(self.matrix)[:self.n_contacts] > 0.0)
+
+    @property
+    def coordinates(self) -> np.ndarray:
+        """Rows of ``matrix`` that are coordinates: the contacts :attr:`rows`, then six per seat."""
+        return np.concatenate([self.rows, self.n_contacts + np.arange(6 * len(self.seat_bodies))])
 
 
 def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes], order: int,
-                        radial_band: float, n_angles: int = 72) -> ResidualCompliance:
+                        radial_band: float, n_angles: int = 72,
+                        seats: dict[str, np.ndarray] | None = None) -> ResidualCompliance:
     """Residual compliance and centrifugal yield of the contacts (module docstring) from the gears' dropped modes.
 
     ``contacts``: flexgear.mbs.contacts.GearContact list (rows of the contact constraint); ``bodies``: {name:
     Body}; ``dropped``: {body name: :class:`DroppedModes`}; ``order`` and ``radial_band`` [m]: the contact
     kernel's Fourier order and band (as the dynamic modal columns). ``n_angles`` spin angles over one
-    revolution are averaged.
+    revolution are averaged. ``seats``: {body name: bearing centre [m], body frame} of the gears whose seat
+    bearing carries their dropped modes' seat motion (module docstring); the others' rows are seat-relative.
     """
-    n_c = len(contacts)
+    seats = {k: v for k, v in (seats or {}).items() if k in dropped}
+    seat_bodies = tuple(seats)
+    n_contacts = len(contacts)
+    n_c = n_contacts + 6 * len(seat_bodies)
     total, cent, second = np.zeros((n_c, n_c)), np.zeros(n_c), np.zeros((n_c, n_c))
     damped = np.zeros((n_c, n_c))
     split = np.zeros(n_c)
@@ -134,24 +174,32 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
                 parts.append((table, sign, spin, rel, np.asarray(c.normal, float)))
         if not rows:
             continue
-        samples = [_rows_at(p, parts, d) for p in 2 * np.pi * np.arange(n_angles) / n_angles]
+        centre = seats.get(name)
+        n_rows = len(rows)
+        if centre is not None:
+            first = n_contacts + 6 * seat_bodies.index(name)
+            rows += list(range(first, first + 6))
+        samples = [_rows_at(p, parts, d, centre) for p in 2 * np.pi * np.arange(n_angles) / n_angles]
         k = d.keep
         comp = np.stack([(a[:, k:] / d.stiffness[k:]) @ a[:, k:].T for a in samples])
         mean = comp.mean(axis=0)
-        spread = max(spread, float(np.abs(comp - mean).max() / np.abs(np.diag(mean)).max()))
+        contact_part = (comp - mean)[:, :n_rows, :n_rows]
+        spread = max(spread, float(np.abs(contact_part).max() / np.abs(np.diag(mean)[:n_rows]).max()))
         total[np.ix_(rows, rows)] += mean
         damped[np.ix_(rows, rows)] += d.stiffness_damping_s * mean
         second[np.ix_(rows, rows)] += np.mean([(a[:, k:] / d.stiffness[k:] ** 2) @ a[:, k:].T for a in samples],
                                               axis=0)
-        spins2 = np.array([p[2] ** 2 for p in parts])
+        spins2 = np.array([p[2] ** 2 for p in parts] + [parts[0][2] ** 2] * (len(rows) - n_rows))
         cent[rows] -= spins2 * np.mean([a @ d.centrifugal for a in samples], axis=0)
         split[rows] -= spins2 * np.mean([a[:, k:] @ d.centrifugal_held[k:] for a in samples], axis=0)
+    centres = np.array([bodies[b].position + np.asarray(seats[b], float) for b in seat_bodies]).reshape(-1, 3)
     return ResidualCompliance(0.5 * (total + total.T), cent, spread, split, 0.5 * (second + second.T),
-                              0.5 * (damped + damped.T))
+                              0.5 * (damped + damped.T), seat_bodies, centres)
 
 
-def _rows_at(phi: float, parts: list, d: DroppedModes) -> np.ndarray:
-    """Rows a_i(phi) (module docstring) of one gear's contacts at its spin angle phi [rad]."""
+def _rows_at(phi: float, parts: list, d: DroppedModes, seat_centre: np.ndarray | None = None) -> np.ndarray:
+    """Rows a_i(phi) (module docstring) of one gear's contacts at its spin angle phi [rad]; with a
+    ``seat_centre`` (body frame) [m] the rows relative to the body frame, then the seat's six rows -r_j."""
     c, s = np.cos(phi), np.sin(phi)
     rot = np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]])  # ground -> body frame at spin phi
     out = []
@@ -161,40 +209,55 @@ def _rows_at(phi: float, parts: list, d: DroppedModes) -> np.ndarray:
         i0 = int(np.floor(x)) % n_grid
         w = x - np.floor(x)
         kernel = (1 - w) * table[i0] + w * table[(i0 + 1) % n_grid]
+        if seat_centre is not None:
+            out.append(sign * kernel)
+            continue
         x_b, n_b = rot @ rel, rot @ normal
         lever = np.concatenate([n_b, np.cross(x_b - d.seat_point, n_b)])
         out.append(sign * (kernel - lever @ d.seat_motion))
-    return np.array(out)
+    if seat_centre is None:
+        return np.array(out)
+    motion = d.motion_at(seat_centre)  # body frame -> ground axes: R(phi)^T = rot.T
+    return np.vstack([np.array(out), -rot.T @ motion[:3], -rot.T @ motion[3:]])
 
 
-def add_residual_coordinates(mbs, residual: ResidualCompliance) -> tuple[int, int, dict[int, int]]:
+def add_residual_coordinates(mbs, residual: ResidualCompliance,
+                             seat_nodes: tuple[int, ...] = ()) -> tuple[int, int, dict[int, int]]:
     """A coordinate per contact with a residual, held by the constant stiffness K = C^-1 with the dropped modes'
-    Ritz mass and damping (one ``ObjectGenericODE2``, module docstring). Returns the node, the object (its
-    ``forceVector`` K y(t) carries the centrifugal yield: :class:`CentrifugalYield`) and {contact row: marker of
-    its coordinate}: the contact law's spring acts between that marker and the contact's deflection coordinate."""
+    Ritz mass and damping (one ``ObjectGenericODE2``, module docstring). ``seat_nodes``: the six-coordinate node
+    e_s of each of ``residual.seat_bodies`` (made by flexgear.mbs.joints.LinearSeat). Returns the contacts' node,
+    the object (its ``forceVector`` K y(t) carries the centrifugal yield: :class:`CentrifugalYield`) and {contact
+    row: marker of its coordinate}: the contact law's spring acts between that marker and the contact's
+    deflection coordinate."""
     from exudyn.itemInterface import MarkerNodeCoordinate, NodeGenericODE2, ObjectGenericODE2
 
-    rows = residual.rows
-    n = len(rows)
-    stiffness = np.linalg.inv(residual.matrix[np.ix_(rows, rows)])
+    if len(seat_nodes) != len(residual.seat_bodies):
+        raise ValueError(f"{len(residual.seat_bodies)} seats with a residual ({residual.seat_bodies}) but "
+                         f"{len(seat_nodes)} seat nodes")
+    rows, coords = residual.rows, residual.coordinates
+    n = len(coords)
+    stiffness = np.linalg.inv(residual.matrix[np.ix_(coords, coords)])
     stiffness = 0.5 * (stiffness + stiffness.T)
+
     def through_stiffness(moment: np.ndarray | None) -> np.ndarray:
-        """K (moment) K on the rows, symmetric (zero without a moment)."""
+        """K (moment) K on the coordinates, symmetric (zero without a moment)."""
         if moment is None:
             return np.zeros((n, n))
-        out = stiffness @ moment[np.ix_(rows, rows)] @ stiffness
+        out = stiffness @ moment[np.ix_(coords, coords)] @ stiffness
         return 0.5 * (out + out.T)
 
     mass = through_stiffness(residual.mass_moment)  # Ritz mass of the static residual shapes (module docstring)
     damping = through_stiffness(residual.damping_moment)  # the dropped modes' beta K damping (module docstring)
-    node = mbs.AddNode(NodeGenericODE2(name="mesh_residual_deflections", numberOfODE2Coordinates=n,
-                                       referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
-                                       initialCoordinates_t=[0.0] * n))
-    obj = mbs.AddObject(ObjectGenericODE2(name="mesh_residual_compliance", nodeNumbers=[node],
-                                          massMatrix=matrix_container(mass),
-                                          stiffnessMatrix=matrix_container(stiffness),
-                                          dampingMatrix=matrix_container(damping),
-                                          forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n)))
+    m = len(rows)
+    node = mbs.AddNode(NodeGenericODE2(name="mesh_residual_deflections", numberOfODE2Coordinates=m,
+                                       referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
+                                       initialCoordinates_t=[0.0] * m))
+    dense = bool(seat_nodes)  # K = C^-1 fills the block: Exudyn's dense product is the cheaper then
+    obj = mbs.AddObject(ObjectGenericODE2(name="mesh_residual_compliance", nodeNumbers=[node, *seat_nodes],
+                                          massMatrix=matrix_container(mass, dense),
+                                          stiffnessMatrix=matrix_container(stiffness, dense),
+                                          dampingMatrix=matrix_container(damping, dense),
+                                          forceVector=np.zeros(n), jacobianUserFunction=zero_user_jacobian(n, dense)))
     markers = {int(r): mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=k)) for k, r in enumerate(rows)}
     return node, obj, markers
 
@@ -204,9 +267,9 @@ class CentrifugalYield:
     docstring), Omega_drive the prescribed STEP speed ramp [rad/s] at the step's end time."""
 
     def __init__(self, residual: ResidualCompliance, obj: int, ramp_time: float, drive_speed: float):
-        rows = residual.rows
+        coords = residual.coordinates
         self.obj, self.ramp_time, self.drive_speed = obj, ramp_time, drive_speed
-        self.unit = np.linalg.solve(residual.matrix[np.ix_(rows, rows)], residual.yield_per_drive_speed2[rows])
+        self.unit = np.linalg.solve(residual.matrix[np.ix_(coords, coords)], residual.yield_per_drive_speed2[coords])
         self._steady = False
 
     def force(self, t: float) -> np.ndarray:

@@ -65,7 +65,8 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
         modal = {name: np.hstack([data(k)[:, 1:] for k in sensors if k.startswith(f"modes_{name}/")])
                  for name, body in model.bodies.items() if body.flexible}  # each body's q~ (recording.py)
         residual = data("residual")[:, 1:] if "residual" in sensors else None
-        extra.update(mesh_deflection_signals(model, time, modal, residual))
+        seats = [data(f"seat_residual/{k}")[:, 1:] for k in range(len(model.seat_residual_nodes))]
+        extra.update(mesh_deflection_signals(model, time, modal, residual, np.hstack(seats) if seats else None))
     return pd.concat([frame, pd.DataFrame(extra)], axis=1)
 
 

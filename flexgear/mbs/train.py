@@ -93,7 +93,8 @@ def contact_sensing_rows(reduced, name: str, position: np.ndarray, contacts: lis
 def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearContact], ramp_time: float,
                    drive_speed: float, *, friction: bool = True,
                    carrier: Carrier | None = None, contact_fourier_order: int = 8,
-                   radial_band: float | None = None, extra_pre_steps: list | None = None) -> GearTrain:
+                   radial_band: float | None = None, extra_pre_steps: list | None = None,
+                   seat_residuals: dict[str, tuple[int, np.ndarray]] | None = None) -> GearTrain:
     """Add the bushings ``elements``, the gear ``contacts`` and their per-step updates for ``bodies``.
 
     ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
@@ -101,7 +102,9 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; rigid gears only).
     Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
     from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
-    tooth height). ``extra_pre_steps``: further pre-step callables (mbs, t) -> bool, run first. Sets the
+    tooth height). ``extra_pre_steps``: further pre-step callables (mbs, t) -> bool, run first.
+    ``seat_residuals``: {body: (node of its seat's residual motion e_s, bearing centre [m] in the body frame)}
+    of the gears whose seat bearing carries their dropped modes' seat motion (flexgear.mbs.residual). Sets the
     system's pre-step user function if any update is needed.
     """
     by_name = {b.name: b for b in bodies}
@@ -127,9 +130,12 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
     if dropped:
         from flexgear.mbs.residual import add_residual_coordinates, residual_compliance
 
-        residual = residual_compliance(contacts, by_name, dropped, contact_fourier_order, radial_band)
+        seats = seat_residuals or {}
+        residual = residual_compliance(contacts, by_name, dropped, contact_fourier_order, radial_band,
+                                       seats={b: centre for b, (_, centre) in seats.items()})
         if residual.rows.size:
-            residual_node, residual_obj, markers = add_residual_coordinates(mbs, residual)
+            residual_node, residual_obj, markers = add_residual_coordinates(
+                mbs, residual, tuple(seats[b][0] for b in residual.seat_bodies))
         else:
             residual = None
     springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
