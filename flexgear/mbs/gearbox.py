@@ -189,11 +189,13 @@ def _seat_loads_carried(spec: GearboxSpec, body: Body) -> bool:
     return getattr(body, "dropped", None) is not None and spec.reduction_assumed.residual_seat_loads == "dynamic"
 
 
-def _gear_seat_name(spec: GearboxSpec, body: Body) -> str:
-    """Interface that ``body``'s residual is measured from (flexgear.fe.reduced.gear_seat)."""
+def _is_gear_seat(spec: GearboxSpec, body: Body, interface: str) -> bool:
+    """Whether ``interface`` of ``body`` is the seat its residual is measured from (flexgear.fe.reduced.gear_seat:
+    the bore; the ring's one joint interface, or the union of its bolt patches)."""
     from flexgear.fe.reduced import gear_seat
 
-    return gear_seat(spec, body.reduced, body.name).name
+    seat, joint = gear_seat(spec, body.reduced, body.name), body.reduced.interface(interface)
+    return np.array_equal(seat.nodes, joint.nodes) and np.allclose(seat.weights, joint.weights, rtol=1e-12, atol=0.0)
 
 
 def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
@@ -343,7 +345,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
             carried = (_seat_loads_carried(spec, lead) and len(found) == 1
-                       and _gear_seat_name(spec, lead) == found[0][0])
+                       and _is_gear_seat(spec, lead, found[0][0]))
             made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
                                          residual=carried) for k, (a, b, p) in enumerate(found)]
             if carried:
