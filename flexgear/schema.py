@@ -272,8 +272,9 @@ class ReductionSettings:
     # "linear" bodies: "interface": linear joints' and seats' interface motions as coordinates (flexgear.mbs.flexible)
     modal_coordinates: str = _choice("modal", "interface", default="modal")
     # Seat load that a gear's dropped modes answer (flexgear.mbs.residual): "dynamic" its linear seat bearing's or
-    # joint's own reaction (coordinates of the seat's residual motion), "quasi_static" the contacts' rigid reaction
-    residual_seat_loads: str = _choice("dynamic", "quasi_static", default="quasi_static")
+    # joint's own reaction (coordinates of the seat's residual motion; seats on generic joints or marker springs
+    # fall back to the other), "quasi_static" the contacts' rigid reaction at the seat
+    residual_seat_loads: str = _choice("dynamic", "quasi_static", default="dynamic")
 
 
 @dataclass(frozen=True)
