@@ -139,6 +139,31 @@ def frame_rows(point: np.ndarray) -> np.ndarray:
     return out
 
 
+def normal_lever(point: np.ndarray, normal: np.ndarray, about: np.ndarray) -> np.ndarray:
+    """(n, (x - p) x n) [-, m]: the motion along ``normal`` n at ``point`` x per rigid translation and small
+    rotation about ``about`` p (the transpose of :func:`frame_rows`' translation rows on n); equally the force and
+    moment about p of a unit force along n at x. Broadcasts over leading axes (..., 3) -> (..., 6)."""
+    normal = np.asarray(normal, float)
+    arm = np.asarray(point, float) - np.asarray(about, float)
+    return np.concatenate(np.broadcast_arrays(normal, np.cross(arm, normal)), axis=-1)
+
+
+def motion_at_point(motion: np.ndarray, origin: np.ndarray, point: np.ndarray) -> np.ndarray:
+    """(6, m) rigid motions, translation [m] at ``origin`` and rotation [rad], moved to translation at ``point``
+    (t + theta x (point - origin), theta)."""
+    arm = np.asarray(point, float) - np.asarray(origin, float)
+    return np.vstack([motion[:3] + np.cross(motion[3:].T, arm).T, motion[3:]])
+
+
+def resting_node(mbs, name: str, n: int) -> int:
+    """A ``NodeGenericODE2`` of ``n`` coordinates, reference, initial value and rate zero."""
+    from exudyn.itemInterface import NodeGenericODE2
+
+    zeros = [0.0] * n
+    return mbs.AddNode(NodeGenericODE2(name=name, numberOfODE2Coordinates=n, referenceCoordinates=zeros,
+                                       initialCoordinates=zeros, initialCoordinates_t=zeros))
+
+
 def matrix_container(a: np.ndarray, dense: bool = False):
     """An (n, n) array as Exudyn's ``MatrixContainer``: sparse triplets (its zeros dropped) or, ``dense``, a dense
     matrix (for a filled block: Exudyn's triplet product then costs several times the dense one)."""

@@ -31,7 +31,7 @@ from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_se
 from flexgear.geometry.pair import _EZ, helix_halves
 from flexgear.laws.contact import ContactLaw, friction_forces, normal_force, periodic_value
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, normal_lever, resting_node
 from flexgear.mbs.elements import _keep_alive
 from flexgear.mbs.mesh_constraint import MeshConstraint, contact_pairs
 from flexgear.spec import Contact, ContactAssumed
@@ -84,9 +84,7 @@ def relative_displacement_gradient(centre1: np.ndarray, centre2: np.ndarray, poi
     the mesh deflection: exact in the spin (lever arm r_b cos(beta_b) on the line of action),
     linearised in translation and tilt.
     """
-    d = np.asarray(direction, float)
-    x = np.asarray(point, float)
-    return np.concatenate([d, np.cross(x - centre1, d)]), -np.concatenate([d, np.cross(x - centre2, d)])
+    return normal_lever(point, direction, centre1), -normal_lever(point, direction, centre2)
 
 
 def contact_gradients(centre1: np.ndarray, centre2: np.ndarray, point: np.ndarray, normal: np.ndarray,
@@ -118,7 +116,6 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     from exudyn import symbolic as esym
     from exudyn.itemInterface import (
         MarkerNodeCoordinate,
-        NodeGenericODE2,
         NodePointGround,
         ObjectConnectorCoordinateSpringDamper,
     )
@@ -132,9 +129,7 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
     q_ref = np.concatenate([[*b.position, 0.0, 0.0, 0.0] for b in bodies] + [np.zeros(extra)])
     # one deflection node per gear pair, added one after the other: their coordinates are one vector
     pairs = contact_pairs(contacts)
-    aux = [mbs.AddNode(NodeGenericODE2(name=f"mesh_deflections_{a}_{b}", numberOfODE2Coordinates=len(rows),
-                                       referenceCoordinates=[0.0] * len(rows), initialCoordinates=[0.0] * len(rows),
-                                       initialCoordinates_t=[0.0] * len(rows))) for (a, b), rows in pairs]
+    aux = [resting_node(mbs, f"mesh_deflections_{a}_{b}", len(rows)) for (a, b), rows in pairs]
     slot = {int(i): (node, k) for node, (_, rows) in zip(aux, pairs, strict=True) for k, i in enumerate(rows)}
     constraint = MeshConstraint(mbs, bodies, contacts, aux, gradient, q_ref, modal_offsets or {})
     m_ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))

@@ -29,7 +29,7 @@ import numpy as np
 from flexgear.fe.reduced import gear_seat, gear_shaft_joints
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import frame_rows
+from flexgear.mbs.bodies import frame_rows, normal_lever
 from flexgear.spec import COMPONENT_GEOMETRY
 
 __all__ = ["transmission_error", "centrifugal_modal_load", "centrifugal_response", "held_interfaces",
@@ -134,7 +134,7 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             x_b = np.stack([ca * rel[0] + sa * rel[1], -sa * rel[0] + ca * rel[1], np.full_like(ang, rel[2])], 1)
             nrm = np.asarray(contact.normal, float)
             n_b = np.stack([ca * nrm[0] + sa * nrm[1], -sa * nrm[0] + ca * nrm[1], np.full_like(ang, nrm[2])], 1)
-            g = np.hstack([n_b, np.cross(x_b - p_seat, n_b)])  # (T, 6) seat rigid motion -> normal at contact
+            g = normal_lever(x_b, n_b, p_seat)  # (T, 6) seat rigid motion -> normal at contact
             coeff = _column_values(kin, row, theta) - g @ motion  # (T, m): relative to the seat
             q = modal[body_name]
             total[:, j] += sign * np.einsum("tm,tm->t", coeff, q)
@@ -174,8 +174,7 @@ def _seat_relative(model, total: np.ndarray, centrifugal: np.ndarray, rate: np.n
             sign = 1.0 if contact.body1 == name else -1.0 if contact.body2 == name else 0.0
             if sign == 0.0:
                 continue
-            nrm = np.asarray(contact.normal, float)
-            lever = np.concatenate([nrm, np.cross(np.asarray(contact.point, float) - centre, nrm)])
+            lever = normal_lever(contact.point, contact.normal, centre)
             total[:, j] -= sign * seat_residual[:, cols] @ lever
             centrifugal[:, j] -= sign * (rate ** 2) * (split[cols] @ lever)
 

@@ -15,7 +15,7 @@ import numpy as np
 
 from flexgear.geometry.supports import Support
 from flexgear.laws.ramps import drive_angle, ramp_fraction
-from flexgear.mbs.bodies import Body, matrix_container, zero_user_jacobian
+from flexgear.mbs.bodies import Body, matrix_container, resting_node, zero_user_jacobian
 from flexgear.spec import Bearing
 
 
@@ -140,7 +140,6 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, 
         MarkerNodeCoordinate,
         MarkerNodeCoordinates,
         MarkerObjectODE2Coordinates,
-        NodeGenericODE2,
         ObjectConnectorCoordinateVector,
         ObjectGenericODE2,
     )
@@ -148,9 +147,7 @@ def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, 
     if interface is None or not body.flexible:
         return mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=body.node, coordinate=5)), body.node, 5
     modal_nodes, r = body.span(body.reduced.interface_motion(interface)[5][None, :])
-    spin = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_{interface}_spin", numberOfODE2Coordinates=1,
-                                       referenceCoordinates=[0.0], initialCoordinates=[0.0],
-                                       initialCoordinates_t=[0.0]))
+    spin = resting_node(mbs, f"{body.name}_{interface}_spin", 1)
     span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_{interface}_span",
                                            nodeNumbers=[body.node, *modal_nodes],
                                            jacobianUserFunction=zero_user_jacobian(6 + r.shape[1])))

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.fe.cms import ReducedBody
-from flexgear.mbs.bodies import Body, add_frame_inertia, matrix_container
+from flexgear.mbs.bodies import Body, add_frame_inertia, matrix_container, resting_node
 
 __all__ = ["FlexibleBody", "add_flexible_body", "interface_basis", "interface_virtual_nodes", "interface_point_modes"]
 
@@ -178,7 +178,6 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         MarkerNodeRigid,
         MarkerSuperElementPosition,
         MarkerSuperElementRigid,
-        NodeGenericODE2,
         ObjectFFRFreducedOrder,
         VObjectFFRFreducedOrder,
     )
@@ -206,10 +205,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         blocks = []
     blocks.append(("modes", m - sum(n for _, n in blocks)))
     labels, sizes = (tuple(x) for x in zip(*blocks, strict=True))
-    modal_nodes = tuple(mbs.AddNode(NodeGenericODE2(name=f"{name}_{label}", numberOfODE2Coordinates=n,
-                                                    referenceCoordinates=[0.0] * n, initialCoordinates=[0.0] * n,
-                                                    initialCoordinates_t=[0.0] * n))
-                        for label, n in zip(labels, sizes, strict=True))
+    modal_nodes = tuple(resting_node(mbs, f"{name}_{label}", n) for label, n in zip(labels, sizes, strict=True))
     modal = modal_nodes[0] if basis is None else -1
     contact_nodes = tuple(n for n, label in zip(modal_nodes, labels, strict=True) if label == "contact") or modal_nodes
     if not superelement:

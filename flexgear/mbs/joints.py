@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from flexgear.laws.compiled import ramp_state, turn_columns
-from flexgear.mbs.bodies import Body, frame_rows, matrix_container, zero_user_jacobian
+from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
 __all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "add_frame_bearing", "frame_form",
            "interface_rows", "linear_bearing", "seat_matrices", "turning_form"]
@@ -44,9 +44,7 @@ def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.nd
     """(6, m): translation [m] at ``local_point`` (body frame) and rotation [rad] of ``interface`` per modal
     coordinate of the flexible ``body`` (the RBE3 motion, flexgear.fe.cms.ReducedBody.interface_motion)."""
     red = body.reduced
-    motion = red.interface_motion(interface)
-    arm = np.asarray(local_point, float) - red.interface(interface).point
-    return np.vstack([motion[:3] + np.cross(motion[3:].T, arm).T, motion[3:]])
+    return motion_at_point(red.interface_motion(interface), red.interface(interface).point, local_point)
 
 
 def turning_form(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -120,7 +118,6 @@ class LinearInterfaceJoint:
                  name: str = "", residual: bool = False):
         from exudyn.itemInterface import (
             MarkerObjectODE2Coordinates,
-            NodeGenericODE2,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
@@ -141,9 +138,7 @@ class LinearInterfaceJoint:
                 q_ref.append(np.zeros(modal.shape[1]))
                 parts.append(turning_form(modal))
             if residual and b is body:
-                self.residual_node = mbs.AddNode(NodeGenericODE2(
-                    name=f"{name}_{b.name}_seat_residual", numberOfODE2Coordinates=6, referenceCoordinates=[0.0] * 6,
-                    initialCoordinates=[0.0] * 6, initialCoordinates_t=[0.0] * 6))
+                self.residual_node = resting_node(mbs, f"{name}_{b.name}_seat_residual", 6)
                 nodes.append(self.residual_node)
                 q_ref.append(np.zeros(6))
                 parts.append((np.eye(6), np.zeros((6, 6)), np.zeros((6, 6))))  # ground axes: does not turn
@@ -191,7 +186,6 @@ class LinearSeat:
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
-            NodeGenericODE2,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
@@ -200,15 +194,11 @@ class LinearSeat:
         centre = np.array([0.0, 0.0, support.centre_z])
         modal_nodes, self.rows = body.span(interface_rows(body, support.interface, centre))
         frame = frame_rows(centre)
-        self.node = mbs.AddNode(NodeGenericODE2(name=f"{body.name}_seat", numberOfODE2Coordinates=6,
-                                                referenceCoordinates=[0.0] * 6, initialCoordinates=[0.0] * 6,
-                                                initialCoordinates_t=[0.0] * 6))
+        self.node = resting_node(mbs, f"{body.name}_seat", 6)
         self.centre = centre
         self.residual_node = -1
         if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
-            self.residual_node = mbs.AddNode(NodeGenericODE2(
-                name=f"{body.name}_seat_residual", numberOfODE2Coordinates=6, referenceCoordinates=[0.0] * 6,
-                initialCoordinates=[0.0] * 6, initialCoordinates_t=[0.0] * 6))
+            self.residual_node = resting_node(mbs, f"{body.name}_seat_residual", 6)
         linear_bearing(mbs, f"bearing_{body.name}", self.node, *seat_matrices(support),
                        series_node=self.residual_node if residual else None)
         span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],

@@ -64,7 +64,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from flexgear.laws.compiled import ramp_state
-from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
+from flexgear.mbs.bodies import matrix_container, motion_at_point, normal_lever, resting_node, zero_user_jacobian
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
 from flexgear.mbs.deflection import centrifugal_modal_load, centrifugal_response, held_interfaces
 
@@ -87,9 +87,7 @@ class DroppedModes:
 
     def motion_at(self, point: np.ndarray) -> np.ndarray:
         """(6, m): the seat's translation [m] at ``point`` (body frame) and rotation [rad] per mode."""
-        arm = np.asarray(point, float) - self.seat_point
-        rot = self.seat_motion[3:]
-        return np.vstack([self.seat_motion[:3] + np.cross(rot.T, arm).T, rot])
+        return motion_at_point(self.seat_motion, self.seat_point, point)
 
 
 def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
@@ -151,8 +149,11 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
     revolution are averaged. ``seats``: {body name: bearing centre [m], body frame} of the gears whose seat
     bearing carries their dropped modes' seat motion (module docstring); the others' rows are seat-relative.
     """
-    seats = {k: v for k, v in (seats or {}).items() if k in dropped}
+    seats = seats or {}
     seat_bodies = tuple(seats)
+    bare = [b for b in seat_bodies if b not in dropped or not any(b in (c.body1, c.body2) for c in contacts)]
+    if bare:  # their seat coordinates would have no stiffness
+        raise ValueError(f"seats {bare} carry residual coordinates but have no dropped modes at a contact")
     n_contacts = len(contacts)
     n_c = n_contacts + 6 * len(seat_bodies)
     total, cent, second = np.zeros((n_c, n_c)), np.zeros(n_c), np.zeros((n_c, n_c))
@@ -212,9 +213,7 @@ def _rows_at(phi: float, parts: list, d: DroppedModes, seat_centre: np.ndarray |
         if seat_centre is not None:
             out.append(sign * kernel)
             continue
-        x_b, n_b = rot @ rel, rot @ normal
-        lever = np.concatenate([n_b, np.cross(x_b - d.seat_point, n_b)])
-        out.append(sign * (kernel - lever @ d.seat_motion))
+        out.append(sign * (kernel - normal_lever(rot @ rel, rot @ normal, d.seat_point) @ d.seat_motion))
     if seat_centre is None:
         return np.array(out)
     motion = d.motion_at(seat_centre)  # body frame -> ground axes: R(phi)^T = rot.T
@@ -229,7 +228,7 @@ def add_residual_coordinates(mbs, residual: ResidualCompliance,
     the object (its ``forceVector`` K y(t) carries the centrifugal yield: :class:`CentrifugalYield`) and {contact
     row: marker of its coordinate}: the contact law's spring acts between that marker and the contact's
     deflection coordinate."""
-    from exudyn.itemInterface import MarkerNodeCoordinate, NodeGenericODE2, ObjectGenericODE2
+    from exudyn.itemInterface import MarkerNodeCoordinate, ObjectGenericODE2
 
     if len(seat_nodes) != len(residual.seat_bodies):
         raise ValueError(f"{len(residual.seat_bodies)} seats with a residual ({residual.seat_bodies}) but "
@@ -248,10 +247,7 @@ def add_residual_coordinates(mbs, residual: ResidualCompliance,
 
     mass = through_stiffness(residual.mass_moment)  # Ritz mass of the static residual shapes (module docstring)
     damping = through_stiffness(residual.damping_moment)  # the dropped modes' beta K damping (module docstring)
-    m = len(rows)
-    node = mbs.AddNode(NodeGenericODE2(name="mesh_residual_deflections", numberOfODE2Coordinates=m,
-                                       referenceCoordinates=[0.0] * m, initialCoordinates=[0.0] * m,
-                                       initialCoordinates_t=[0.0] * m))
+    node = resting_node(mbs, "mesh_residual_deflections", len(rows))
     dense = bool(seat_nodes)  # K = C^-1 fills the block: Exudyn's dense product is the cheaper then
     obj = mbs.AddObject(ObjectGenericODE2(name="mesh_residual_compliance", nodeNumbers=[node, *seat_nodes],
                                           massMatrix=matrix_container(mass, dense),

@@ -46,6 +46,7 @@ class GearTrain:
     friction: MeshFriction | None = None
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the gears' dropped modes
     residual_node: int = -1  # node of the residual deflections e (one per contact in residual.rows)
+    seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies, in order
 
     def springs_named(self, prefix: str) -> list[int]:
         """Spring-dampers of the contacts whose name starts with ``prefix`` (e.g. all helix halves of a mesh)."""
@@ -126,22 +127,22 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         raise ValueError(f"flexible bodies {[b.name for b in flexible]} need radial_band [m] (about one normal module)")
     frame_elements, coords = add_linear_elements(mbs, bodies, elements)
     dropped = {b.name: b.dropped for b in flexible if getattr(b, "dropped", None) is not None}
-    residual, residual_node, markers = None, -1, None
-    if dropped:
+    residual, residual_node, markers, seat_nodes = None, -1, None, ()
+    seats = seat_residuals or {}
+    if dropped or seats:
         from flexgear.mbs.residual import add_residual_coordinates, residual_compliance
 
-        seats = seat_residuals or {}
         residual = residual_compliance(contacts, by_name, dropped, contact_fourier_order, radial_band,
                                        seats={b: centre for b, (_, centre) in seats.items()})
+        seat_nodes = tuple(seats[b][0] for b in residual.seat_bodies)
         if residual.rows.size:
-            residual_node, residual_obj, markers = add_residual_coordinates(
-                mbs, residual, tuple(seats[b][0] for b in residual.seat_bodies))
+            residual_node, residual_obj, markers = add_residual_coordinates(mbs, residual, seat_nodes)
         else:
             residual = None
     springs, aux, constraint, base, schedule = add_gear_contacts(mbs, bodies, contacts, ramp_time, drive_speed,
                                                                  offsets, n_total, markers)
     train = GearTrain(by_name, contacts, springs, aux, constraint, frame_elements, coords,
-                      residual=residual, residual_node=residual_node)
+                      residual=residual, residual_node=residual_node, seat_residual_nodes=seat_nodes)
     pre_steps = [*(extra_pre_steps or []), *([schedule] if schedule is not None else [])]
     if markers:
         from flexgear.mbs.residual import CentrifugalYield
