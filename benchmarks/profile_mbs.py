@@ -1,6 +1,7 @@
 """Profile one multibody run: Exudyn's CPU-time statistics per solver part, Newton counts, and cProfile.
 
 Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
+     [--trace-newton 6]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, benchmarks/speed_common.floor_variant), warmed with a 1e-4 s run, then
@@ -33,7 +34,7 @@ from flexgear.spec import load_variant
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def solve(variant, t_end: float, timers: bool, profile: bool) -> tuple[str, float, float]:
+def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = False) -> tuple[str, float, float]:
     """Build and solve; returns Exudyn's printed statistics, wall and CPU time of the solve."""
     import exudyn as exu
 
@@ -46,7 +47,7 @@ def solve(variant, t_end: float, timers: bool, profile: bool) -> tuple[str, floa
         print(f"  build: wall {time.perf_counter() - b0:.2f} s, cpu {time.process_time() - bc0:.2f} s")
     settings = simulation_settings(variant, t_end, False)
     if timers:
-        settings.timeIntegration.verboseMode = 1
+        settings.timeIntegration.verboseMode = 2 if trace else 1  # 2: every Newton iteration's residual
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             settings.displayComputationTime = True
@@ -108,6 +109,9 @@ def main() -> None:
     ap.add_argument("--variants-dir", default=str(ROOT / "model_variants"))
     ap.add_argument("--ramp", type=float, default=None,
                     help="shorten the ramps to this [s] (profile at full speed: 0.005 with --t-end 0.02)")
+    ap.add_argument("--trace-newton", type=int, default=0, metavar="STEPS",
+                    help="print Exudyn's Newton residuals and contractions of the last STEPS steps (verboseMode 2; "
+                         "the timers then include the printing)")
     ap.add_argument("--blas-threads", type=int, default=1,
                     help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
     a = ap.parse_args()
@@ -124,7 +128,11 @@ def main() -> None:
             lc = dataclasses.replace(gb.load_case, ramp_time_s=a.ramp, end_time_s=max(a.t_end, a.ramp))
             variant = dataclasses.replace(variant, gearbox=gb.with_changes(load_case=lc))
         solve(variant, 1e-4, False, False)
-        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile)
+        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0)
+        if a.trace_newton:
+            lines = [ln for ln in text.splitlines() if "initial residual" in ln or "NEWTON STEP" in ln]
+            starts = [k for k, ln in enumerate(lines) if "initial residual" in ln]
+            print("\n".join(lines[starts[-a.trace_newton]:] if len(starts) >= a.trace_newton else lines))
         steps = round(a.t_end / variant.gearbox.load_case.step_size_s)
         print(f"{case}: solve wall {wall:.2f} s, cpu {cpu:.2f} s ({1e6 * cpu / steps:.1f} us/step cpu); "
               f"{load_average()}")
