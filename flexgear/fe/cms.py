@@ -144,7 +144,6 @@ class _FreeBodySolver:
         # K_ff (positive definite): its lower triangle, which is the lower triangle of K restricted to the
         # (ascending) free coordinates, all the factorisation reads
         self.chol = SparseCholesky(sp.tril(fe.K, format="csr")[self.free][:, self.free])
-        self.factor_bytes = self.chol.factor_bytes
 
     def solve_ff(self, rhs: np.ndarray) -> np.ndarray:
         return self.chol.solve(rhs)
@@ -368,19 +367,18 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
         attached[idofs] = solve(patterns[idofs])
-    return static, fixed, attached, chol.factor_bytes
+    return static, fixed, attached
 
 
 @dataclass
 class BasisParts:
     """The reduction basis before compression: interface static modes (3n, 6 J), fixed-interface modes
     (3n, n_modes, lowest first), attachment modes (3n, sum 2 N + 1, per circle in the order of
-    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3) and its factor's memory [bytes]."""
+    flexgear.fe.attachment.fourier_basis); the free-body solver (RBE3)."""
 
     static: np.ndarray
     fixed: np.ndarray
     attached: np.ndarray
-    factor_bytes: int
     solver: _FreeBodySolver | None = None
 
 
@@ -401,7 +399,7 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
     static = con.solve(None, np.eye(con.p))
     fixed = con.eigen(fe, n_modes, fe.mass_operator())[1] if n_modes else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
-    return BasisParts(static, fixed, attached, solver.factor_bytes, solver)
+    return BasisParts(static, fixed, attached, solver)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
@@ -433,7 +431,7 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
     if n_compare:  # here, while the factor exists: it is freed before the dense work on the basis
         full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
     t_full = time.perf_counter() - t_full
-    n_attached, factor_bytes = parts.attached.shape[1], parts.factor_bytes
+    n_attached = parts.attached.shape[1]
     basis = np.hstack([parts.static, parts.fixed, parts.attached])
     del parts  # the factor and the blocks: the peak memory is the factor's or the basis's, not both
     modes, lam, dropped = modal_basis(basis, fe.K, fe.mass_operator())
@@ -442,7 +440,7 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
         modes, lam = modes[:, :keep_modes], lam[:keep_modes]
     t_reduce = time.perf_counter() - t0 - t_full
     invariants = ffrf_invariants(fe.mass_scalar, fe.nodes, modes)
-    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes), "factor_mb": factor_bytes / 1e6,
+    info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes),
             "attachment_vectors": float(n_attached), "dropped_directions": float(dropped),
             "reduce_time_s": t_reduce, "total_time_s": time.perf_counter() - t0}
     return ReducedBody(fe.nodes, modes, lam, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), full, itfs, kind,
