@@ -26,7 +26,6 @@ def test_cholesky_solves_the_stiffness_system_as_superlu_does():
     loads = np.random.default_rng(3).standard_normal((len(free), 3))
     expected = sla.splu(k_ff.tocsc()).solve(loads)
     chol = SparseCholesky(k_ff)
-
     got = chol.solve(loads)
     k_norm = sla.norm(k_ff, 1)  # normwise backward error ||K u - f|| / (||K|| ||u|| + ||f||): round-off
     for u in (got, expected):

@@ -5,9 +5,11 @@ clamped body) are symmetric positive definite. CHOLMOD's supernodal Cholesky fac
 the lower triangle (fill-reducing AMD ordering, dense supernode blocks through BLAS) holds one
 triangular factor. Against NGSolve's ``sparsecholesky``, which the project used before, on the coarse
 planet's free body (121 k coordinates): factorisation 1.6 s instead of 2.6 s, one solve 48 ms instead of
-108 ms, the same peak memory; the cold build of the planet 49.7 s -> 39.1 s and of the ring 75.4 s ->
-54.4 s, first frequencies equal to 1e-11 (benchmarks/bench_cold.py times the whole cold build). CVXOPT's
-wheels carry SuiteSparse and a single-threaded OpenBLAS: the caller chooses the parallelism.
+108 ms; the cold build of the planet 49.7 s -> 39.1 s and of the ring 75.4 s ->
+54.4 s (the ring's process peaks at 1.44 GB either way), first frequencies equal to 1e-11
+(benchmarks/bench_cold.py times the whole cold build). CVXOPT's
+wheels carry SuiteSparse and a single-threaded OpenBLAS: the caller chooses the parallelism. CHOLMOD's
+supernodal mode is CVXOPT's process-wide option; :class:`SparseCholesky` asks for it on each factorisation.
 """
 
 from __future__ import annotations
