@@ -2,7 +2,7 @@
 
 The reduction's stiffness systems (free body with six support coordinates removed, or the interior of a
 clamped body) are symmetric positive definite. CHOLMOD's supernodal Cholesky factorisation K = L L^T of
-the lower triangle (fill-reducing AMD ordering, dense supernode blocks through BLAS) holds one
+the lower triangle (CHOLMOD's default fill-reducing ordering, dense supernode blocks through BLAS) holds one
 triangular factor. Against NGSolve's ``sparsecholesky``, which the project used before, on the coarse
 planet's free body (121 k coordinates): factorisation 1.6 s instead of 2.6 s, one solve 48 ms instead of
 108 ms; the cold build of the planet 49.7 s -> 39.1 s and of the ring 75.4 s ->
