@@ -236,6 +236,12 @@ class SolverSettings:
     # "sparse": Eigen's SparseLU orders the Jacobian anew at each factorization or reuses the ordering of the last
     # one while its pattern holds (Exudyn's reuseAnalyzedPattern)
     sparse_ordering: str = _choice("per_jacobian", "reused", default="per_jacobian")
+    # when the modified Newton gets a fresh Jacobian (flexgear.mbs.newton): "exudyn" only after a step fails to
+    # converge within newton_max_modified_iterations; "economy" also when the iterations paid above the fewest since
+    # the last Jacobian reach a Jacobian's measured cost in iterations (assumed jacobian_initial_cost_iterations
+    # until measured)
+    jacobian_updates: str = _choice("exudyn", "economy", default="exudyn")
+    jacobian_initial_cost_iterations: float = _num(1.0, default=10.0)
 
 
 @dataclass(frozen=True)

@@ -4,7 +4,8 @@ Solver: generalized-alpha (spectral radius from ``[solver_assumed]``), modified 
 Jacobian update after at most ``newton_max_modified_iterations`` iterations, dense linear solver,
 one thread, no solution file; sensors store every ``record_every_steps``-th step in memory.
 
-Divergence guard (:class:`RunGuard`, a post-step user function): the run stops and is recorded as
+Divergence guard (:class:`RunGuard`, a post-step user function; it also drives the Jacobian economy of
+``[solver_assumed] jacobian_updates = "economy"``, flexgear.mbs.newton): the run stops and is recorded as
 failed, with its reason, when the state is not finite (NaN), when a shaft spins faster than
 ``runaway_speed_factor`` times its nominal speed (a runaway), when the wall time exceeds
 ``wall_time_budget_s`` (all three in ``[solver_assumed]``), or when Newton's method fails (Exudyn's
@@ -24,6 +25,7 @@ import pandas as pd
 
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
+from flexgear.mbs.newton import JacobianEconomy
 from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.progress import Progress
@@ -123,8 +125,13 @@ class RunGuard:
         self.steps = 0
         self.t0 = time.perf_counter()
         self.bar = Progress(t_end, f"run {variant.name}", "s", enabled=progress, fmt="{:.4g}")
+        sv = variant.gearbox.solver_assumed
+        self.economy = (JacobianEconomy(sv.jacobian_initial_cost_iterations) if sv.jacobian_updates == "economy"
+                        else None)
 
     def __call__(self, mbs, t: float) -> bool:
+        if self.economy is not None:
+            self.economy(mbs)
         self.steps += 1
         if self.steps % GUARD_EVERY_STEPS:
             return True
@@ -196,6 +203,14 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
     guard.bar.close()
 
 
+def solver_counts(mbs) -> dict[str, int]:
+    """Newton iterations and Jacobian computations of the last ``SolveDynamic`` (stored solver), for the metadata."""
+    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
+    if solver is None:
+        return {}
+    return {"newton_iterations": int(solver.it.newtonStepsCount), "jacobians": int(solver.it.newtonJacobiCount)}
+
+
 def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
                 mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
                 time_budget_s: float | None = None, record_states_every: int = 0) -> RunResult:
@@ -230,6 +245,9 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         build_s = time.perf_counter() - wall0
         guard = RunGuard(model, variant, t_end, budget - build_s, progress)
         _solve(mbs, variant, t_end, guard)
+        meta.update(solver_counts(mbs))
+        if guard.economy is not None:  # a Jacobian's cost in iterations as measured (flexgear.mbs.newton)
+            meta["jacobian_cost_iterations"] = guard.economy.ratio
         signals = _signals(mbs, model, sensors)
         window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:

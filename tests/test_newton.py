@@ -1,0 +1,96 @@
+"""The Jacobian economy (flexgear.mbs.newton): its rule on a scripted solver, and a run that keeps every signal.
+
+No timings (benchmarks/bench_speed.py measures the runs); the cost ratio is fitted from a scripted clock.
+"""
+
+import dataclasses
+
+import pytest
+from conftest import VARIANTS
+
+from flexgear.mbs.newton import MIN_SAMPLES, JacobianEconomy
+from flexgear.mbs.run import run_variant
+from flexgear.spec import load_variant
+from flexgear.study.agreement import signal_agreement
+
+
+class _Solver:
+    """Stand-in for Exudyn's stored solver: ``it.newtonSteps``, ``it.newtonJacobiCount``, ``conv`` flag."""
+
+    def __init__(self):
+        self.it = type("It", (), {"newtonSteps": 0, "newtonJacobiCount": 1})()
+        self.conv = type("Conv", (), {"jacobianUpdateRequested": False})()
+
+
+class _System:
+    def __init__(self):
+        self.sys = {"dynamicSolver": _Solver()}
+
+
+class _Clock:
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self):
+        return self.now
+
+
+def _step(economy, system, clock, n, jacobian, a=10e-6, b=5e-6, cost=40e-6):
+    """One scripted step: n iterations, with a Jacobian or not; its wall time a + b n (+ cost)."""
+    solver = system.sys["dynamicSolver"]
+    solver.it.newtonSteps = n
+    if jacobian:
+        solver.it.newtonJacobiCount += 1
+        solver.conv.jacobianUpdateRequested = False  # Exudyn consumes the request with the Jacobian
+    clock.now += a + b * n + (cost if jacobian else 0.0)
+    economy(system)
+    return solver.conv.jacobianUpdateRequested
+
+
+def test_a_jacobian_is_requested_when_the_extra_iterations_reach_its_assumed_cost():
+    clock, system = _Clock(), _System()
+    economy = JacobianEconomy(initial_ratio=4.0, clock=clock)
+    _step(economy, system, clock, 1, False)  # first call: binds the solver, no timing
+    assert not _step(economy, system, clock, 1, False)  # the fewest since the last Jacobian: 1
+    assert not _step(economy, system, clock, 3, False)  # paid 2 above it
+    assert _step(economy, system, clock, 3, False)  # paid 4 = the assumed cost: the next step gets a Jacobian
+    assert not _step(economy, system, clock, 1, True)  # the Jacobian step resets the account
+
+
+def test_the_cost_ratio_is_fitted_from_the_steps_times():
+    """Steps take a + b n, a Jacobian adds c: the ratio is c / b (40 us / 5 us = 8 iterations)."""
+    clock, system = _Clock(), _System()
+    economy = JacobianEconomy(initial_ratio=100.0, clock=clock)
+    _step(economy, system, clock, 1, False)
+    for k in range(2 * MIN_SAMPLES):
+        _step(economy, system, clock, 1 + k % 3, False)  # iteration counts that vary: a and b identifiable
+    assert economy.ratio == pytest.approx(100.0)  # no Jacobian step measured yet: the assumption holds
+    _step(economy, system, clock, 2, True)
+    assert economy.ratio == pytest.approx(8.0, rel=1e-9)
+
+
+@pytest.fixture(scope="module")
+def short_model1():
+    """Model 1 on ramps of 0.02 s to 0.03 s: light load early in the ramps, where Exudyn keeps a stale Jacobian."""
+    v = load_variant(VARIANTS / "model1.toml")
+    g = v.gearbox
+    g = g.with_changes(load_case=dataclasses.replace(g.load_case, ramp_time_s=0.02, end_time_s=0.03))
+    return dataclasses.replace(v, gearbox=g, rigid_mass_properties="exact")
+
+
+def _with_updates(variant, updates: str):
+    g = variant.gearbox
+    return dataclasses.replace(variant, gearbox=g.with_changes(
+        solver_assumed=dataclasses.replace(g.solver_assumed, jacobian_updates=updates)))
+
+
+def test_the_economy_keeps_every_signal_and_saves_iterations(short_model1):
+    """Issue 16's rule (means 0.1 %, 1x mesh amplitudes 2 %) against Exudyn's own Jacobian policy, fewer iterations."""
+    ref = run_variant(_with_updates(short_model1, "exudyn"))
+    new = run_variant(_with_updates(short_model1, "economy"))
+    assert ref.ok and new.ok, (ref.meta.get("reason"), new.meta.get("reason"))
+    lc = short_model1.gearbox.load_case
+    agreement = signal_agreement(ref, new, (lc.ramp_time_s, lc.end_time_s), ref.meta["theory"]["mesh_frequency_hz"])
+    assert agreement.ok(), agreement.table
+    assert new.meta["newton_iterations"] < ref.meta["newton_iterations"]
+    assert new.meta["jacobian_cost_iterations"] >= 1.0
