@@ -20,23 +20,15 @@ flexgear.mbs.newton) side by side, the ratios per policy; without it, the varian
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import sys
 from pathlib import Path
 
-from speed_common import figure_line, floor_variant, load_average, ratio_line
+from speed_common import figure_line, floor_variant, load_average, ratio_line, with_jacobian_updates
 
 from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def with_jacobian_updates(variant, updates: str):
-    """``variant`` with ``[solver_assumed] jacobian_updates = updates`` (flexgear.mbs.newton)."""
-    g = variant.gearbox
-    return dataclasses.replace(variant, gearbox=g.with_changes(
-        solver_assumed=dataclasses.replace(g.solver_assumed, jacobian_updates=updates)))
 
 
 def main() -> None:

@@ -56,3 +56,10 @@ def floor_variant(variant: Variant) -> Variant:
         contact_assumed=dataclasses.replace(gb.contact_assumed, stiffness_variation="constant"),
         contact=dataclasses.replace(gb.contact, friction_coefficient=0.0))
     return dataclasses.replace(variant, gearbox=gb, name=f"{variant.name}_floor")
+
+
+def with_jacobian_updates(variant: Variant, updates: str) -> Variant:
+    """``variant`` with ``[solver_assumed] jacobian_updates = updates`` (flexgear.mbs.newton)."""
+    g = variant.gearbox
+    return dataclasses.replace(variant, gearbox=g.with_changes(
+        solver_assumed=dataclasses.replace(g.solver_assumed, jacobian_updates=updates)))
