@@ -238,10 +238,9 @@ class SolverSettings:
     sparse_ordering: str = _choice("per_jacobian", "reused", default="per_jacobian")
     # when the modified Newton gets a fresh Jacobian (flexgear.mbs.newton): "exudyn" only after a step fails to
     # converge within newton_max_modified_iterations; "economy" also when the iterations paid above the fewest since
-    # the last Jacobian reach a Jacobian's measured cost in iterations (assumed jacobian_initial_cost_iterations
-    # until measured)
+    # the last Jacobian reach jacobian_cost_iterations, a Jacobian's cost in iterations
     jacobian_updates: str = _choice("exudyn", "economy", default="exudyn")
-    jacobian_initial_cost_iterations: float = _num(1.0, default=10.0)
+    jacobian_cost_iterations: float = _num(1.0, default=12.0)
 
 
 @dataclass(frozen=True)

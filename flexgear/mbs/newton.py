@@ -4,24 +4,25 @@ Exudyn's modified Newton keeps the factorised Jacobian of an earlier step until 
 within ``newton_max_modified_iterations`` iterations: with the default 3, a step that converges in its
 fourth iteration keeps the old Jacobian, and so may every following step. That happens where the
 Jacobian goes stale slowly: at light load early in the ramps (contacts near separation, where the impact
-law's tangent k e delta^(e-1) varies most) and in the flexible variants, whose linear joints and seats turn
-with the spin (``profile_mbs.py --trace-newton``). A Jacobian costs ``r`` iterations' time (model 1 about 3,
-model 7 about 11: a sparse LU of the ring's and output shaft's dense modal blocks).
+law's tangent k e delta^(e-1) varies most; model 1 needs about 3 iterations per step over 0-0.1 s and 1
+after 0.2 s, ``benchmarks/bench_newton.py``) and in the flexible variants, whose linear joints and seats
+turn with the spin (``benchmarks/profile_mbs.py --trace-newton``).
 
 :class:`JacobianEconomy` (``[solver_assumed] jacobian_updates = "economy"``) watches, after every step, the
 iterations the step took. Since the last Jacobian the steps have paid ``E = sum(n_k) - count x min(n_k)``
-iterations above the fewest any of them needed; when ``E`` reaches ``r`` it asks Exudyn for a Jacobian at
-the next step (``conv.jacobianUpdateRequested``). That is the break-even rule of the ski-rental problem: the
-extra iterations paid never exceed about one Jacobian's cost per refresh, and a Jacobian is bought only
-when the iterations it saves have already cost as much. ``r`` is measured during the run from the steps'
-wall time: ``t = a + b n`` fitted over the steps without a Jacobian (least squares in running sums; ``b``
-the cost of one iteration), a Jacobian's cost the excess ``t - (a + b n)`` of the steps with one, averaged.
-Until a Jacobian step and ``MIN_SAMPLES`` steps without one are measured, ``r`` is the configuration's
-``[solver_assumed] jacobian_initial_cost_iterations``.
+iterations above the fewest any of them needed; when ``E`` reaches ``r``, a Jacobian's cost in iterations
+(``[solver_assumed] jacobian_cost_iterations``), it asks Exudyn for a Jacobian at the next step
+(``conv.jacobianUpdateRequested``). That is the break-even rule of the ski-rental problem: the extra
+iterations paid never exceed about one Jacobian's cost per refresh, and a Jacobian is bought only when the
+iterations it saves have already cost as much.
 
-The converged solution is the same to the Newton tolerance (the tolerance and the iteration are unchanged,
-only the matrix they use is fresher); ``tests/test_newton.py`` checks issue 16's rule against Exudyn's own
-Jacobian policy.
+``r`` is a fixed setting, so that a run is deterministic (the same state, the same Jacobians). The run also
+measures it, for the report only (:attr:`JacobianEconomy.measured_ratio`, the run's metadata
+``jacobian_cost_iterations_measured``): from the steps' wall times, ``t = a + b n`` fitted over the steps
+without a Jacobian (least squares in running sums; ``b`` the cost of one iteration) and a Jacobian's cost the
+mean excess ``t - (a + b n)`` of the steps with one. The converged solution is the same to the Newton
+tolerance (the tolerance and the iteration are unchanged, only the matrix they use is fresher);
+``tests/test_newton.py`` checks issue 16's rule against Exudyn's own Jacobian policy.
 """
 
 from __future__ import annotations
@@ -32,20 +33,25 @@ from collections.abc import Callable
 __all__ = ["MIN_SAMPLES", "JacobianEconomy"]
 
 MIN_SAMPLES = 8
-"""Steps without a Jacobian needed (beside one with a Jacobian) before the measured cost ratio is used."""
+"""Steps without a Jacobian needed (beside one with a Jacobian) before the cost ratio is reported as measured."""
 
 
 class JacobianEconomy:
     """Post-step bookkeeping of one run (call it after every step with the run's Exudyn system).
 
-    ``initial_ratio``: a Jacobian's cost in iterations until it is measured
-    (``[solver_assumed] jacobian_initial_cost_iterations``); ``ratio`` the current value.
+    ``ratio``: a Jacobian's cost in iterations that the rule uses (``[solver_assumed] jacobian_cost_iterations``);
+    ``clock`` [s]: the wall clock of the cost measurement (a scripted one in the tests).
     """
 
-    __slots__ = ("_it", "_conv", "_jacobians", "_clock", "_count", "_sum", "_min", "_free", "_jac", "ratio", "_now")
+    __slots__ = ("_it", "_conv", "_jacobians", "_clock", "_count", "_sum", "_min", "_free", "_jac", "_now",
+                 "ratio", "requests")
 
-    def __init__(self, initial_ratio: float, clock: Callable[[], float] = time.perf_counter) -> None:
-        self._now = clock  # [s]; a scripted clock in the tests
+    def __init__(self, ratio: float, clock: Callable[[], float] = time.perf_counter) -> None:
+        if not ratio >= 1.0:
+            raise ValueError(f"a Jacobian's cost in iterations must be >= 1, got {ratio!r}")
+        self.ratio = float(ratio)
+        self.requests = 0  # Jacobians this rule asked for
+        self._now = clock
         self._it = None  # the stored solver's iteration data (flexgear.mbs.run stores the solver)
         self._conv = None
         self._jacobians = 0
@@ -53,7 +59,6 @@ class JacobianEconomy:
         self._count, self._sum, self._min = 0, 0, 1 << 30  # steps, iterations and the fewest since the last Jacobian
         self._free = [0.0, 0.0, 0.0, 0.0, 0.0]  # steps without a Jacobian: count, sum n, sum n^2, sum t, sum n t [s]
         self._jac = [0.0, 0.0, 0.0]  # steps with one: count, sum n, sum t [s]
-        self.ratio = float(initial_ratio)  # a Jacobian's cost in iterations: assumed until measured
 
     def __call__(self, mbs) -> None:
         now = self._now()
@@ -72,7 +77,6 @@ class JacobianEconomy:
             s[1] += n
             s[2] += dt
             self._count, self._sum, self._min = 0, 0, 1 << 30
-            self._update_ratio()
             return
         f = self._free
         f[0] += 1.0
@@ -84,18 +88,19 @@ class JacobianEconomy:
         self._sum += n
         if n < self._min:
             self._min = n
-        if self._sum - self._count * self._min >= self.ratio:
+        if self._sum - self._count * self._min >= self.ratio and not self._conv.jacobianUpdateRequested:
             self._conv.jacobianUpdateRequested = True
+            self.requests += 1
 
-    def _update_ratio(self) -> None:
-        """r = (mean Jacobian-step time - (a + b mean n of those steps)) / b from the running sums."""
+    @property
+    def measured_ratio(self) -> float | None:
+        """A Jacobian's cost in iterations as this run measured it, or None before enough steps (report only)."""
         f, s = self._free, self._jac
         if f[0] < MIN_SAMPLES or s[0] < 1.0:
-            return
+            return None
         det = f[0] * f[2] - f[1] * f[1]
         b = (f[0] * f[4] - f[1] * f[3]) / det if det > 1e-9 * f[0] * f[0] else f[3] / f[1]
         if not b > 0.0:  # iteration counts that do not vary enough to fit: the mean time per iteration
             b = f[3] / f[1]
         a = (f[3] - b * f[1]) / f[0]
-        cost = (s[2] - s[0] * a - b * s[1]) / s[0]
-        self.ratio = max(cost / b, 1.0)
+        return max((s[2] - s[0] * a - b * s[1]) / s[0] / b, 0.0)

@@ -126,8 +126,7 @@ class RunGuard:
         self.t0 = time.perf_counter()
         self.bar = Progress(t_end, f"run {variant.name}", "s", enabled=progress, fmt="{:.4g}")
         sv = variant.gearbox.solver_assumed
-        self.economy = (JacobianEconomy(sv.jacobian_initial_cost_iterations) if sv.jacobian_updates == "economy"
-                        else None)
+        self.economy = JacobianEconomy(sv.jacobian_cost_iterations) if sv.jacobian_updates == "economy" else None
 
     def __call__(self, mbs, t: float) -> bool:
         if self.economy is not None:
@@ -246,8 +245,9 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         guard = RunGuard(model, variant, t_end, budget - build_s, progress)
         _solve(mbs, variant, t_end, guard)
         meta.update(solver_counts(mbs))
-        if guard.economy is not None:  # a Jacobian's cost in iterations as measured (flexgear.mbs.newton)
-            meta["jacobian_cost_iterations"] = guard.economy.ratio
+        if guard.economy is not None:  # the Jacobians it asked for, a Jacobian's cost as measured (flexgear.mbs.newton)
+            meta.update(jacobian_requests=guard.economy.requests,
+                        jacobian_cost_iterations_measured=guard.economy.measured_ratio)
         signals = _signals(mbs, model, sensors)
         window_start = min(variant.gearbox.load_case.ramp_time_s, 0.8 * t_end)
         if model.kinematics is not None:
