@@ -34,8 +34,8 @@ ROOT = Path(__file__).resolve().parents[1]
 def shortened(variant, ramp: float, t_end: float, tolerance: float):
     """``variant`` on ramps of ``ramp`` [s] to ``t_end`` [s] with the Newton relative tolerance ``tolerance``."""
     g = variant.gearbox
-    g = g.with_changes(load_case=dataclasses.replace(g.load_case, ramp_time_s=ramp, end_time_s=t_end),
-                       solver_assumed=dataclasses.replace(g.solver_assumed, newton_relative_tolerance=tolerance))
+    g = g.with_fields("load_case", ramp_time_s=ramp, end_time_s=t_end).with_fields(
+        "solver_assumed", newton_relative_tolerance=tolerance)
     return dataclasses.replace(variant, gearbox=g)
 
 

@@ -60,6 +60,4 @@ def floor_variant(variant: Variant) -> Variant:
 
 def with_jacobian_updates(variant: Variant, updates: str) -> Variant:
     """``variant`` with ``[solver_assumed] jacobian_updates = updates`` (flexgear.mbs.newton)."""
-    g = variant.gearbox
-    return dataclasses.replace(variant, gearbox=g.with_changes(
-        solver_assumed=dataclasses.replace(g.solver_assumed, jacobian_updates=updates)))
+    return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("solver_assumed", jacobian_updates=updates))

@@ -434,6 +434,11 @@ class GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""
         return dataclasses.replace(self, **tables)
 
+    def with_fields(self, table: str, **fields: Any) -> GearboxSpec:
+        """A new spec with single fields of one table replaced (``spec.with_fields("solver_assumed",
+        jacobian_updates="exudyn")``)."""
+        return dataclasses.replace(self, **{table: dataclasses.replace(getattr(self, table), **fields)})
+
 
 @dataclass(frozen=True)
 class Variant:

@@ -88,9 +88,7 @@ def short_model1():
 
 
 def _with_updates(variant, updates: str):
-    g = variant.gearbox
-    return dataclasses.replace(variant, gearbox=g.with_changes(
-        solver_assumed=dataclasses.replace(g.solver_assumed, jacobian_updates=updates)))
+    return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("solver_assumed", jacobian_updates=updates))
 
 
 def test_the_economy_keeps_every_signal_and_saves_iterations(short_model1):

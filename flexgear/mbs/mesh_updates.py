@@ -38,8 +38,6 @@ class MeshUpdates:
         self.factor_rows = np.array([keys.index(k) for k in wanted], dtype=np.int64)
         self._index: tuple[np.ndarray, np.ndarray] | None = None
         self._force: np.ndarray | None = None
-        self._read: tuple | None = None  # (the coordinates' and the velocities' readers), set by bind
-        self._write: tuple | None = None  # (SetObjectParameter, the friction container)
 
     def values_and_forces(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Stiffness factors of the schedule's variables and friction forces on the frames (compiled; the
@@ -73,23 +71,14 @@ class MeshUpdates:
                       (*self._index, self.law, f._means, f._cos, f._sin, columns, sliding, spin,
                        self.factor_rows, self._force, self._factors, np.zeros(len(f.mu)), f.law.kind == "iso6336"))
         self._set = [var.SetValue for var in self.schedule.variables]
-        # the per-step calls into Exudyn, looked up once; without residual deflections the law sees the
-        # coordinates themselves (MeshFriction.tooth_state is then the two reads)
-        system = mbs.systemData
-        self._read = ((system.GetODE2Coordinates, system.GetODE2Coordinates_t) if f.residual is None else None)
-        self._write = (mbs.SetObjectParameter, f.container)
 
     def __call__(self, mbs, t: float) -> bool:
         if self._index is None:
             self.bind(mbs)
         head, tail = self._args
-        if self._read is None:
-            self._kernel(t, *head, *self.friction.tooth_state(mbs), *tail)
-        else:
-            self._kernel(t, *head, self._read[0](), self._read[1](), *tail)
+        self._kernel(t, *head, *self.friction.tooth_state(mbs), *tail)
         for set_value, value in zip(self._set, self._factors.tolist(), strict=True):
             set_value(value)
-        set_parameter, container = self._write
-        set_parameter(container, "forceVector", self._force)
+        mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
         return True
 

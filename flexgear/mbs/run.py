@@ -204,7 +204,7 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
 
 def solver_counts(mbs) -> dict[str, int]:
     """Newton iterations and Jacobian computations of the last ``SolveDynamic`` (stored solver), for the metadata."""
-    solver = mbs.sys.get("dynamicSolver") if hasattr(mbs, "sys") else None
+    solver = mbs.sys.get("dynamicSolver")
     if solver is None:
         return {}
     return {"newton_iterations": int(solver.it.newtonStepsCount), "jacobians": int(solver.it.newtonJacobiCount)}
