@@ -135,7 +135,7 @@ def test_fused_mesh_updates_equal_their_parts(model1):
     updates.bind(mbs)
     rng = np.random.default_rng(11)
     n = mbs.systemData.ODE2Size()
-    aux = updates._index[0]
+    aux = updates._tooth[0]
     for t in (0.01, 0.3, 0.55):
         q, q_t = rng.normal(0, 1e-3, n), rng.normal(0, 300, n)
         q[aux] = rng.uniform(-1e-4, 5e-4, aux.size)
@@ -186,3 +186,57 @@ def test_matrix_orders_runs_by_their_dynamic_modes(monkeypatch, tmp_path):
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path))  # nothing cached: the count of flexible bodies
     assert run_cost(variants["model7"]) is None
     assert _run_order(variants)[:1] == ["model7"] and _run_order(variants)[-1] == "model1"
+
+
+def test_mesh_updates_read_views_that_follow_the_solver(model1, monkeypatch):
+    """The per-step mesh updates read the state through views of the system's vectors (no copies): a run gives
+    bit-identical signals to one that hands them fresh copies every step, and the views are still the
+    system's state at the end of the run."""
+    short = dataclasses.replace(model1, gearbox=model1.gearbox.with_changes(load_case=dataclasses.replace(
+        model1.gearbox.load_case, ramp_time_s=0.004, end_time_s=0.008)))
+    seen = []
+    original = MeshUpdates.__call__
+
+    def checked(self, mbs, t):
+        ok = original(self, mbs, t)
+        seen.append(np.array_equal(self._q, mbs.systemData.GetODE2Coordinates())
+                    and np.array_equal(self._q_t, mbs.systemData.GetODE2Coordinates_t()))
+        return ok
+
+    monkeypatch.setattr(MeshUpdates, "__call__", checked)
+    fast = run_variant(short)
+    assert fast.ok, fast.meta.get("reason")
+    assert len(seen) >= 800 and all(seen)
+
+    def copying(self, mbs, t):
+        if self._q is None:
+            self.bind(mbs)
+        self._q, self._q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        return original(self, mbs, t)
+
+    monkeypatch.setattr(MeshUpdates, "__call__", copying)
+    ref = run_variant(short)
+    assert ref.ok, ref.meta.get("reason")
+    forces = fast.signals.filter(regex="mesh_force").to_numpy()
+    assert forces[-1].min() > 10.0  # the teeth carry load, with friction and varying stiffness acting
+    np.testing.assert_array_equal(fast.signals.to_numpy(), ref.signals.to_numpy())
+
+
+def test_pre_step_chain_drops_a_finished_function():
+    from flexgear.mbs.contact_kinematics import PreStepChain
+
+    calls = []
+
+    class Ramp:
+        finished = False
+
+        def __call__(self, mbs, t):
+            calls.append(("ramp", t))
+            self.finished = t >= 2
+            return True
+
+    chain = PreStepChain([Ramp(), lambda mbs, t: calls.append(("mesh", t)) or True])
+    for t in range(5):
+        assert chain(None, t)
+    assert [t for name, t in calls if name == "ramp"] == [0, 1, 2]
+    assert [t for name, t in calls if name == "mesh"] == [0, 1, 2, 3, 4]

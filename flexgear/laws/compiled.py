@@ -150,48 +150,55 @@ def turn_columns(buffer, const, cos_part, sin_part, spin_index, spins, target, t
 
 
 @njit(cache=True)
-def mesh_step(t, ramp_time, drive_speed, rate, offset, q, q_t, aux, frames, law, means, cos_c, sin_c,  # noqa: PLR0913
-              columns, sliding, spin, factor_rows, force, factors, work, linear=False):  # pragma: no cover
-    """One step's mesh updates in one call, without temporaries: stiffness factors s(phi) of the contacts
-    ``factor_rows`` (written into ``factors``; ``work``: one entry per contact) and the friction forces on the
-    frame coordinates (written into ``force[:frames.size]``).
+def mesh_step(t, ramp_time, drive_speed, q, q_t, tooth, frames, law, series, columns, rows,  # noqa: PLR0913
+              factor_rows, out, linear=False):  # pragma: no cover - compiled
+    """One step's mesh updates in one call, without temporaries: the friction forces on the frame coordinates
+    (written into ``out[:frames.size]``) and the stiffness factors s(phi) of the contacts ``factor_rows``
+    (written into ``out[frames.size:frames.size + factor_rows.size]``; the rest of ``out``, one entry per
+    contact, is work space).
 
-    phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
-    (:func:`ramp_state`); ``q``, ``q_t``: all ODE2 coordinates and rates, ``aux``: the contacts'
-    deflection coordinates, ``frames``: the bodies' frame coordinates; ``law`` rows: stiffness,
-    exponent, damping_max, penetration depth, mu, v_reg. The sliding and spin rows of contact i are sparse
-    (each touches the 12 frame coordinates of its two gears): ``sliding[i, k]``, ``spin[i, k]`` are their
-    entries at frame coordinate ``columns[i, k]`` (:func:`padded_sparse_rows`). Same numbers as
-    :func:`periodic_values` plus :func:`mesh_friction_forces` with the dense rows.
+    Per contact i: phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
+    (:func:`ramp_state`); ``law[:, i]``: stiffness, exponent, damping_max, penetration depth, mu, v_reg, rate,
+    offset; ``series[k, i]``: mean, cos and sin coefficients (harmonics 1..n_h) of series k (0: stiffness factor,
+    1: sliding direction kappa, 2: lever lambda [m]). ``q``, ``q_t``: all ODE2 coordinates and rates (read
+    only); the contact's tooth deflection is q[tooth[0, i]] less q[tooth[1, i]] when tooth[1, i] >= 0 (its
+    residual deflection, flexgear.mbs.residual); ``frames``: the bodies' frame coordinates. The sliding and
+    spin rows of contact i are sparse (each touches the 12 frame coordinates of its two gears): ``rows[0, i, k]``
+    and ``rows[1, i, k]`` are their entries at frame coordinate ``columns[i, k]`` (:func:`padded_sparse_rows`).
+    Same numbers as :func:`periodic_values` plus :func:`mesh_friction_forces` with the dense rows.
     """
     theta = drive_speed * ramp_state(t, ramp_time)[0]
-    n_c, n_h = cos_c.shape[1], cos_c.shape[2]
-    for j in range(frames.size):
-        force[j] = 0.0
+    n_c, n_h, n_f = law.shape[1], (series.shape[2] - 1) // 2, frames.size
+    work = n_f + factor_rows.size
+    for j in range(n_f):
+        out[j] = 0.0
     for i in range(n_c):
-        x = 2.0 * math.pi * (rate[i] * theta - offset[i])
+        x = 2.0 * math.pi * (law[6, i] * theta - law[7, i])
         c1, s1 = math.cos(x), math.sin(x)
         ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
-        v0, v1, v2 = means[0, i], means[1, i], means[2, i]
-        for h in range(n_h):
-            v0 += cos_c[0, i, h] * ch + sin_c[0, i, h] * sh
-            v1 += cos_c[1, i, h] * ch + sin_c[1, i, h] * sh
-            v2 += cos_c[2, i, h] * ch + sin_c[2, i, h] * sh
+        v0, v1, v2 = series[0, i, 0], series[1, i, 0], series[2, i, 0]
+        for h in range(1, n_h + 1):
+            v0 += series[0, i, h] * ch + series[0, i, n_h + h] * sh
+            v1 += series[1, i, h] * ch + series[1, i, n_h + h] * sh
+            v2 += series[2, i, h] * ch + series[2, i, n_h + h] * sh
             ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
-        work[i] = v0
-        d, d_t = q[aux[i]], q_t[aux[i]]
+        out[work + i] = v0
+        d, d_t = q[tooth[0, i]], q_t[tooth[0, i]]
+        if tooth[1, i] >= 0:
+            d -= q[tooth[1, i]]
+            d_t -= q_t[tooth[1, i]]
         if linear:
             normal = linear_normal_force(d, d_t, law[0, i] * v0, law[2, i])
         else:
             normal = impact_normal_force(d, d_t, law[0, i] * v0, law[1, i], law[2, i], law[3, i])
         spin_rate = 0.0
         for k in range(columns.shape[1]):
-            spin_rate += spin[i, k] * q_t[frames[columns[i, k]]]
-        f = law[4, i] * normal * math.tanh(spin_rate * means[2, i] / law[5, i])
+            spin_rate += rows[1, i, k] * q_t[frames[columns[i, k]]]
+        f = law[4, i] * normal * math.tanh(spin_rate * series[2, i, 0] / law[5, i])
         for k in range(columns.shape[1]):
-            force[columns[i, k]] -= sliding[i, k] * (f * v1) + spin[i, k] * (f * v2)
+            out[columns[i, k]] -= rows[0, i, k] * (f * v1) + rows[1, i, k] * (f * v2)
     for k in range(factor_rows.size):
-        factors[k] = work[factor_rows[k]]
+        out[n_f + k] = out[work + factor_rows[k]]
 
 
 def padded_sparse_rows(*rows: np.ndarray) -> tuple[np.ndarray, ...]:

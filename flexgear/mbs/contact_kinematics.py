@@ -142,13 +142,23 @@ class ContactKinematics:
 
 
 class PreStepChain:
-    """Several pre-step functions as one (Exudyn takes a single pre-step user function)."""
+    """Several pre-step functions as one (Exudyn takes a single pre-step user function).
+
+    A function with a ``finished`` attribute leaves the chain once that is true (the spin schedule after the
+    ramp: flexgear.mbs.spin.SpinSchedule), so that the steady part of a run does not call it every step.
+    """
 
     def __init__(self, functions: list[Callable]):
         self.functions = [f for f in functions if f is not None]
+        self._finishing = [f for f in self.functions if hasattr(f, "finished")]
 
     def __call__(self, mbs, t: float) -> bool:
         ok = True
         for f in self.functions:
             ok = f(mbs, t) and ok
+        for f in self._finishing:
+            if f.finished:
+                self.functions.remove(f)
+                self._finishing.remove(f)
+                break  # the others at the next step
         return ok

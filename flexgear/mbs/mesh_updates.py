@@ -5,7 +5,8 @@ variables) and :class:`flexgear.mbs.contacts.MeshFriction` (friction from the st
 the step as a generalized load) each need the drive angle, the mesh phases and the stiffness series
 once per step. Run as two pre-step functions they cost four compiled calls and their Python glue;
 :class:`MeshUpdates` does the same work in one (flexgear.laws.compiled.mesh_step), which is what a
-run spends in Python per step besides Exudyn's own call overhead. The numbers are those of the two
+run spends in Python per step besides Exudyn's own call overhead. It reads the state through views of
+the system's coordinate vectors (no copies per step). The numbers are those of the two
 parts (:meth:`MeshUpdates.reference` evaluates them with the parts' numpy reference implementations).
 """
 
@@ -24,8 +25,9 @@ class MeshUpdates:
     def __init__(self, schedule: StiffnessSchedule, friction: MeshFriction):
         self.schedule, self.friction = schedule, friction
         f = friction
-        self.law = np.ascontiguousarray([f.law.stiffness, f.law.exponent, f.law.damping_max,
-                                         f.law.penetration_depth, f.mu, f.reg], dtype=float)
+        # the kernel's rows per contact (flexgear.laws.compiled.mesh_step)
+        self.law = np.ascontiguousarray([f.law.stiffness, f.law.exponent, f.law.damping_max, f.law.penetration_depth,
+                                         f.mu, f.reg, f.phase_rate, f.offsets], dtype=float)
         # schedule variable k takes the factor of the first contact with its phase and stiffness series
         def key(rate: float, offset: float, mean: float, cos: np.ndarray, sin: np.ndarray) -> tuple:
             return (float(rate), float(offset), float(mean), *np.ravel(cos).tolist(), *np.ravel(sin).tolist())
@@ -36,49 +38,68 @@ class MeshUpdates:
         wanted = [key(schedule.rate[k], schedule.offsets[k], means[k], schedule._cos[k], schedule._sin[k])
                   for k in range(len(schedule.variables))]
         self.factor_rows = np.array([keys.index(k) for k in wanted], dtype=np.int64)
-        self._index: tuple[np.ndarray, np.ndarray] | None = None
-        self._force: np.ndarray | None = None
+        self._q: np.ndarray | None = None  # views of the system's state (:meth:`bind`)
+        self._bound_t = -np.inf
 
     def values_and_forces(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """Stiffness factors of the schedule's variables and friction forces on the frames (compiled; the
-        arrays are overwritten by the next call)."""
-        head, tail = self._args
-        self._kernel(float(t), *head, q, q_t, *tail)
-        return self._factors, self._force[:self._index[1].size]
+        """Stiffness factors of the schedule's variables and friction forces on the frames at the state ``q``,
+        ``q_t`` (all ODE2 coordinates and rates; compiled, the arrays are overwritten by the next call)."""
+        self._kernel(t, *self._head, q, q_t, *self._tail)
+        return self._factors, self._frame_force
 
     def reference(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Same as :meth:`values_and_forces` with the two parts' numpy reference implementations."""
-        aux, frames = self._index
-        forces = self.friction.forces(t, q[aux], q_t[aux], q_t[frames])
-        self._force[:frames.size] = forces
+        (aux, residual), frames = self._tooth, self._frames
+        delta, delta_t = q[aux].copy(), q_t[aux].copy()
+        has = residual >= 0
+        delta[has] -= q[residual[has]]
+        delta_t[has] -= q_t[residual[has]]
+        forces = self.friction.forces(t, delta, delta_t, q_t[frames])
+        self._frame_force[:] = forces
         return self.schedule.values(t), forces
 
     def bind(self, mbs) -> None:
-        """Coordinate indices and the force buffer (after ``mbs.Assemble()``; done by the first call)."""
-        f = self.friction
-        self._index = (f.deflection_indices(mbs),
-                       np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
-                                       for b in f.bodies]).astype(np.int64))
-        self._force = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")))
-        self._factors = np.zeros(self.factor_rows.size)
+        """Coordinate indices, the kernel's arguments and the views of the system's state (after ``mbs.Assemble()``;
+        done by the first call of a solve)."""
         from flexgear.laws.compiled import mesh_step, padded_sparse_rows
 
+        f = self.friction
+        n_c = len(f.mu)
+        tooth = np.full((2, n_c), -1, dtype=np.int64)  # deflection coordinate, residual deflection coordinate
+        tooth[0] = f.deflection_indices(mbs)
+        if f.residual is not None:
+            node, rows = f.residual
+            first = mbs.GetNodeODE2Index(node)
+            tooth[1, rows] = first + np.arange(len(rows))
+        self._tooth = tooth
+        self._frames = np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
+                                       for b in f.bodies]).astype(np.int64)
+        n_f = self._frames.size
+        # the container's force vector, then the factors, then one work entry per contact
+        self._out = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")) + self.factor_rows.size + n_c)
+        self._force = self._out[:self._out.size - self.factor_rows.size - n_c]
+        self._frame_force = self._out[:n_f]
+        self._factors = self._out[self._force.size:self._force.size + self.factor_rows.size]
         columns, sliding, spin = padded_sparse_rows(f.sliding_rows, f.spin_rows)
-
+        series = np.concatenate([f._means[:, :, None], f._cos, f._sin], axis=2)
         # the kernel and its arguments, looked up once (this runs every step)
         self._kernel = mesh_step
-        self._args = ((f.ramp_time, f.drive_speed, f.phase_rate, f.offsets),
-                      (*self._index, self.law, f._means, f._cos, f._sin, columns, sliding, spin,
-                       self.factor_rows, self._force, self._factors, np.zeros(len(f.mu)), f.law.kind == "iso6336"))
+        self._head = (f.ramp_time, f.drive_speed)
+        self._tail = (tooth, self._frames, self.law, np.ascontiguousarray(series), columns,
+                      np.ascontiguousarray([sliding, spin]), self.factor_rows, self._out, f.law.kind == "iso6336")
         self._set = [var.SetValue for var in self.schedule.variables]
+        # views of the system's coordinates and rates, not copies: the solver updates these vectors in place
+        # (their size is fixed once assembled), so each step reads the state without a copy
+        self._q = mbs.systemData.GetODE2Coordinates(copy=False)
+        self._q_t = mbs.systemData.GetODE2Coordinates_t(copy=False)
+        self._bound_t = -np.inf
 
     def __call__(self, mbs, t: float) -> bool:
-        if self._index is None:
+        if t < self._bound_t or self._q is None:  # a new solve (time went back): bind to its state afresh
             self.bind(mbs)
-        head, tail = self._args
-        self._kernel(t, *head, *self.friction.tooth_state(mbs), *tail)
-        for set_value, value in zip(self._set, self._factors.tolist(), strict=True):
+        self._bound_t = t
+        factors, _ = self.values_and_forces(t, self._q, self._q_t)
+        for set_value, value in zip(self._set, factors.tolist(), strict=True):
             set_value(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
         return True
-

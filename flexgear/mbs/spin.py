@@ -121,6 +121,11 @@ class SpinSchedule:
         self._next = 0.0  # time of the next matrix update
         self._steady = False
 
+    @property
+    def finished(self) -> bool:
+        """True once the ramp is over: nothing is left to do (flexgear.mbs.contact_kinematics.PreStepChain drops it)."""
+        return self._steady
+
     def force(self, t: float) -> np.ndarray:
         """Omega(t)^2 c, stacked over the bodies."""
         return ramp_state(float(t), self.ramp_time)[1] ** 2 * self.cent
