@@ -34,10 +34,12 @@ def figure_line(name: str, values: Sequence[float], unit: str = "s") -> str:
 
 
 def ratio_line(name: str, numerator: Sequence[float], denominator: Sequence[float], goal: str = "") -> str:
-    """Ratio of the medians, and the median of the per-round ratios (same round = same machine load)."""
+    """Ratio of the medians, the median of the per-round ratios (same round = same machine load) and the ratio of
+    the minima (each case's least disturbed run: a shared machine's load only ever adds time)."""
     per_round = [a / b for a, b in zip(numerator, denominator, strict=True)]
     text = (f"{name:<44s} {median(numerator) / median(denominator):9.3f} (ratio of medians), "
-            f"{median(per_round):.3f} (median of per-round ratios)")
+            f"{median(per_round):.3f} (median of per-round ratios), {min(numerator) / min(denominator):.3f} "
+            "(ratio of minima)")
     return f"{text}   goal {goal}" if goal else text
 
 

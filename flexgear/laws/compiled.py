@@ -12,7 +12,8 @@ import numpy as np
 from numba import njit
 
 __all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces",
-           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step", "padded_sparse_rows"]
+           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step", "bound_entry",
+           "padded_sparse_rows"]
 
 
 @njit(cache=True)
@@ -150,55 +151,74 @@ def turn_columns(buffer, const, cos_part, sin_part, spin_index, spins, target, t
 
 
 @njit(cache=True)
-def mesh_step(t, ramp_time, drive_speed, q, q_t, tooth, frames, law, series, columns, rows,  # noqa: PLR0913
+def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, columns, rows,  # noqa: PLR0913
               factor_rows, out, linear=False):  # pragma: no cover - compiled
     """One step's mesh updates in one call, without temporaries: the friction forces on the frame coordinates
     (written into ``out[:frames.size]``) and the stiffness factors s(phi) of the contacts ``factor_rows``
-    (written into ``out[frames.size:frames.size + factor_rows.size]``; the rest of ``out``, one entry per
+    (written into ``out[frames.size:frames.size + factor_rows.size]``; the rest of ``out``, four entries per
     contact, is work space).
 
     Per contact i: phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
     (:func:`ramp_state`); ``law[:, i]``: stiffness, exponent, damping_max, penetration depth, mu, v_reg, rate,
     offset; ``series[k, i]``: mean, cos and sin coefficients (harmonics 1..n_h) of series k (0: stiffness factor,
     1: sliding direction kappa, 2: lever lambda [m]). ``q``, ``q_t``: all ODE2 coordinates and rates (read
-    only); the contact's tooth deflection is q[tooth[0, i]] less q[tooth[1, i]] when tooth[1, i] >= 0 (its
-    residual deflection, flexgear.mbs.residual); ``frames``: the bodies' frame coordinates. The sliding and
-    spin rows of contact i are sparse (each touches the 12 frame coordinates of its two gears): ``rows[0, i, k]``
-    and ``rows[1, i, k]`` are their entries at frame coordinate ``columns[i, k]`` (:func:`padded_sparse_rows`).
-    Same numbers as :func:`periodic_values` plus :func:`mesh_friction_forces` with the dense rows.
+    only); the contact's tooth deflection is q[index[0, i]] less q[index[1, i]] when index[1, i] >= 0 (its
+    residual deflection, flexgear.mbs.residual). Contact i takes its series values and its friction direction
+    factor tanh(Omega lambda_mean / v_reg) from contact index[2, i] <= i (the first of the contacts that share
+    phase, series, spin row and v_reg, such as the helix halves of one mesh), which computes them once.
+    ``frames``: the bodies' frame coordinates. The sliding and spin rows of contact i are sparse (each touches
+    the 12 frame coordinates of its two gears): ``rows[0, i, k]`` and ``rows[1, i, k]`` are their entries at
+    frame coordinate ``columns[i, k]`` (:func:`padded_sparse_rows`). Same numbers as :func:`periodic_values`
+    plus :func:`mesh_friction_forces` with the dense rows.
     """
     theta = drive_speed * ramp_state(t, ramp_time)[0]
     n_c, n_h, n_f = law.shape[1], (series.shape[2] - 1) // 2, frames.size
-    work = n_f + factor_rows.size
+    w = n_f + factor_rows.size  # work: v0, v1, v2, tanh of contact i at w + 4 i
     for j in range(n_f):
         out[j] = 0.0
     for i in range(n_c):
-        x = 2.0 * math.pi * (law[6, i] * theta - law[7, i])
-        c1, s1 = math.cos(x), math.sin(x)
-        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
-        v0, v1, v2 = series[0, i, 0], series[1, i, 0], series[2, i, 0]
-        for h in range(1, n_h + 1):
-            v0 += series[0, i, h] * ch + series[0, i, n_h + h] * sh
-            v1 += series[1, i, h] * ch + series[1, i, n_h + h] * sh
-            v2 += series[2, i, h] * ch + series[2, i, n_h + h] * sh
-            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
-        out[work + i] = v0
-        d, d_t = q[tooth[0, i]], q_t[tooth[0, i]]
-        if tooth[1, i] >= 0:
-            d -= q[tooth[1, i]]
-            d_t -= q_t[tooth[1, i]]
+        lead = w + 4 * index[2, i]
+        if index[2, i] == i:
+            x = 2.0 * math.pi * (law[6, i] * theta - law[7, i])
+            c1, s1 = math.cos(x), math.sin(x)
+            ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
+            v0, v1, v2 = series[0, i, 0], series[1, i, 0], series[2, i, 0]
+            for h in range(1, n_h + 1):
+                v0 += series[0, i, h] * ch + series[0, i, n_h + h] * sh
+                v1 += series[1, i, h] * ch + series[1, i, n_h + h] * sh
+                v2 += series[2, i, h] * ch + series[2, i, n_h + h] * sh
+                ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
+            spin_rate = 0.0
+            for k in range(columns.shape[1]):
+                spin_rate += rows[1, i, k] * q_t[frames[columns[i, k]]]
+            out[lead], out[lead + 1], out[lead + 2] = v0, v1, v2
+            out[lead + 3] = math.tanh(spin_rate * series[2, i, 0] / law[5, i])
+        v0, v1, v2, direction = out[lead], out[lead + 1], out[lead + 2], out[lead + 3]
+        d, d_t = q[index[0, i]], q_t[index[0, i]]
+        if index[1, i] >= 0:
+            d -= q[index[1, i]]
+            d_t -= q_t[index[1, i]]
         if linear:
             normal = linear_normal_force(d, d_t, law[0, i] * v0, law[2, i])
         else:
             normal = impact_normal_force(d, d_t, law[0, i] * v0, law[1, i], law[2, i], law[3, i])
-        spin_rate = 0.0
-        for k in range(columns.shape[1]):
-            spin_rate += rows[1, i, k] * q_t[frames[columns[i, k]]]
-        f = law[4, i] * normal * math.tanh(spin_rate * series[2, i, 0] / law[5, i])
+        f = law[4, i] * normal * direction
         for k in range(columns.shape[1]):
             out[columns[i, k]] -= rows[0, i, k] * (f * v1) + rows[1, i, k] * (f * v2)
     for k in range(factor_rows.size):
-        out[n_f + k] = out[work + factor_rows[k]]
+        out[n_f + k] = out[w + 4 * factor_rows[k]]
+
+
+def bound_entry(kernel, args: tuple):
+    """``kernel``'s compiled entry point for the types of ``args``, for a hot loop that calls it with arguments of
+    exactly those types (numba's dispatcher resolves every argument's type on every call, about 60-80 ns each:
+    half of mesh_step's call). Falls back to the dispatcher itself where numba offers no entry point."""
+    import numba
+
+    try:
+        return kernel.compile(tuple(numba.typeof(a) for a in args))
+    except (AttributeError, TypeError):
+        return kernel
 
 
 def padded_sparse_rows(*rows: np.ndarray) -> tuple[np.ndarray, ...]:

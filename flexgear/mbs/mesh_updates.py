@@ -22,6 +22,9 @@ __all__ = ["MeshUpdates"]
 class MeshUpdates:
     """Pre-step user function: ``schedule``'s factors and ``friction``'s generalized load, one call per step."""
 
+    compiled = True
+    """False: runs evaluate the updates with :meth:`reference` (the numpy parts), for the tests."""
+
     def __init__(self, schedule: StiffnessSchedule, friction: MeshFriction):
         self.schedule, self.friction = schedule, friction
         f = friction
@@ -56,50 +59,55 @@ class MeshUpdates:
         delta_t[has] -= q_t[residual[has]]
         forces = self.friction.forces(t, delta, delta_t, q_t[frames])
         self._frame_force[:] = forces
-        return self.schedule.values(t), forces
+        self._factors[:] = self.schedule.values(t)
+        return self._factors, self._frame_force
 
     def bind(self, mbs) -> None:
         """Coordinate indices, the kernel's arguments and the views of the system's state (after ``mbs.Assemble()``;
         done by the first call of a solve)."""
-        from flexgear.laws.compiled import mesh_step, padded_sparse_rows
+        from flexgear.laws.compiled import bound_entry, mesh_step, padded_sparse_rows
 
         f = self.friction
         n_c = len(f.mu)
-        tooth = np.full((2, n_c), -1, dtype=np.int64)  # deflection coordinate, residual deflection coordinate
-        tooth[0] = f.deflection_indices(mbs)
+        series = np.ascontiguousarray(np.concatenate([f._means[:, :, None], f._cos, f._sin], axis=2))
+        # per contact: deflection coordinate, residual deflection coordinate (-1: none), the first contact with the
+        # same phase, series, spin row and v_reg (the helix halves of a mesh), whose phase terms it shares
+        index = np.full((3, n_c), -1, dtype=np.int64)
+        index[0] = f.deflection_indices(mbs)
         if f.residual is not None:
             node, rows = f.residual
-            first = mbs.GetNodeODE2Index(node)
-            tooth[1, rows] = first + np.arange(len(rows))
-        self._tooth = tooth
+            index[1, rows] = mbs.GetNodeODE2Index(node) + np.arange(len(rows))
+        keys = [(*self.law[[5, 6, 7], i], *series[:, i].ravel(), *f.spin_rows[i]) for i in range(n_c)]
+        index[2] = [keys.index(k) for k in keys]
+        self._tooth = index[:2]
         self._frames = np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
                                        for b in f.bodies]).astype(np.int64)
-        n_f = self._frames.size
-        # the container's force vector, then the factors, then one work entry per contact
-        self._out = np.zeros(len(mbs.GetObjectParameter(f.container, "forceVector")) + self.factor_rows.size + n_c)
-        self._force = self._out[:self._out.size - self.factor_rows.size - n_c]
-        self._frame_force = self._out[:n_f]
-        self._factors = self._out[self._force.size:self._force.size + self.factor_rows.size]
+        n_force, n_k = len(mbs.GetObjectParameter(f.container, "forceVector")), self.factor_rows.size
+        # the container's force vector, then the factors, then four work entries per contact
+        self._out = np.zeros(n_force + n_k + 4 * n_c)
+        self._force = self._out[:n_force]
+        self._frame_force = self._out[:self._frames.size]
+        self._factors = self._out[n_force:n_force + n_k]
         columns, sliding, spin = padded_sparse_rows(f.sliding_rows, f.spin_rows)
-        series = np.concatenate([f._means[:, :, None], f._cos, f._sin], axis=2)
-        # the kernel and its arguments, looked up once (this runs every step)
-        self._kernel = mesh_step
         self._head = (f.ramp_time, f.drive_speed)
-        self._tail = (tooth, self._frames, self.law, np.ascontiguousarray(series), columns,
-                      np.ascontiguousarray([sliding, spin]), self.factor_rows, self._out, f.law.kind == "iso6336")
+        self._tail = (index, self._frames, self.law, series, columns, np.ascontiguousarray([sliding, spin]),
+                      self.factor_rows, self._out, f.law.kind == "iso6336")
         self._set = [var.SetValue for var in self.schedule.variables]
         # views of the system's coordinates and rates, not copies: the solver updates these vectors in place
         # (their size is fixed once assembled), so each step reads the state without a copy
         self._q = mbs.systemData.GetODE2Coordinates(copy=False)
         self._q_t = mbs.systemData.GetODE2Coordinates_t(copy=False)
+        self._kernel = mesh_step  # any arrays (values_and_forces); the bound ones per step:
+        self._step = (bound_entry(mesh_step, (0.0, *self._head, self._q, self._q_t, *self._tail)) if self.compiled
+                      else lambda t, *_: self.reference(t, self._q, self._q_t))
         self._bound_t = -np.inf
 
     def __call__(self, mbs, t: float) -> bool:
         if t < self._bound_t or self._q is None:  # a new solve (time went back): bind to its state afresh
             self.bind(mbs)
         self._bound_t = t
-        factors, _ = self.values_and_forces(t, self._q, self._q_t)
-        for set_value, value in zip(self._set, factors.tolist(), strict=True):
+        self._step(t, *self._head, self._q, self._q_t, *self._tail)
+        for set_value, value in zip(self._set, self._factors.tolist(), strict=True):
             set_value(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
         return True
