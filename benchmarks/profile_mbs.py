@@ -5,7 +5,8 @@ Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, benchmarks/speed_common.floor_variant), warmed with a 1e-4 s run, then
-solved with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
+solved as a run solves it (the Jacobian economy of ``[solver_assumed] jacobian_updates``, the collector's
+generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
 case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
 step (the ``Python`` timer is the pre-step user functions), Newton iterations and Jacobians per step;
 with ``--cprofile`` the top Python functions. ``--blas-threads 2`` shows what BLAS threads cost the build.
@@ -17,6 +18,7 @@ import argparse
 import contextlib
 import cProfile
 import dataclasses
+import gc
 import io
 import pstats
 import re
@@ -28,6 +30,7 @@ from pathlib import Path
 from speed_common import floor_variant, load_average
 
 from flexgear.mbs.gearbox import build_star_gearbox
+from flexgear.mbs.newton import JacobianEconomy
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.spec import load_variant
 
@@ -52,15 +55,22 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
             warnings.simplefilter("ignore", DeprecationWarning)
             settings.displayComputationTime = True
             settings.displayStatistics = True
+    sv = variant.gearbox.solver_assumed
+    if sv.jacobian_updates == "economy":  # as flexgear.mbs.run's post-step guard drives it
+        economy = JacobianEconomy(sv.jacobian_cost_iterations)
+        mbs.SetPostStepUserFunction(lambda mbs, t: economy(mbs) or True)
     prof = cProfile.Profile() if profile else None
+    gc.collect()
+    gc.freeze()  # as flexgear.mbs.run solves: the collector does not walk the built model every few steps
     w0, c0 = time.perf_counter(), time.process_time()
     with _captured_stdout() as out:
         if prof:
             prof.enable()
-        mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha)
+        mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha, storeSolver=True)
         if prof:
             prof.disable()
     wall, cpu = time.perf_counter() - w0, time.process_time() - c0
+    gc.unfreeze()
     text = out.getvalue()
     if prof:
         s = io.StringIO()
