@@ -50,9 +50,18 @@ def _pss(pid: int) -> int:
     return 0
 
 
-def _tree_memory(root: int) -> tuple[int, int]:
+def _command(pid: int) -> str:
+    """The command line of process ``pid``, shortened ('' if it has ended)."""
+    try:
+        with open(f"/proc/{pid}/cmdline", "rb") as f:
+            return f.read().replace(b"\0", b" ").decode(errors="replace").strip()[:100]
+    except OSError:
+        return ""
+
+
+def _tree_memory(root: int, parts: list | None = None) -> tuple[int, int]:
     """Sums of the resident sets and of the proportional set sizes [bytes] of process ``root`` and its
-    descendants (Linux /proc)."""
+    descendants (Linux /proc); ``parts``, if given, receives (PSS [bytes], command line) of each of them."""
     parent, rss = {}, {}
     for entry in os.listdir("/proc"):
         if not entry.isdigit():
@@ -70,7 +79,10 @@ def _tree_memory(root: int) -> tuple[int, int]:
     while todo:
         pid = todo.pop()
         total_rss += rss.get(pid, 0)
-        total_pss += _pss(pid)
+        pss = _pss(pid)
+        total_pss += pss
+        if parts is not None:
+            parts.append((pss, _command(pid)))
         todo += children.get(pid, [])
     return total_rss, total_pss
 
@@ -81,11 +93,16 @@ def _child(cmd: list[str]) -> None:
     t0 = time.perf_counter()
     proc = subprocess.Popen(cmd, cwd=ROOT, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
     peak_sum = [0, 0]
+    at_peak: dict = {"t_s": 0.0, "processes": []}  # the process tree when the PSS sum peaked
     stop = threading.Event()
 
     def sample() -> None:
         while not stop.wait(_SAMPLE_S):
-            peak_sum[:] = [max(p, m) for p, m in zip(peak_sum, _tree_memory(proc.pid), strict=True)]
+            parts: list = []
+            now = _tree_memory(proc.pid, parts)
+            if now[1] > peak_sum[1]:
+                at_peak.update(t_s=time.perf_counter() - t0, processes=sorted(parts, reverse=True)[:6])
+            peak_sum[:] = [max(p, m) for p, m in zip(peak_sum, now, strict=True)]
 
     sampler = threading.Thread(target=sample, daemon=True)
     sampler.start()
@@ -97,7 +114,7 @@ def _child(cmd: list[str]) -> None:
     tail = stderr.strip().splitlines()[-3:] if proc.returncode else []
     print(json.dumps({"wall_s": wall, "cpu_s": usage.ru_utime + usage.ru_stime, "returncode": proc.returncode,
                       "max_rss_bytes": usage.ru_maxrss * 1024, "tree_rss_bytes": peak_sum[0],
-                      "tree_pss_bytes": peak_sum[1],
+                      "tree_pss_bytes": peak_sum[1], "pss_peak": at_peak,
                       "stderr_tail": tail}))  # ru_maxrss: KiB (Linux)
 
 
@@ -145,6 +162,9 @@ def main() -> None:
             print(f"round {i + 1} {section}: wall {res['wall_s']:.1f} s, CPU {res['cpu_s']:.1f} s, "
                   f"peak RSS {rss[section][-1]:.2f} GB (largest process), sums over the processes: RSS "
                   f"{tree[section][-1]:.2f} GB, PSS {tree_pss[section][-1]:.2f} GB; {load_average()}", flush=True)
+            peak = res["pss_peak"]
+            print(f"  PSS sum peaked at {peak['t_s']:.1f} s: " + "; ".join(
+                f"{pss / 1e9:.2f} GB {command}" for pss, command in peak["processes"]), flush=True)
     print()
     goals = {"cold": ("<= 90 s", ""), "make": ("", "<= 2 GB")}
     for section in a.sections:
