@@ -247,7 +247,6 @@ class MeshFriction:
                  ramp_time: float, drive_speed: float, residual: tuple[int, np.ndarray] | None = None):
         self.mbs, self.container, self.contacts = mbs, container, contacts
         self.residual = residual  # (node, contact rows) of the residual deflections e: the law acts on delta - e
-        self._tooth_index: tuple[np.ndarray, np.ndarray] | None = None
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
         self.sliding_rows = _assemble_rows(bodies, contacts, row=1)
         self.spin_rows = _assemble_rows(bodies, contacts, row=2)
@@ -302,33 +301,39 @@ class MeshFriction:
             raise RuntimeError("the contacts' deflection nodes do not hold consecutive system coordinates")
         return np.arange(first, first + sum(sizes), dtype=np.int64)
 
-    def tooth_state(self, mbs) -> tuple[np.ndarray, np.ndarray]:
-        """The system's coordinates and velocities (copies) with each contact's deflection coordinate
-        reduced by its residual deflection e (flexgear.mbs.residual): the tooth deflection the law sees."""
-        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+    def tooth_index(self, mbs) -> np.ndarray:
+        """(2, n_contacts) system indices (after ``mbs.Assemble()``): each contact's deflection coordinate and its
+        residual deflection coordinate e (flexgear.mbs.residual; -1: none)."""
+        index = np.full((2, len(self.contacts)), -1, dtype=np.int64)
+        index[0] = self.deflection_indices(mbs)
         if self.residual is not None:
-            if self._tooth_index is None:  # (deflection, residual) coordinate indices, once (a per-step path)
-                node, rows = self.residual
-                first = mbs.GetNodeODE2Index(node)
-                self._tooth_index = (self.deflection_indices(mbs)[rows], np.arange(first, first + len(rows)))
-            delta, e = self._tooth_index
-            q[delta] -= q[e]
-            q_t[delta] -= q_t[e]
-        return q, q_t
+            node, rows = self.residual
+            index[1, rows] = mbs.GetNodeODE2Index(node) + np.arange(len(rows))
+        return index
+
+    def frame_indices(self, mbs) -> np.ndarray:
+        """System indices of the bodies' frame coordinates, six per body in order (after ``mbs.Assemble()``)."""
+        return np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
+                               for b in self.bodies]).astype(np.int64)
+
+    @staticmethod
+    def tooth_deflections(q: np.ndarray, q_t: np.ndarray, index: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """The tooth deflections the law sees and their rates (new arrays): each contact's deflection coordinate
+        less its residual deflection, at the system state ``q``, ``q_t`` (``index``: :meth:`tooth_index`)."""
+        delta, delta_t = q[index[0]], q_t[index[0]]
+        has = index[1] >= 0
+        delta[has] -= q[index[1, has]]
+        delta_t[has] -= q_t[index[1, has]]
+        return delta, delta_t
 
     def __call__(self, mbs, t: float) -> bool:
         """Pre-step user function: friction from the state at the start of the step."""
         if self._index is None:
-            self._index = (
-                self.deflection_indices(mbs),
-                np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
-                                for b in self.bodies]),
-            )
-        aux, frames = self._index
-        if self._force is None:
+            self._index = (self.tooth_index(mbs), self.frame_indices(mbs))
             self._force = np.zeros(len(mbs.GetObjectParameter(self.container, "forceVector")))
-        q, q_t = self.tooth_state(mbs)
-        self._force[:len(frames)] = self.fast_forces(t, q[aux], q_t[aux], q_t[frames])
+        tooth, frames = self._index
+        q, q_t = mbs.systemData.GetODE2Coordinates(), mbs.systemData.GetODE2Coordinates_t()
+        self._force[:len(frames)] = self.fast_forces(t, *self.tooth_deflections(q, q_t, tooth), q_t[frames])
         mbs.SetObjectParameter(self.container, "forceVector", self._force)
         return True
 

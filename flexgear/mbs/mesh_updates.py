@@ -47,17 +47,14 @@ class MeshUpdates:
     def values_and_forces(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Stiffness factors of the schedule's variables and friction forces on the frames at the state ``q``,
         ``q_t`` (all ODE2 coordinates and rates; compiled, the arrays are overwritten by the next call)."""
-        self._kernel(t, *self._head, q, q_t, *self._tail)
+        a = self._args
+        self._kernel(t, *a[:2], q, q_t, *a[4:])
         return self._factors, self._frame_force
 
     def reference(self, t: float, q: np.ndarray, q_t: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Same as :meth:`values_and_forces` with the two parts' numpy reference implementations."""
-        (aux, residual), frames = self._tooth, self._frames
-        delta, delta_t = q[aux].copy(), q_t[aux].copy()
-        has = residual >= 0
-        delta[has] -= q[residual[has]]
-        delta_t[has] -= q_t[residual[has]]
-        forces = self.friction.forces(t, delta, delta_t, q_t[frames])
+        f = self.friction
+        forces = f.forces(t, *f.tooth_deflections(q, q_t, self._tooth), q_t[self._frames])
         self._frame_force[:] = forces
         self._factors[:] = self.schedule.values(t)
         return self._factors, self._frame_force
@@ -72,16 +69,12 @@ class MeshUpdates:
         series = np.ascontiguousarray(np.concatenate([f._means[:, :, None], f._cos, f._sin], axis=2))
         # per contact: deflection coordinate, residual deflection coordinate (-1: none), the first contact with the
         # same phase, series, spin row and v_reg (the helix halves of a mesh), whose phase terms it shares
-        index = np.full((3, n_c), -1, dtype=np.int64)
-        index[0] = f.deflection_indices(mbs)
-        if f.residual is not None:
-            node, rows = f.residual
-            index[1, rows] = mbs.GetNodeODE2Index(node) + np.arange(len(rows))
+        index = np.empty((3, n_c), dtype=np.int64)
+        index[:2] = f.tooth_index(mbs)
         keys = [(*self.law[[5, 6, 7], i], *series[:, i].ravel(), *f.spin_rows[i]) for i in range(n_c)]
         index[2] = [keys.index(k) for k in keys]
         self._tooth = index[:2]
-        self._frames = np.concatenate([np.arange(mbs.GetNodeODE2Index(b.node), mbs.GetNodeODE2Index(b.node) + 6)
-                                       for b in f.bodies]).astype(np.int64)
+        self._frames = f.frame_indices(mbs)
         n_force, n_k = len(mbs.GetObjectParameter(f.container, "forceVector")), self.factor_rows.size
         # the container's force vector, then the factors, then four work entries per contact
         self._out = np.zeros(n_force + n_k + 4 * n_c)
@@ -89,16 +82,16 @@ class MeshUpdates:
         self._frame_force = self._out[:self._frames.size]
         self._factors = self._out[n_force:n_force + n_k]
         columns, sliding, spin = padded_sparse_rows(f.sliding_rows, f.spin_rows)
-        self._head = (f.ramp_time, f.drive_speed)
-        self._tail = (index, self._frames, self.law, series, columns, np.ascontiguousarray([sliding, spin]),
-                      self.factor_rows, self._out, f.law.kind == "iso6336")
         self._set = [var.SetValue for var in self.schedule.variables]
         # views of the system's coordinates and rates, not copies: the solver updates these vectors in place
         # (their size is fixed once assembled), so each step reads the state without a copy
         self._q = mbs.systemData.GetODE2Coordinates(copy=False)
         self._q_t = mbs.systemData.GetODE2Coordinates_t(copy=False)
+        # the kernel's arguments after t (q, q_t: the views; values_and_forces swaps in its own)
+        self._args = (f.ramp_time, f.drive_speed, self._q, self._q_t, index, self._frames, self.law, series, columns,
+                      np.ascontiguousarray([sliding, spin]), self.factor_rows, self._out, f.law.kind == "iso6336")
         self._kernel = mesh_step  # any arrays (values_and_forces); the bound ones per step:
-        self._step = (bound_entry(mesh_step, (0.0, *self._head, self._q, self._q_t, *self._tail)) if self.compiled
+        self._step = (bound_entry(mesh_step, (0.0, *self._args)) if self.compiled
                       else lambda t, *_: self.reference(t, self._q, self._q_t))
         self._bound_t = -np.inf
 
@@ -106,7 +99,7 @@ class MeshUpdates:
         if t < self._bound_t or self._q is None:  # a new solve (time went back): bind to its state afresh
             self.bind(mbs)
         self._bound_t = t
-        self._step(t, *self._head, self._q, self._q_t, *self._tail)
+        self._step(t, *self._args)
         for set_value, value in zip(self._set, self._factors.tolist(), strict=True):
             set_value(value)
         mbs.SetObjectParameter(self.friction.container, "forceVector", self._force)
