@@ -7,9 +7,11 @@ them alike). The machine is shared: the load average is printed before and after
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import os
 import statistics
+import time
 from collections.abc import Sequence
 
 from flexgear.spec import Variant
@@ -63,3 +65,48 @@ def floor_variant(variant: Variant) -> Variant:
 def with_jacobian_updates(variant: Variant, updates: str) -> Variant:
     """``variant`` with ``[solver_assumed] jacobian_updates = updates`` (flexgear.mbs.newton)."""
     return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("solver_assumed", jacobian_updates=updates))
+
+
+def shortened(variant: Variant, ramp: float, t_end: float) -> Variant:
+    """``variant`` with its STEP ramps shortened to ``ramp`` [s] and its load case ending at ``t_end`` [s]."""
+    gb = variant.gearbox
+    lc = dataclasses.replace(gb.load_case, ramp_time_s=ramp, end_time_s=t_end)
+    return dataclasses.replace(variant, gearbox=gb.with_changes(load_case=lc))
+
+
+@contextlib.contextmanager
+def window_clock(start: float, end: float, step: float):
+    """While active, every run's post-step function (flexgear.mbs.run.RunGuard, wrapped) records the CPU clock and
+    the solver's (iterations, Jacobians) counts at the first steps at or after ``start`` and ``end`` [s]: yields
+    the list of those marks, (cpu [s], iterations, Jacobians, t [s])."""
+    import flexgear.mbs.run as run_module
+
+    marks: list[tuple[float, int, int, float]] = []
+    guard_call = run_module.RunGuard.__call__
+
+    def call(guard, mbs, t):
+        if len(marks) < 2 and t >= (start, end)[len(marks)] - 0.5 * step:
+            it = mbs.sys["dynamicSolver"].it
+            marks.append((time.process_time(), it.newtonStepsCount, it.newtonJacobiCount, t))
+        return guard_call(guard, mbs, t)
+
+    run_module.RunGuard.__call__ = call
+    try:
+        yield marks
+    finally:
+        run_module.RunGuard.__call__ = guard_call
+
+
+def measure_window(variant: Variant, window: tuple[float, float]) -> tuple[float, float, float]:
+    """Run ``variant`` (flexgear.mbs.run.run_variant) to ``window[1]``: CPU [us] per step, Newton iterations per step
+    and Jacobians per 1000 steps over ``window`` [s]."""
+    from flexgear.mbs.run import run_variant
+
+    h = variant.gearbox.load_case.step_size_s
+    with window_clock(*window, h) as marks:
+        r = run_variant(variant, t_end_s=window[1])
+    if not r.ok or len(marks) < 2:
+        raise SystemExit(f"{variant.name}: {r.meta.get('reason') or 'window not reached'}")
+    (c0, n0, j0, t0), (c1, n1, j1, t1) = marks
+    steps = round((t1 - t0) / h)
+    return 1e6 * (c1 - c0) / steps, (n1 - n0) / steps, 1e3 * (j1 - j0) / steps

@@ -347,7 +347,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             carried = (_seat_loads_carried(spec, lead) and len(found) == 1
                        and _is_gear_seat(spec, lead, found[0][0]))
             made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
-                                         residual=carried) for k, (a, b, p) in enumerate(found)]
+                                         residual=carried, axes=spec.joints_assumed.joint_axes)
+                    for k, (a, b, p) in enumerate(found)]
             if carried:
                 seat_residuals[lead.name] = (made[0].residual_node, made[0].centre)
             linear_gears.append(lead.name)

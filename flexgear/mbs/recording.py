@@ -163,7 +163,7 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
                                                       outputVariableType=ovt.Coordinates, storeInternal=True))
     for gear, joints in model.joints.items():
         for k, (joint, point) in enumerate(joints):
-            if gear in model.linear_joints:  # multipliers: ground force [N] and moment [N m] (flexgear.mbs.joints)
+            if gear in model.linear_joints:  # multipliers: force [N] and moment [N m], ground or body axes (joints)
                 sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
                     objectNumber=joint, outputVariableType=ovt.Force, storeInternal=True))
                 continue
@@ -207,9 +207,11 @@ def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: s
     total = None
     for k, (_, point) in enumerate(model.joints[gear]):
         data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
-        if gear in model.linear_joints:  # multipliers on the shaft: ground force F and moment M at the point
+        if gear in model.linear_joints:  # multipliers on the shaft: force F and moment M at the point
             torque = data[:, 6].copy()  # M_z, plus (X x F)_z at the point's place X = R_z(phi_n) p off the axis
-            if np.hypot(point[0], point[1]) > 0.0:
+            if np.hypot(point[0], point[1]) > 0.0 and model.spec.joints_assumed.joint_axes == "body":
+                torque += point[0] * data[:, 2] - point[1] * data[:, 1]  # F in the body axes, where X is p
+            elif np.hypot(point[0], point[1]) > 0.0:
                 lc = model.spec.load_case
                 th = model.theory  # the gear's spin per drive angle
                 ratio = (th.output_speed if gear == "ring" else th.input_speed) / th.input_speed

@@ -1,0 +1,71 @@
+"""The linear joints' equations in body axes (``[joints_assumed] joint_axes``, flexgear.mbs.joints.body_axes_form).
+
+Premultiplying a joint's six equations by Q(a)^T = blockdiag(R_z(a)^T, R_z(a)^T) is an exact row transformation:
+the forms must equal Q^T times the ground-axes rows at every angle, and a short model-7 run must give the
+ground-axes run's signals to the Newton tolerance, including the ring's joint torque, which the recording
+now reads from body-axes multipliers (twelve bolts off the axis).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+from conftest import VARIANTS
+
+import flexgear as fg
+from flexgear.mbs.joints import body_axes_form, frame_form, turning_form
+from flexgear.study.agreement import signal_agreement
+
+
+def _q_transposed(a: float) -> np.ndarray:
+    c, s = np.cos(a), np.sin(a)
+    return np.kron(np.eye(2), np.array([[c, s, 0.0], [-s, c, 0.0], [0.0, 0.0, 1.0]]))
+
+
+def _at(form, a: float) -> np.ndarray:
+    return form[0] + np.cos(a) * form[1] + np.sin(a) * form[2]
+
+
+def test_body_axes_form_is_the_rotated_rows():
+    """Modal rows (turning as R_z) become constant; an off-axis frame lever's rows equal Q^T times the ground rows
+    at every angle; rows that do not turn as R_z (a second harmonic in body axes) are refused."""
+    rng = np.random.default_rng(3)
+    rows = rng.normal(size=(6, 7))
+    const, cos_part, sin_part = body_axes_form(turning_form(rows))
+    assert np.allclose(const, rows, rtol=0, atol=1e-14) and not cos_part.any() and not sin_part.any()
+    ground = frame_form(np.array([0.12, -0.05, 0.03]))  # a bolt off the axis: its lever turns
+    body = body_axes_form(ground)
+    for a in rng.uniform(-np.pi, np.pi, 5):
+        assert np.allclose(_at(body, a), _q_transposed(a) @ _at(ground, a), rtol=0, atol=1e-14)
+    # in body axes the lever is the bolt's own place p: the rows are [R^T, -p~ R^T] on the ground frame coordinates
+    a = 1.1
+    r_t = _q_transposed(a)[:3, :3]
+    p_tilde = np.array([[0.0, -0.03, -0.05], [0.03, 0.0, -0.12], [0.05, 0.12, 0.0]])
+    assert np.allclose(_at(body, a)[:3], np.hstack([r_t, -p_tilde @ r_t]), rtol=0, atol=1e-14)
+    with pytest.raises(ValueError, match="second harmonic"):
+        body_axes_form((np.zeros((6, 6)), np.eye(6), np.zeros((6, 6))))
+
+
+def test_body_axes_keep_model7_signals():
+    """Model 7 (every joint linear, the ring on twelve bolts), ramps 6 ms, window 6-12 ms: body against ground axes,
+    means within 1e-5 and 1x mesh amplitudes within 1e-3 (the Newton tolerance), joint torques within 1e-5."""
+    from flexgear.mbs.run import run_variant
+
+    v = fg.load_variant(VARIANTS / "model7.toml")
+    g = v.gearbox
+    lc = dataclasses.replace(g.load_case, ramp_time_s=0.006, end_time_s=0.012)
+    runs = {}
+    for axes in ("ground", "body"):
+        spec = g.with_changes(load_case=lc, joints_assumed=dataclasses.replace(g.joints_assumed, joint_axes=axes))
+        runs[axes] = run_variant(dataclasses.replace(v, gearbox=spec))
+        assert runs[axes].ok, runs[axes].meta.get("reason")
+    ref, new = runs["ground"], runs["body"]
+    agreement = signal_agreement(ref, new, (lc.ramp_time_s, lc.end_time_s), ref.meta["theory"]["mesh_frequency_hz"])
+    assert agreement.ok(1e-5, 1e-3), agreement.table
+    for gear in ("sun", "ring"):
+        key = f"joint_torque_{gear}_nm"
+        assert new.meta[key] == pytest.approx(ref.meta[key], rel=1e-5), key
+    # the torques are the gear's share of the load: the ring's joints carry the output torque's order of magnitude
+    assert abs(ref.meta["joint_torque_ring_nm"]) > 0.5 * abs(ref.meta["joint_torque_sun_nm"])
