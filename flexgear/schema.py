@@ -398,8 +398,9 @@ class JointsAssumed:
     circle. ``bolt_patch`` "rbe2" (rigid disc) or "rbe3"; ``bolt_clamp_diameter_mm`` the disc's diameter.
     ``joint_equations`` "generic" (Exudyn's ObjectJointGeneric on the interface markers) or "linear" (first
     order about the prescribed spin, flexgear.mbs.joints; joints on the axis only, bolt patches stay generic).
-    ``joint_axes`` "ground" or "body": the axes of the linear joints' equations and multipliers (the same
-    solution; flexgear.mbs.joints, "body" costs the modified Newton method fewer iterations).
+    ``joint_axes`` "ground", "body" or "auto" (body axes where the shaft is flexible): the axes of the linear
+    joints' equations and multipliers (the same solution, a different cost to the modified Newton method;
+    flexgear.mbs.joints).
     """
 
     ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),
@@ -408,7 +409,7 @@ class JointsAssumed:
     bolt_clamp_diameter_mm: float = field(default=21.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
     joint_equations: str = field(default="generic", metadata={"choices": ("generic", "linear"),
                                                                "doc": "gear-shaft joint equations"})
-    joint_axes: str = field(default="body", metadata={"choices": ("body", "ground"),
+    joint_axes: str = field(default="auto", metadata={"choices": ("auto", "body", "ground"),
                                                           "doc": "axes of the linear joints' equations"})
 
 

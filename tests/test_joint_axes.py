@@ -69,3 +69,18 @@ def test_body_axes_keep_model7_signals():
         assert new.meta[key] == pytest.approx(ref.meta[key], rel=1e-5), key
     # the torques are the gear's share of the load: the ring's joints carry the output torque's order of magnitude
     assert abs(ref.meta["joint_torque_ring_nm"]) > 0.5 * abs(ref.meta["joint_torque_sun_nm"])
+
+
+@pytest.mark.parametrize("case, body_axes", [("model3", ("sun", "ring")), ("model4", ())])
+def test_auto_writes_joints_in_body_axes_where_the_shaft_is_flexible(case, body_axes):
+    """``joint_axes = "auto"`` (the default): model 3's flexible shafts take both gears' joints to body axes, model 4's
+    rigid shafts keep them in ground axes (where body axes cost more Jacobians, gearbox.toml)."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+
+    v = fg.load_variant(VARIANTS / f"{case}.toml")
+    assert v.gearbox.joints_assumed.joint_axes == "auto"
+    model = build_star_gearbox(exu.SystemContainer().AddSystem(), v)
+    assert set(model.linear_joints) == {"sun", "ring"}
+    assert model.body_axes_joints == body_axes

@@ -64,8 +64,10 @@ class GearboxModel:
     output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
     residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
-    # gears whose joints are flexgear.mbs.joints constraints (Force output: ground force, moment)
+    # gears whose joints are flexgear.mbs.joints constraints (Force output: force, moment in ground axes, or in the
+    # gear's body axes for the gears in body_axes_joints: [joints_assumed] joint_axes)
     linear_joints: tuple[str, ...] = ()
+    body_axes_joints: tuple[str, ...] = ()
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
 
 
@@ -175,6 +177,15 @@ def run_cost(variant: Variant) -> float | None:
         count = spec.gears.planet_count if component == "planets" else 1
         cost += count * float(dynamic_modes(spec, geometry, frequencies, cutoff)) ** 2
     return cost
+
+
+def _joint_axes(spec: GearboxSpec, shaft: Body) -> str:
+    """The axes of a linear gear-shaft joint's equations (flexgear.mbs.joints): ``[joints_assumed] joint_axes``;
+    "auto": body axes where the ``shaft`` is flexible, ground axes where it is rigid (measured, gearbox.toml)."""
+    axes = spec.joints_assumed.joint_axes
+    if axes == "auto":
+        return "body" if shaft.flexible else "ground"
+    return axes
 
 
 def _linear_joints(spec: GearboxSpec) -> bool:
@@ -337,7 +348,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     by_body = {bd.name: bd for bd in bodies}
     joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
     seat_residuals = {}  # gears whose seat's joint or bearing carries their dropped modes' seat motion (residual)
-    linear_gears = []  # gears whose joints are linear constraints
+    linear_gears, body_axes = [], []  # gears whose joints are linear constraints; those written in body axes
     for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
         if _linear_joints(spec):
@@ -346,9 +357,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
             carried = (_seat_loads_carried(spec, lead) and len(found) == 1
                        and _is_gear_seat(spec, lead, found[0][0]))
+            axes = _joint_axes(spec, other)
             made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
-                                         residual=carried, axes=spec.joints_assumed.joint_axes)
-                    for k, (a, b, p) in enumerate(found)]
+                                         residual=carried, axes=axes) for k, (a, b, p) in enumerate(found)]
+            if axes == "body":
+                body_axes.append(lead.name)
             if carried:
                 seat_residuals[lead.name] = (made[0].residual_node, made[0].centre)
             linear_gears.append(lead.name)
@@ -404,5 +417,5 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         tuple(train.aux_nodes), ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
-                        train.residual, linear_joints=tuple(linear_gears),
+                        train.residual, linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
                         seat_residual_nodes=train.seat_residual_nodes)

@@ -21,14 +21,16 @@ before each step (:meth:`LinearInterfaceJoint.__call__`), one marker per body; i
 On the axis (the sun's bore, the ring's bolt-circle RBE3) the frame columns are constant; off the axis (the
 ring's bolts on bolt patches) the lever R_n p of the frame rotations turns as well (:func:`frame_form`).
 
-``[joints_assumed] joint_axes`` says in which axes the six equations are written. "ground": as above, the
+``[joints_assumed] joint_axes`` says in which axes the six equations are written ("auto": per joint, below).
+"ground": as above, the
 modal columns turn (R_n Psi) and, off the axis, the frame rotations' lever. "body": the same equations
 premultiplied by Q_n^T = blockdiag(R_n^T, R_n^T) (:func:`body_axes_form`), an exact row transformation, so
 the solution is the same; the modal columns are then constant and the frame columns (R_n^T u, R_n^T phi) turn.
-The modified Newton method keeps a Jacobian over many steps while the coefficients turn; turning frame
-columns cost it fewer iterations than turning modal ones (benchmarks/bench_joint_axes.py, model 7: 3.19 ->
-3.05 Newton iterations per step over the Table 5 case, 3.71 -> 3.12 at full speed). The multipliers are then
-the force and moment in the gear's body axes.
+The modified Newton method keeps a Jacobian over many steps while the coefficients turn; with a flexible
+shaft, turning frame columns cost it fewer iterations than turning modal ones (benchmarks/bench_joint_axes.py
+over the Table 5 case: model 3 3.06 -> 2.11 Newton iterations per step, model 7 3.19 -> 3.05), with a rigid
+shaft more Jacobians (model 4: 88 -> 148 per 1000 steps); "auto" takes body axes where the shaft is flexible.
+The multipliers are then the force and moment in the gear's body axes.
 
 A bearing at a flexible body's seat (flexgear.geometry.supports: three springs on the axis) acts on the seat
 interface's motion s = (translation at the bearing centre, rotation) in ground, the same first-order
