@@ -399,18 +399,15 @@ class JointsAssumed:
     ``joint_equations`` "generic" (Exudyn's ObjectJointGeneric on the interface markers) or "linear" (first
     order about the prescribed spin, flexgear.mbs.joints; joints on the axis only, bolt patches stay generic).
     ``joint_axes`` "ground", "body" or "auto" (body axes where the shaft is flexible): the axes of the linear
-    joints' equations and multipliers (the same solution, a different cost to the modified Newton method;
-    flexgear.mbs.joints).
+    joints' equations and multipliers (the same solution, a different Newton cost; flexgear.mbs.joints).
     """
 
     ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),
                                                                       "doc": "ring-output shaft joint model"})
     bolt_patch: str = field(default="rbe2", metadata={"choices": ("rbe2", "rbe3"), "doc": "bolt patch kind"})
     bolt_clamp_diameter_mm: float = field(default=21.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
-    joint_equations: str = field(default="generic", metadata={"choices": ("generic", "linear"),
-                                                               "doc": "gear-shaft joint equations"})
-    joint_axes: str = field(default="auto", metadata={"choices": ("auto", "body", "ground"),
-                                                          "doc": "axes of the linear joints' equations"})
+    joint_equations: str = _choice("generic", "linear", doc="gear-shaft joint equations", default="generic")
+    joint_axes: str = _choice("auto", "body", "ground", doc="axes of the linear joints' equations", default="auto")
 
 
 @dataclass(frozen=True)
