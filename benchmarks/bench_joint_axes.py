@@ -24,9 +24,8 @@ AXES = ("ground", "body")
 
 
 def with_axes(variant: Variant, axes: str) -> Variant:
-    gb = variant.gearbox
-    return dataclasses.replace(variant, gearbox=gb.with_changes(
-        joints_assumed=dataclasses.replace(gb.joints_assumed, joint_axes=axes)))
+    """``variant`` with ``[joints_assumed] joint_axes = axes``."""
+    return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("joints_assumed", joint_axes=axes))
 
 
 def main() -> None:

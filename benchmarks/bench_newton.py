@@ -5,7 +5,7 @@ Run: nice -n 5 python benchmarks/bench_newton.py [--cases model1 floor] [--updat
 
 Each case runs once to the last of ``--ends`` (the full Table 5 load case, cut there) with each policy of
 ``[solver_assumed] jacobian_updates`` (flexgear.mbs.newton); the solver's running counts, read by the run's
-post-step function (flexgear.mbs.run.RunGuard, wrapped here) when it passes each end time, give the iterations
+post-step function (speed_common.solver_marks) when it passes each end time, give the iterations
 and Jacobians per step in each window (one run: the economy's choices depend on measured times, so runs to
 different end times are not prefixes of each other). Shows where a policy pays: model 1 under Exudyn's own rule needs
 about 3 iterations per step at light load early in the ramps and 1 after 0.2 s.
@@ -16,36 +16,12 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from speed_common import floor_variant, load_average, with_jacobian_updates
+from speed_common import floor_variant, load_average, solver_marks, with_jacobian_updates
 
-import flexgear.mbs.run as run_module
 from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-class _Counts:
-    """Wraps RunGuard.__call__: the solver's (iterations, Jacobians) counts at the first step at or after each end."""
-
-    def __init__(self, ends: list[float]):
-        self.ends, self.counts = sorted(ends), []
-        self.guard_call = run_module.RunGuard.__call__
-
-    def __enter__(self):
-        outer = self
-
-        def call(guard, mbs, t):
-            if len(outer.counts) < len(outer.ends) and t >= outer.ends[len(outer.counts)] - 1e-12:
-                it = mbs.sys["dynamicSolver"].it
-                outer.counts.append((it.newtonStepsCount, it.newtonJacobiCount))
-            return outer.guard_call(guard, mbs, t)
-
-        run_module.RunGuard.__call__ = call
-        return self
-
-    def __exit__(self, *exc):
-        run_module.RunGuard.__call__ = self.guard_call
 
 
 def main() -> None:
@@ -62,12 +38,12 @@ def main() -> None:
             v = floor_variant(v)
         h = v.gearbox.load_case.step_size_s
         for updates in a.updates:
-            with _Counts(a.ends) as counts:
+            with solver_marks(a.ends, h) as marks:
                 r = run_variant(with_jacobian_updates(v, updates), t_end_s=max(a.ends))
             if not r.ok:
                 raise SystemExit(f"{case} {updates}: {r.meta['reason']}")
             before, start, cells = (0, 0), 0.0, []
-            for end, now in zip(counts.ends, counts.counts, strict=False):
+            for end, (_, *now, _) in zip(sorted(a.ends), marks, strict=False):
                 steps = (end - start) / h
                 cells.append(f"{start:g}-{end:g} s: {(now[0] - before[0]) / steps:.2f} it, "
                              f"{1e3 * (now[1] - before[1]) / steps:.1f} Jac/1000")

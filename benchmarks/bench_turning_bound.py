@@ -50,41 +50,37 @@ GROUPS = {  # spin per drive angle of each co-rotating group: sun +1, planets -4
 }
 
 
+def _once_at_zero(call):
+    """A pre-step function that does its work once, at t = 0, and nothing after (a cost bound, wrong physics)."""
+    def frozen(self, mbs, t):
+        if getattr(self, "_bound_done", False):
+            return True
+        self._bound_done = True
+        return call(self, mbs, 0.0)
+    return frozen
+
+
 @contextlib.contextmanager
-def _frozen(classes: tuple[type, ...], keep_turning=None):
-    """Every ``classes`` pre-step function does its work once, at t = 0, and nothing after (a cost bound, wrong
-    physics); ``keep_turning(spin)``: TurningBlocks keep only the entries of those spins (the others stay at
-    their initial coefficients)."""
-    saved = {cls: (cls.__init__, cls.__call__) for cls in classes}
-
-    def frozen_call(original):
-        def call(self, mbs, t):
-            if getattr(self, "_bound_done", False):
-                return True
-            self._bound_done = True
-            return original(self, mbs, 0.0)
-        return call
-
+def _frozen(classes: tuple[type, ...] = (), keep_turning=None):
+    """The pre-step functions of ``classes`` frozen at t = 0; ``keep_turning(spin)``: TurningBlocks keep only the
+    entries of those spins (the others stay at their initial coefficients)."""
+    saved = {cls: (cls.__init__, cls.__call__) for cls in (TurningBlocks, ContactKinematics)}
     try:
         for cls in classes:
-            cls.__call__ = frozen_call(saved[cls][1])
+            cls.__call__ = _once_at_zero(saved[cls][1])
         if keep_turning is not None:
-            init, call = saved.get(TurningBlocks, (TurningBlocks.__init__, TurningBlocks.__call__))
-
-            def selective_init(self, entries, ramp_time, drive_speed):
-                init(self, [e for e in entries if keep_turning(e[5])], ramp_time, drive_speed)
-
-            TurningBlocks.__init__, TurningBlocks.__call__ = selective_init, call
-            saved.setdefault(TurningBlocks, (init, call))
+            init = saved[TurningBlocks][0]
+            TurningBlocks.__init__ = lambda self, entries, *rest: init(
+                self, [e for e in entries if keep_turning(e[5])], *rest)
         yield
     finally:
         for cls, (init, call) in saved.items():
             cls.__init__, cls.__call__ = init, call
 
 
-def measure(variant: Variant, window: tuple[float, float], freeze=()) -> tuple[float, float, float]:
-    """speed_common.measure_window with the ``freeze`` arguments of :func:`_frozen` in force."""
-    with _frozen(*freeze) if freeze else contextlib.nullcontext():
+def measure(variant: Variant, window: tuple[float, float], classes=(), keep_turning=None) -> tuple[float, float, float]:
+    """speed_common.measure_window with ``classes`` frozen and only ``keep_turning`` spins turning (:func:`_frozen`)."""
+    with _frozen(classes, keep_turning):
         return measure_window(variant, window)
 
 
@@ -103,24 +99,24 @@ def main() -> None:
     window = (float(a.window[0]), float(a.window[1])) if a.window else (lc.step_size_s, lc.end_time_s)
     if a.ramp is not None:
         m1, m7 = (shortened(v, a.ramp, window[1]) for v in (m1, m7))
-    cases = {"model1": (m1, ()), "model7": (m7, ()),
-             "model7_joints_frozen": (m7, ((TurningBlocks,),)),
-             "model7_contacts_frozen": (m7, ((ContactKinematics,),)),
-             "model7_all_frozen": (m7, ((TurningBlocks, ContactKinematics),))}
+    cases = {"model1": (m1, (), None), "model7": (m7, (), None),
+             "model7_joints_frozen": (m7, (TurningBlocks,), None),
+             "model7_contacts_frozen": (m7, (ContactKinematics,), None),
+             "model7_all_frozen": (m7, (TurningBlocks, ContactKinematics), None)}
     if a.groups:
         for g, sel in GROUPS.items():
-            cases[f"model7_only_{g}_turning"] = (m7, ((), sel))
+            cases[f"model7_only_{g}_turning"] = (m7, (), sel)
     ramp = m1.gearbox.load_case.ramp_time_s
     print(f"bench_turning_bound: ramp {ramp} s, window {window[0]:g}-{window[1]:g} s; {load_average()}",
           flush=True)
     results: dict[str, list[tuple[float, float, float]]] = {k: [] for k in cases}
     for r in range(a.repeat):
-        for name, (variant, freeze) in cases.items():
-            results[name].append(measure(variant, window, freeze))
+        for name, (variant, classes, keep) in cases.items():
+            results[name].append(measure(variant, window, classes, keep))
             us, it, jac = results[name][-1]
             print(f"  round {r + 1} {name:<28s} {us:8.1f} us/step  {it:5.2f} it/step  {jac:5.1f} Jac/1000 steps",
                   flush=True)
-    print("CPU per step at full speed [us]:")
+    print("CPU per step over the window [us]:")
     for name, vals in results.items():
         print(figure_line(name, [v[0] for v in vals], "us"))
         print(f"{'':<44s} Newton iterations per step, median {median([v[1] for v in vals]):.2f}; "

@@ -17,7 +17,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import cProfile
-import dataclasses
 import gc
 import io
 import pstats
@@ -27,7 +26,7 @@ import time
 import warnings
 from pathlib import Path
 
-from speed_common import floor_variant, load_average
+from speed_common import floor_variant, load_average, shortened
 
 from flexgear.mbs.gearbox import build_star_gearbox
 from flexgear.mbs.newton import JacobianEconomy
@@ -134,9 +133,7 @@ def main() -> None:
         variant = floor_variant(load_variant(folder / "model1.toml")) if case == "floor" else \
             load_variant(folder / f"{case}.toml")
         if a.ramp is not None:
-            gb = variant.gearbox
-            lc = dataclasses.replace(gb.load_case, ramp_time_s=a.ramp, end_time_s=max(a.t_end, a.ramp))
-            variant = dataclasses.replace(variant, gearbox=gb.with_changes(load_case=lc))
+            variant = shortened(variant, a.ramp, max(a.t_end, a.ramp))
         solve(variant, 1e-4, False, False)
         text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0)
         if a.trace_newton:

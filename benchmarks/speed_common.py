@@ -75,17 +75,18 @@ def shortened(variant: Variant, ramp: float, t_end: float) -> Variant:
 
 
 @contextlib.contextmanager
-def window_clock(start: float, end: float, step: float):
+def solver_marks(times: Sequence[float], step: float):
     """While active, every run's post-step function (flexgear.mbs.run.RunGuard, wrapped) records the CPU clock and
-    the solver's (iterations, Jacobians) counts at the first steps at or after ``start`` and ``end`` [s]: yields
-    the list of those marks, (cpu [s], iterations, Jacobians, t [s])."""
+    the solver's running (iterations, Jacobians) counts at the first step at or after each of ``times`` [s] (in
+    increasing order): yields the list of those marks, (cpu [s], iterations, Jacobians, t [s])."""
     import flexgear.mbs.run as run_module
 
+    ends = sorted(times)
     marks: list[tuple[float, int, int, float]] = []
     guard_call = run_module.RunGuard.__call__
 
     def call(guard, mbs, t):
-        if len(marks) < 2 and t >= (start, end)[len(marks)] - 0.5 * step:
+        if len(marks) < len(ends) and t >= ends[len(marks)] - 0.5 * step:
             it = mbs.sys["dynamicSolver"].it
             marks.append((time.process_time(), it.newtonStepsCount, it.newtonJacobiCount, t))
         return guard_call(guard, mbs, t)
@@ -103,7 +104,7 @@ def measure_window(variant: Variant, window: tuple[float, float]) -> tuple[float
     from flexgear.mbs.run import run_variant
 
     h = variant.gearbox.load_case.step_size_s
-    with window_clock(*window, h) as marks:
+    with solver_marks(window, h) as marks:
         r = run_variant(variant, t_end_s=window[1])
     if not r.ok or len(marks) < 2:
         raise SystemExit(f"{variant.name}: {r.meta.get('reason') or 'window not reached'}")

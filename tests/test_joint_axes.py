@@ -58,7 +58,7 @@ def test_body_axes_keep_model7_signals():
     lc = dataclasses.replace(g.load_case, ramp_time_s=0.006, end_time_s=0.012)
     runs = {}
     for axes in ("ground", "body"):
-        spec = g.with_changes(load_case=lc, joints_assumed=dataclasses.replace(g.joints_assumed, joint_axes=axes))
+        spec = g.with_changes(load_case=lc).with_fields("joints_assumed", joint_axes=axes)
         runs[axes] = run_variant(dataclasses.replace(v, gearbox=spec))
         assert runs[axes].ok, runs[axes].meta.get("reason")
     ref, new = runs["ground"], runs["body"]

@@ -183,7 +183,6 @@ class LinearInterfaceJoint:
                                                    jacobianUserFunction=zero_user_jacobian(width)))
             markers.append(mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)))
         self.forms = forms  # per body (C, A, B), signed: body 2 minus body 1
-        self.axes = axes
         self.q_ref = np.concatenate(q_ref)
         split = forms[0][0].shape[1]  # columns of the first body
         c = self.matrix_at(0.0)
@@ -198,7 +197,7 @@ class LinearInterfaceJoint:
 
     def matrix_at(self, phi: float) -> np.ndarray:
         """C (6, columns) at the spin angle ``phi`` [rad]: rows translation x, y, z and rotation x, y, z of body 2
-        minus body 1, in ground axes or in the axes turned by ``phi`` (``axes``)."""
+        minus body 1, in ground axes or in the axes turned by ``phi`` (the joint's ``axes``)."""
         c, s = np.cos(phi), np.sin(phi)
         return np.hstack([f[0] + c * f[1] + s * f[2] for f in self.forms])
 

@@ -209,9 +209,10 @@ def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: s
         data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
         if gear in model.linear_joints:  # multipliers on the shaft: force F and moment M at the point
             torque = data[:, 6].copy()  # M_z, plus (X x F)_z at the point's place X = R_z(phi_n) p off the axis
-            if np.hypot(point[0], point[1]) > 0.0 and gear in model.body_axes_joints:
+            off_axis = np.hypot(point[0], point[1]) > 0.0
+            if off_axis and gear in model.body_axes_joints:
                 torque += point[0] * data[:, 2] - point[1] * data[:, 1]  # F in the body axes, where X is p
-            elif np.hypot(point[0], point[1]) > 0.0:
+            elif off_axis:  # F in ground axes
                 lc = model.spec.load_case
                 th = model.theory  # the gear's spin per drive angle
                 ratio = (th.output_speed if gear == "ring" else th.input_speed) / th.input_speed
