@@ -14,9 +14,13 @@ Mesh sizes per level come from ``[meshing_assumed.<level>]`` of gearbox.toml: ``
 on the tooth and bolt-hole faces, ``body_size_mm`` elsewhere, ``element_order`` 1 or 2. Second
 order nodes are placed on the true (OCC) surfaces by Netgen.
 
-Cache (``meshes/``, keyed by a hash of every input): the solid as ``.brep``, the Netgen mesh as
-``.vol.gz`` (reload with :meth:`ComponentMesh.ngsolve_mesh`, which re-attaches the OCC geometry
-so that curved elements sit on the true surfaces), the arrays as ``.npz`` and a JSON summary.
+Cache (``meshes/``, keyed by a hash of every input): the solid as ``.brep`` with its digest
+(``.brep.sha256``), the Netgen mesh as ``.vol.gz`` (reload with :meth:`ComponentMesh.ngsolve_mesh`, which
+re-attaches the OCC geometry so that curved elements sit on the true surfaces), the arrays as ``.npz`` and a
+JSON summary, written last. Every file is checked before use (OCC hangs on a truncated ``.brep`` and Netgen
+crashes on a truncated ``.vol.gz``, so those two are checked before their readers see them); an entry that
+cannot be read is rebuilt with a warning, and an entry is built by one process at a time
+(flexgear.cache.load_or_build).
 """
 
 from __future__ import annotations
@@ -32,7 +36,15 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.cache import (
+    atomic_write_bytes,
+    cache_dir,
+    check_digest,
+    check_gzip,
+    load_or_build,
+    read_entry,
+    record_digest,
+)
 from flexgear.geometry.layout import component_layout, exact_mass_properties, geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
@@ -123,9 +135,17 @@ def _private_temporary(path: Path, suffix: str) -> Path:
 
 
 def component_brep(spec: GearboxSpec, component: str, progress: bool = False) -> Path:
-    """Path of the cached OCC solid (``.brep``) of ``component``; built on a cache miss."""
+    """Path of the cached OCC solid (``.brep``) of ``component``, checked against its digest; built on a cache
+    miss or when the file does not match its digest."""
     path = cache_dir() / f"solid-{component}-{geometry_hash(spec, component)}.brep"
-    if not path.exists():
+
+    def load() -> Path | None:
+        if not path.exists():
+            return None
+        check_digest(path)
+        return path
+
+    def build() -> Path:
         from flexgear.geometry.solids import component_solid
 
         t0 = time.perf_counter()
@@ -133,8 +153,11 @@ def component_brep(spec: GearboxSpec, component: str, progress: bool = False) ->
         tmp = _private_temporary(path, ".brep")
         shape.WriteBrep(str(tmp))
         tmp.replace(path)
+        record_digest(path)
         _say(progress, f"  {component}: solid built in {time.perf_counter() - t0:.1f} s")
-    return path
+        return path
+
+    return load_or_build(path, load, build)
 
 
 def _say(progress: bool, text: str) -> None:
@@ -257,22 +280,39 @@ def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", ord
         raise ValueError(f"unknown mesh level {level!r}; gearbox.toml [meshing_assumed] has "
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
-    cached = _cached_mesh(spec, component, level, order, progress)
-    return cached if cached is not None else _build_mesh(spec, component, level, order, progress)[0]
+    return _mesh(spec, component, level, order, progress)
 
 
-def _cached_mesh(spec: GearboxSpec, component: str, level: str, order: int,
-                 progress: bool) -> ComponentMesh | None:
-    """The cached mesh of ``component`` at ``level`` and ``order``, or None."""
+def _mesh(spec: GearboxSpec, component: str, level: str, order: int, progress: bool) -> ComponentMesh:
+    """The cached mesh (:func:`_cached_mesh`), or the one built and stored (:func:`_build_mesh`) when it is
+    missing or cannot be read, by one process at a time (the lock of its JSON summary)."""
     paths = _paths(spec, component, level, order)
     brep = component_brep(spec, component, progress)
+    return load_or_build(paths["json"], lambda: _cached_mesh(paths, component, level, order, brep),
+                         lambda: _build_mesh(spec, component, level, order, progress)[0])
+
+
+def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int, brep: Path) -> ComponentMesh | None:
+    """The cached mesh stored at ``paths``, or None when a file is missing; raises
+    flexgear.cache.UnreadableEntry naming a file that cannot be read (the JSON summary and every array read,
+    the node count of both compared, the ``.vol.gz`` read through to its checksum)."""
     if not (paths["npz"].exists() and paths["vol"].exists() and paths["json"].exists()):
         return None
-    data = np.load(paths["npz"])
-    info = json.loads(paths["json"].read_text())
-    regions = {k[len("region_"):]: data[k] for k in data.files if k.startswith("region_")}
+    info = read_entry(paths["json"], lambda p: json.loads(p.read_text()))
+    build_time = read_entry(paths["json"], lambda _: float(info["build_time_s"]))
+
+    def arrays(path: Path) -> dict[str, np.ndarray]:
+        with np.load(path, allow_pickle=False) as data:
+            out = {k: data[k] for k in data.files}
+        if len(out["nodes"]) != info.get("nodes", len(out["nodes"])):
+            raise ValueError(f"{len(out['nodes'])} nodes, the summary {paths['json'].name} says {info['nodes']}")
+        return out
+
+    data = read_entry(paths["npz"], arrays)
+    check_gzip(paths["vol"])
+    regions = {k[len("region_"):]: v for k, v in data.items() if k.startswith("region_")}
     return ComponentMesh(component, level, order, data["nodes"], data["elements"], data["surface"], regions,
-                         info["build_time_s"], paths["vol"], brep)
+                         build_time, paths["vol"], brep)
 
 
 def _build_mesh(spec: GearboxSpec, component: str, level: str, order: int, progress: bool):
@@ -284,16 +324,15 @@ def _build_mesh(spec: GearboxSpec, component: str, level: str, order: int, progr
     """
     paths = _paths(spec, component, level, order)
     brep = component_brep(spec, component, progress)
+    paths["json"].unlink(missing_ok=True)  # written last: until then readers find no entry, not a mixed one
     t0 = time.perf_counter()
     if order == 1:
         ngmesh = _netgen_mesh(brep, spec, component, level)
     else:
-        first = _cached_mesh(spec, component, level, 1, progress)
-        if first is None:
-            first, ngmesh = _build_mesh(spec, component, level, 1, progress)
-            ngmesh = ngmesh.Copy()  # the first-order one stays in _JUST_BUILT
-        else:
-            ngmesh = _load_netgen_mesh(first.vol_path, brep)
+        first = _mesh(spec, component, level, 1, progress)
+        just_built = _JUST_BUILT.get(first.vol_path)
+        # the first-order one stays in _JUST_BUILT
+        ngmesh = just_built.Copy() if just_built is not None else _load_netgen_mesh(first.vol_path, brep)
         ngmesh.SecondOrder()
     nodes, elements, surface = _arrays(ngmesh, order)
     build = time.perf_counter() - t0

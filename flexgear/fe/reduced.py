@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flexgear.cache import atomic_write_bytes, cache_dir
+from flexgear.cache import atomic_write_bytes, cache_dir, load_or_build, read_entry
 from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.bolted import bolt_axes, clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
@@ -239,14 +239,15 @@ def _load_frequencies(path: Path) -> np.ndarray:
 
 
 def _read_cached(key: str, read: Callable[[Path], object]) -> object | None:
-    """``read(path)`` of the reduced body cached under ``key``; None if it is missing or unreadable."""
+    """``read(path)`` of the reduced body cached under ``key``; None if it is missing or cannot be read (a
+    damaged file is reported and rebuilt by :func:`cached_reduced_body`)."""
     path = reduced_cache_path(key)
     if not path.exists():
         return None
     try:
         return read(path)
-    except (OSError, ValueError, KeyError):
-        return None  # damaged entry: cached_reduced_body rebuilds it
+    except Exception:
+        return None
 
 
 def _component_reduction(spec: GearboxSpec, component: str, level: str,
@@ -296,15 +297,19 @@ def cached_reduced_body(key: str, build: Callable[[], ReducedBody],
     """Load the reduced body cached under ``key``, or ``build()`` it and store it atomically.
 
     ``key`` must be a hash of every input (flexgear.spec.spec_hash of geometry, mesh and reduction
-    settings): a changed input gives a new key and a rebuild; an unreadable file is rebuilt.
+    settings): a changed input gives a new key and a rebuild. A file that cannot be read (every member is
+    read, its zip checksum checked) is rebuilt with a flexgear.cache.CacheWarning naming it; a missing body is
+    built by one process at a time, the others load its file (flexgear.cache.load_or_build).
     """
     path = reduced_cache_path(key, directory)
-    if path.exists():
-        try:
-            return ReducedBody.load(path)  # np.load reads each member from the file: no copy of the whole file
-        except (OSError, ValueError, KeyError):
-            pass  # damaged entry: rebuild and overwrite
-    body = build()
-    path.parent.mkdir(parents=True, exist_ok=True)
-    atomic_write_bytes(path, body.save())
-    return body
+
+    def load() -> ReducedBody | None:
+        # np.load reads each member from the file: no copy of the whole file
+        return read_entry(path, ReducedBody.load) if path.exists() else None
+
+    def store() -> ReducedBody:
+        body = build()
+        atomic_write_bytes(path, body.save())
+        return body
+
+    return load_or_build(path, load, store)
