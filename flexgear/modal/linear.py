@@ -286,9 +286,9 @@ def _settings(t_star: float):
     st.newton.absoluteTolerance = 1e-10
     st.newton.useModifiedNewton = False
     st.newton.maxIterations = 50
-    ss.linearSolverType = exu.LinearSolverType.EigenDense
-    ss.solutionSettings.writeSolutionToFile = False
-    ss.solutionSettings.sensorsWritePeriod = math.inf
+    ss.linearSolver.solverType = exu.LinearSolverType.EigenDense
+    ss.solution.file.write = False
+    ss.solution.sensors.writePeriod = math.inf
     return ss
 
 
@@ -322,10 +322,9 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
         n = m.shape[0]
         labels = _labels(mbs, model, n)
         q = np.array(mbs.systemData.GetODE2Coordinates())
-        deflections = {}
-        for node in model.aux_nodes:
-            start = mbs.GetNodeODE2Index(node)
-            deflections[mbs.GetNode(node)["name"]] = q[start:start + len(mbs.GetNode(node)["referenceCoordinates"])]
+        rows = [mbs.GetNodeODE2Index(node) + k for node in model.aux_nodes
+                for k in range(len(mbs.GetNode(node)["referenceCoordinates"]))]  # contacts in order
+        static = {contact.name: float(q[i]) for contact, i in zip(model.contacts, rows, strict=True)}
         parts = _mass_parts(built, model, mbs)
     finally:
         sc.Reset()
@@ -338,7 +337,6 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     mr, kr, dr = (basis.T @ a @ basis for a in (m, k, dx))
     flexible = tuple(_component_name(nm) for nm, b in model.bodies.items() if b.flexible)
     components = _components(spec.gears.planet_count)
-    static = {name: float(v.mean()) for name, v in deflections.items()}
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
                        basis, tuple(labels), m, k, components, flexible, parts, static)
 
