@@ -18,13 +18,24 @@ from flexgear.progress import Progress, say
 __all__ = ["main", "SUBCOMMANDS"]
 
 OUT_HELP = "results folder; each run goes to OUT/<variant name>/ (default: %(default)s)"
-T_END_HELP = "simulated time in s (default: end_time_s of the load case)"
+T_END_HELP = ("simulated time in s, or 'settled': continue past the load case's end_time_s until the run has "
+              "settled ([load_case] settle_max_time_s at most) (default: the load case's end)")
+
+
+def _t_end(text: str) -> float | str:
+    """``--t-end``: a time in s or the word 'settled'."""
+    if text == "settled":
+        return text
+    try:
+        return float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a time in s or 'settled', got {text!r}") from None
 
 
 # --------------------------------------------------------------------------- run
 def _args_run(p: argparse.ArgumentParser) -> None:
     p.add_argument("variant", help="variant file (model_variants/model1.toml ...)")
-    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--t-end", type=_t_end, default=None, metavar="S", help=T_END_HELP)
     p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP)
     p.add_argument("--time-budget", type=float, default=None, metavar="S",
                    help="wall-time budget in s (default: [solver_assumed] wall_time_budget_s)")
@@ -40,7 +51,7 @@ def cmd_run(a: argparse.Namespace) -> int:
 
     variant = load_variant(a.variant)
     task = make_task(variant, a.t_end, a.time_budget)
-    warning = ramp_warning(variant, variant.gearbox.load_case.end_time_s if a.t_end is None else a.t_end)
+    warning = ramp_warning(variant, a.t_end if isinstance(a.t_end, float) else variant.gearbox.load_case.end_time_s)
     if warning:
         say(f"warning: {variant.name}: {warning}")
     result = run_variant(variant, t_end_s=a.t_end, progress=True, time_budget_s=a.time_budget,
@@ -58,7 +69,7 @@ def cmd_run(a: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- matrix
 def _args_matrix(p: argparse.ArgumentParser) -> None:
     p.add_argument("variants", nargs="+", metavar="VARIANT", help="variant files, one run each")
-    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--t-end", type=_t_end, default=None, metavar="S", help=T_END_HELP)
     p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP + "; finished runs are kept (resume)")
     p.add_argument("--workers", type=int, default=2, metavar="N",
                    help="local worker processes (default: %(default)s; ignored with --scheduler)")
@@ -86,7 +97,7 @@ def cmd_matrix(a: argparse.Namespace) -> int:
 def _args_sweep(p: argparse.ArgumentParser) -> None:
     p.add_argument("sweep", help="sweep file (TOML; see flexgear.study.sweep)")
     p.add_argument("--out", default=None, metavar="DIR", help="results folder (default: results/sweep_<name>)")
-    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--t-end", type=_t_end, default=None, metavar="S", help=T_END_HELP)
     p.add_argument("--workers", type=int, default=2, metavar="N", help="local worker processes (default: %(default)s)")
     p.add_argument("--scheduler", default=None, metavar="ADDR", help="Dask scheduler address (default: local)")
     p.add_argument("--all-combinations", action="store_true",

@@ -72,6 +72,13 @@ class Progress:
                 self._next_plain += self.plain_step
         self.value = value
 
+    def extend(self, total: float) -> None:
+        """A longer task than announced (a run continued until it settles): the new ``total``."""
+        self.total = float(total)
+        if self._bar is not None:
+            self._bar.total = self.total
+            self._bar.refresh()
+
     def _plain(self, value: float, postfix: str) -> None:
         pct = 100.0 * value / self.total if self.total > 0 else 100.0
         text = (f"{self.desc}: {self.fmt.format(value)}/{self.fmt.format(self.total)} {self.unit} ({pct:.0f} %), "

@@ -14,10 +14,22 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from flexgear.schema_fields import SpecError, _choice, _num
+from flexgear.schema_screening import (
+    IndicatorTolerance,
+    IndicatorWeights,
+    LengthTolerance,
+    LevelTolerance,
+    LoadTolerance,
+    ReferenceIndicators,
+    ScreeningSettings,
+)
+
 __all__ = [
     "SpecError", "GearSet", "GearSetAssumed", "Material", "ComponentsAssumed", "Bearing", "Bearings", "Contact",
     "ContactAssumed", "SupportsAssumed", "JointsAssumed", "LoadCase", "SolverSettings", "MeshingSettings",
-    "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "ReferenceIndicators", "ScreeningSettings",
+    "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "LoadTolerance",
+    "LevelTolerance", "LengthTolerance", "ReferenceIndicators", "ScreeningSettings",
     "LumpedAssumed", "GearboxSpec", "Variant", "COMPONENTS", "GEAR_COMPONENTS", "SHAFT_COMPONENTS",
     "GEOMETRY_COMPONENTS", "COMPONENT_GEOMETRY",
 ]
@@ -31,32 +43,6 @@ GEOMETRY_COMPONENTS = GEAR_COMPONENTS + SHAFT_COMPONENTS
 
 COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"}
 """Table 3 component (or geometry) name -> its geometry name."""
-
-
-class SpecError(ValueError):
-    """A specification file is wrong: the message names the file, the field and what is allowed."""
-
-    def __init__(self, path: str | Path, fieldname: str, allowed: str, got: Any = None):
-        self.path, self.field, self.allowed = str(path), fieldname, allowed
-        got_text = "" if got is None else f", got {got!r}"
-        super().__init__(f"{path}: field '{fieldname}': {allowed}{got_text}")
-
-
-def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
-         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
-    """Field with a numeric range check (validated on load); optional when ``default`` is given."""
-    return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
-
-
-def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:
-    meta = {"choices": choices, "doc": doc}
-    return field(metadata=meta) if default is None else field(default=default, metadata=meta)
-
-
-def _text(doc: str = "", default: str | None = None) -> Any:
-    if default is None:
-        return field(metadata={"doc": doc})
-    return field(default=default, metadata={"doc": doc})
 
 
 # --------------------------------------------------------------------------- gearbox tables
@@ -209,6 +195,11 @@ class LoadCase:
     ramp_time_s: float = _num(0.0, lo_open=True)
     end_time_s: float = _num(0.0, lo_open=True)
     step_size_s: float = _num(0.0, lo_open=True)
+    # "time": stop at end_time_s; "settled": from end_time_s on, continue in chunks of settle_chunk_s until the
+    # settling test (flexgear.settling, [screening] settle_*) passes or settle_max_time_s is reached
+    end: str = _choice("time", "settled", default="time")
+    settle_chunk_s: float = _num(0.0, lo_open=True, default=0.1)
+    settle_max_time_s: float = _num(0.0, lo_open=True, default=2.0)
 
     @property
     def input_speed_rad_s(self) -> float:
@@ -229,16 +220,12 @@ class SolverSettings:
     runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
     # linear floating frame: interval [s] of the spin-term updates in the ramp (flexgear.mbs.spin.SpinSchedule)
     spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
-    # body frames' inertia: "exact" Exudyn's ObjectRigidBody; "linear" constant matrices about the prescribed spin
-    # (flexgear.mbs.bodies.add_linear_frame), for bodies axisymmetric within frame_axisymmetry_tolerance
+    # body frames' inertia: Exudyn's ObjectRigidBody, or constant matrices about the spin (mbs.bodies.add_linear_frame)
     frame_equations: str = _choice("exact", "linear", default="exact")
     frame_axisymmetry_tolerance: float = _num(0.0, 1.0, default=1e-4)
-    # "sparse": Eigen's SparseLU orders the Jacobian anew at each factorization or reuses the ordering of the last
-    # one while its pattern holds (Exudyn's reuseAnalyzedPattern)
+    # sparse LU: a new ordering at each factorization, or the last one reused while its pattern holds
     sparse_ordering: str = _choice("per_jacobian", "reused", default="per_jacobian")
-    # when the modified Newton gets a fresh Jacobian (flexgear.mbs.newton): "exudyn" only after a step fails to
-    # converge within newton_max_modified_iterations; "economy" also when the iterations paid above the fewest since
-    # the last Jacobian reach jacobian_cost_iterations, a Jacobian's cost in iterations
+    # when the modified Newton gets a fresh Jacobian (flexgear.mbs.newton)
     jacobian_updates: str = _choice("exudyn", "economy", default="exudyn")
     jacobian_cost_iterations: float = _num(1.0, default=12.0)
 
@@ -268,88 +255,14 @@ class ReductionSettings:
     attachment_order: int = _num(0, 60, integer=True)
     # 0: keep every mode of the (attachment-corrected) basis; n > 0: the n lowest (loses the static correction)
     simulation_modes: int = _num(0, 400, integer=True, default=0)
-    # Gears only (bodies with gear contacts): modes above this multiple of the nominal mesh frequency
-    # leave the time integration and return as the static residual compliance of the contacts
-    # (flexgear.mbs.residual); 0 keeps every mode dynamic.
+    # gears: modes above this multiple of the mesh frequency become static residual compliance (0: all dynamic)
     dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
     # "ffrf": Exudyn's nonlinear floating frame; "linear": flexgear.mbs.spin (rigid frame + linear modal equations)
     floating_frame: str = _choice("ffrf", "linear", default="ffrf")
     # "linear" bodies: "interface": linear joints' and seats' interface motions as coordinates (flexgear.mbs.flexible)
     modal_coordinates: str = _choice("modal", "interface", default="modal")
-    # Seat load that a gear's dropped modes answer (flexgear.mbs.residual): "dynamic" its linear seat bearing's or
-    # joint's own reaction (coordinates of the seat's residual motion; seats on generic joints or marker springs
-    # fall back to the other), "quasi_static" the contacts' rigid reaction at the seat
+    # seat load that a gear's dropped modes answer (flexgear.mbs.residual)
     residual_seat_loads: str = _choice("dynamic", "quasi_static", default="dynamic")
-
-
-@dataclass(frozen=True)
-class IndicatorWeights:
-    """Weights of the study's five screening indicators in the composite point (sum 1).
-
-    Section 2.2: "taking 20 % of each of the five simulation indicators".
-    """
-
-    input_speed: float = _num(0.0, 1.0)
-    output_speed: float = _num(0.0, 1.0)
-    transmission_ratio: float = _num(0.0, 1.0)
-    outer_mesh_force: float = _num(0.0, 1.0)
-    inner_mesh_force: float = _num(0.0, 1.0)
-
-
-@dataclass(frozen=True)
-class IndicatorTolerance:
-    """Allowable total error TEa (%) and weight of one indicator in the reference screening."""
-
-    tea_pct: float = _num(0.0, 1000.0, lo_open=True)
-    weight: float = _num(0.0, 1.0)
-
-
-@dataclass(frozen=True)
-class ReferenceIndicators:
-    """TEa and weight of every indicator when variants are screened against a reference variant
-    (``[screening.reference_indicators]``; flexgear.study.indicators defines each indicator)."""
-
-    input_speed: IndicatorTolerance
-    output_speed: IndicatorTolerance
-    transmission_ratio: IndicatorTolerance
-    outer_mesh_force: IndicatorTolerance
-    inner_mesh_force: IndicatorTolerance
-    outer_mesh_ripple: IndicatorTolerance
-    inner_mesh_ripple: IndicatorTolerance
-    load_sharing: IndicatorTolerance
-    dynamic_factor: IndicatorTolerance
-    input_bearing_rms: IndicatorTolerance
-    output_bearing_rms: IndicatorTolerance
-    input_bearing_mesh1x: IndicatorTolerance
-    output_bearing_mesh1x: IndicatorTolerance
-    transmission_error: IndicatorTolerance
-
-
-@dataclass(frozen=True)
-class ScreeningSettings:
-    """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
-
-    See ``[screening]`` in gearbox.toml and :mod:`flexgear.study.screening` for each value's meaning.
-    """
-
-    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
-    lines: str = _choice("westgard", "six_sigma")
-    window: str = _choice("settled", "after_ramps", "fixed")
-    after_ramp_delay_s: float = _num(0.0)
-    window_start_s: float = _num(0.0)
-    window_end_s: float = _num(0.0, lo_open=True)
-    short_run_fraction: float = _num(0.0, 1.0, lo_open=True)
-    sample_count: int = _num(2, 10000, integer=True)
-    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
-    weights: IndicatorWeights
-    reference_indicators: ReferenceIndicators
-    # settled window (flexgear.study.indicators.settled_start): blocks of whole mesh cycles, tolerances in %
-    settle_block_mesh_cycles: int = _num(1, 100000, integer=True)
-    settle_final_blocks: int = _num(1, 1000, integer=True)
-    settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
-    settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
-    # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
-    reference: str = _text(default="")
 
 
 @dataclass(frozen=True)
@@ -376,11 +289,7 @@ class LumpedAssumed:
 class SupportsAssumed:
     """Where the bearings, the speed drive and the load torque act (flexgear.geometry.supports).
 
-    ``placement`` "bearing_seats": bushings at the shafts' bearing seats and the planets' bores, drive and load at
-    the input shaft's and output shaft's bearing-seat interfaces; "gear_centres": all on the body frames at the
-    gear mid-planes (the former model, kept for comparison). ``seat_equations`` (flexible bodies' seats):
-    "markers", three spring-dampers on the seat's virtual nodes; "linear", the same springs summed into one 6 x 6
-    bearing on the seat's motion, first order about the prescribed spin (flexgear.mbs.joints.LinearSeat).
+    ``placement`` "bearing_seats" or "gear_centres"; ``seat_equations`` "markers" or "linear" (flexgear.mbs.joints).
     """
 
     placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
@@ -393,13 +302,8 @@ class SupportsAssumed:
 class JointsAssumed:
     """How the ring and the output shaft are joined when either is flexible (flexgear.fe.bolted, flexgear.fe.reduced).
 
-    ``ring_output_shaft`` "bolt_patches": per bolt a patch over its clamped disc on each mating face, joined
-    pairwise; "rbe3": one RBE3 interface over all bolt-hole walls of each body, one fixed joint at the bolt
-    circle. ``bolt_patch`` "rbe2" (rigid disc) or "rbe3"; ``bolt_clamp_diameter_mm`` the disc's diameter.
-    ``joint_equations`` "generic" (Exudyn's ObjectJointGeneric on the interface markers) or "linear" (first
-    order about the prescribed spin, flexgear.mbs.joints; joints on the axis only, bolt patches stay generic).
-    ``joint_axes`` "ground", "body" or "auto" (body axes where the shaft is flexible): the axes of the linear
-    joints' equations and multipliers (the same solution, a different Newton cost; flexgear.mbs.joints).
+    ``ring_output_shaft``: a patch per bolt ("bolt_patches") or one RBE3 joint; ``bolt_patch`` rbe2/rbe3;
+    ``joint_equations`` and ``joint_axes``: the gear-shaft joints' equations (flexgear.mbs.joints).
     """
 
     ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),

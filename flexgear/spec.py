@@ -211,7 +211,8 @@ def _check_consistency(spec: GearboxSpec) -> None:
     weights = dataclasses.astuple(spec.screening.weights)
     if abs(sum(weights) - 1.0) > 1e-9:
         raise SpecError(p, "screening.weights", "expected weights that sum to 1", sum(weights))
-    ref_weights = [w for _, w in dataclasses.astuple(spec.screening.reference_indicators)]
+    ref = spec.screening.reference_indicators
+    ref_weights = [getattr(ref, f.name).weight for f in dataclasses.fields(ref)]
     if abs(sum(ref_weights) - 1.0) > 1e-9:
         raise SpecError(p, "screening.reference_indicators", "expected weights that sum to 1", sum(ref_weights))
     if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
@@ -221,6 +222,9 @@ def _check_consistency(spec: GearboxSpec) -> None:
         raise SpecError(p, "solver_assumed.frame_equations", "'linear' needs [joints_assumed] joint_equations = "
                         "'linear' (generic joints need Exudyn's rigid bodies)", "linear")
     lc = spec.load_case
+    if lc.end == "settled" and lc.settle_max_time_s < lc.end_time_s:
+        raise SpecError(p, "load_case.settle_max_time_s", "expected >= end_time_s (the settled run's maximum time)",
+                        lc.settle_max_time_s)
     if lc.step_size_s >= min(lc.end_time_s, lc.ramp_time_s):
         raise SpecError(p, "load_case.step_size_s", "expected < ramp_time_s and < end_time_s", lc.step_size_s)
     for level, m in spec.meshing_assumed.items():

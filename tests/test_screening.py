@@ -38,8 +38,8 @@ def test_known_bias_and_cv_per_indicator_and_composite(settings):
     s = screen_result(synthetic_result("synth", bias, cv), settings)
     assert s.window.steady and s.window.start_s == pytest.approx(0.5)
     for key, r in s.indicators.items():
-        assert r.bias_pct == pytest.approx(100 * abs(bias[key]), abs=1e-9)
-        assert r.cv_pct == pytest.approx(100 * cv[key] / abs(1 + bias[key]), rel=1e-9, abs=1e-12)
+        assert r.bias == pytest.approx(100 * abs(bias[key]), abs=1e-9)
+        assert r.cv == pytest.approx(100 * cv[key] / abs(1 + bias[key]), rel=1e-9, abs=1e-12)
         assert len(r.samples) == settings.sample_count
     # composite point: 20 % of each indicator (section 2.2), distance from the origin
     exp_bias = 0.2 * sum(100 * abs(b) for b in bias.values())
@@ -55,7 +55,7 @@ def test_mesh_force_is_the_mean_over_planets(settings):
     s = screen_result(synthetic_result("synth"), settings)
     for key in ("outer_mesh_force", "inner_mesh_force"):
         r = s.indicators[key]
-        assert r.bias_pct == pytest.approx(0.0, abs=1e-9)
+        assert r.bias == pytest.approx(0.0, abs=1e-9)
         assert r.mean == pytest.approx(r.theory, rel=1e-12)
 
 
@@ -113,7 +113,12 @@ def test_selection_rules_on_the_studys_table():
     assert sel.variant == "model6" and "model4" in sel.reasoning
     nothing = table.assign(zone_rank=0)
     assert select_variant(nothing, "fastest_acceptable", lines).variant is None
-    assert "WARNING" in select_variant(nothing, "fastest_in_best_zone", lines).reasoning
+    honest = select_variant(nothing, "fastest_in_best_zone", lines)   # never the fastest non-conforming variant
+    assert honest.variant is None and "No variant is acceptable" in honest.reasoning
+    only_ref = nothing.copy()
+    only_ref.loc[only_ref["variant"] == "model7", "zone_rank"] = 3
+    sel = select_variant(only_ref, "fastest_in_best_zone", lines, reference="model7")
+    assert sel.variant == "model7" and sel.reasoning.startswith("Only the reference model7 is acceptable")
     with pytest.raises(ValueError, match="unknown selection rule"):
         select_variant(table, "cheapest", lines)
 

@@ -60,6 +60,10 @@ class JacobianEconomy:
         self._free = [0.0, 0.0, 0.0, 0.0, 0.0]  # steps without a Jacobian: count, sum n, sum n^2, sum t, sum n t [s]
         self._jac = [0.0, 0.0, 0.0]  # steps with one: count, sum n, sum t [s]
 
+    def new_solve(self) -> None:
+        """A run continued by a new ``SolveDynamic`` (a new solver object): read its data at the next step."""
+        self._it = None
+
     def __call__(self, mbs) -> None:
         now = self._now()
         it = self._it

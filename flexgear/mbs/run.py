@@ -38,6 +38,27 @@ GUARD_EVERY_STEPS = 50
 """Steps between two checks of the divergence guard (each reads two node velocities and the clock)."""
 
 
+class SensorLog:
+    """Stored sensor data of a run solved in one or more chunks (Exudyn clears it at each ``SolveDynamic``):
+    :meth:`collect` after each chunk appends its rows, :meth:`GetSensorStoredData` reads them all (the name of
+    Exudyn's own reader, so that the signal functions read either)."""
+
+    def __init__(self, mbs, sensors: dict[str, int]) -> None:
+        self.mbs = mbs
+        self.parts: dict[int, list[np.ndarray]] = {i: [] for i in set(sensors.values())}
+
+    def collect(self) -> None:
+        for i, parts in self.parts.items():
+            data = np.asarray(self.mbs.GetSensorStoredData(i))
+            if parts:  # a continued chunk starts with the previous chunk's last recorded time
+                data = data[data[:, 0] > parts[-1][-1, 0] + 1e-12]
+            parts.append(data)
+
+    def GetSensorStoredData(self, i: int) -> np.ndarray:  # noqa: N802 (Exudyn's name)
+        parts = self.parts[i]
+        return parts[0] if len(parts) == 1 else np.vstack(parts)
+
+
 def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     """Signal table (flexgear.results.signal_columns) from the stored sensor data."""
     def data(key: str) -> np.ndarray:
@@ -163,8 +184,9 @@ def ramp_warning(variant: Variant, t_end: float) -> str:
     return ""
 
 
-def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
-    """SolveDynamic with Exudyn's console output off; raises with the guard's or the solver's reason."""
+def _solve(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard) -> None:
+    """SolveDynamic from ``t_start`` to ``t_end`` [s] with Exudyn's console output off, leaving the final state
+    as the initial state of a continuation; raises with the guard's or the solver's reason."""
     import exudyn as exu
     import exudyn.solver as exu_solver
 
@@ -173,9 +195,15 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
     # vectors. The warning says nothing about a particular run, so it is switched off.
     exu_solver.solverCheckMemoryAllocationsThreshold = math.inf
     # a post-step function: the pre-step one belongs to the model (contact kinematics, friction, drive schedule)
-    if mbs.GetPostStepUserFunction() not in (0, None):
+    if t_start == 0.0 and mbs.GetPostStepUserFunction() not in (0, None):
         raise RuntimeError("the model has a post-step user function already; the divergence guard needs it")
     mbs.SetPostStepUserFunction(guard)
+    if guard.economy is not None:
+        guard.economy.new_solve()
+    settings = simulation_settings(variant, t_end, False)
+    step = variant.gearbox.load_case.step_size_s
+    settings.timeIntegration.startTime = t_start
+    settings.timeIntegration.numberOfSteps = max(1, round((t_end - t_start) / step))
     was_printing = exu.config.printToConsole
     exu.config.printToConsole = False
     # the per-step Python allocates small objects: without this, each garbage collection of the older generations
@@ -183,8 +211,8 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
     gc.collect()
     gc.freeze()
     try:
-        mbs.SolveDynamic(simulation_settings(variant, t_end, False), solverType=exu.DynamicSolverType.GeneralizedAlpha,
-                         storeSolver=True, showHints=False)
+        mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha, storeSolver=True,
+                         showHints=False, updateInitialValues=True)
     except Exception as exc:
         guard.bar.close()
         if guard.reason:
@@ -199,7 +227,42 @@ def _solve(mbs, variant: Variant, t_end: float, guard: RunGuard) -> None:
         guard.bar.close()
         raise FloatingPointError(guard.reason)
     guard.bar.update_to(t_end)
-    guard.bar.close()
+
+
+def _solve_chunk(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard, log: SensorLog,
+                 counts: dict[str, int]) -> dict[str, int]:
+    """Solve one chunk, keep its sensor data, add its solver counts to ``counts`` (returned)."""
+    _solve(mbs, variant, t_start, t_end, guard)
+    log.collect()
+    return {k: counts.get(k, 0) + v for k, v in solver_counts(mbs).items()}
+
+
+def _continue_until_settled(mbs, model: GearboxModel, variant: Variant, sensors: dict[str, int], guard: RunGuard,
+                            log: SensorLog, counts: dict[str, int], meta: dict) -> tuple[float, dict[str, int]]:
+    """Continue a run at its steady operating point in chunks until it settles (:mod:`flexgear.settling`) or
+    reaches ``settle_max_time_s``; records the outcome in ``meta``. Returns the end time [s] and solver counts."""
+    from flexgear.settling import SettleRule, settled_start
+
+    lc, screening = variant.gearbox.load_case, variant.gearbox.screening
+    rule = SettleRule.from_settings(screening)
+    after = lc.ramp_time_s + screening.after_ramp_delay_s
+    f_mesh = float(meta["theory"]["mesh_frequency_hz"])
+    t_end = lc.end_time_s
+    while True:
+        test = settled_start(_signals(log, model, sensors), after, f_mesh, rule)
+        if test.settled or t_end >= lc.settle_max_time_s - 1e-12:
+            break
+        # one chunk, or up to four at once when the test's estimate says that many are needed
+        jump = min(test.needed_end_s, t_end + 4 * lc.settle_chunk_s) if math.isfinite(test.needed_end_s) else 0.0
+        t_next = min(lc.settle_max_time_s, max(t_end + lc.settle_chunk_s, jump))
+        t_next = round(t_next / lc.step_size_s) * lc.step_size_s  # whole steps: the time grid of a single run
+        guard.bar.extend(t_next)
+        guard.t_end = t_next
+        counts = _solve_chunk(mbs, variant, t_end, t_next, guard, log, counts)
+        t_end = t_next
+    meta.update(settled=test.settled, settled_at_s=test.start_s, settle_reason=test.reason,
+                settle_max_time_s=lc.settle_max_time_s)
+    return t_end, counts
 
 
 def solver_counts(mbs) -> dict[str, int]:
@@ -210,11 +273,15 @@ def solver_counts(mbs) -> dict[str, int]:
     return {"newton_iterations": int(solver.it.newtonStepsCount), "jacobians": int(solver.it.newtonJacobiCount)}
 
 
-def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool = False,
+def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: bool = False,
                 mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
                 time_budget_s: float | None = None, record_states_every: int = 0) -> RunResult:
-    """Run ``variant`` for ``t_end_s`` (default: the load case's end time).
+    """Run ``variant`` for ``t_end_s`` [s] (default: the load case's end), or until it has settled.
 
+    ``t_end_s = "settled"`` (or ``[load_case] end = "settled"`` with ``t_end_s`` None): the run goes to the load
+    case's ``end_time_s``, then continues in chunks of ``settle_chunk_s`` at the steady operating point until the
+    settling test of :mod:`flexgear.settling` (``[screening]`` settle_* fields) passes or ``settle_max_time_s`` is
+    reached; the metadata records ``settled``, ``settled_at_s`` and the test's reason either way.
     ``time_budget_s`` overrides ``[solver_assumed] wall_time_budget_s``. ``record_states_every`` > 0 also
     records the bodies' states every that many steps (extra table ``states``, flexgear.mbs.states; for
     ``flexgear animate``). Never raises for a model or solver failure: the result then has status
@@ -223,7 +290,9 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
     import exudyn as exu
     from threadpoolctl import threadpool_limits
 
-    t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
+    lc = variant.gearbox.load_case
+    until_settled = t_end_s == "settled" or (t_end_s is None and lc.end == "settled")
+    t_end = lc.end_time_s if (t_end_s is None or until_settled) else float(t_end_s)
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
     meta = _meta(variant, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
@@ -243,8 +312,13 @@ def run_variant(variant: Variant, t_end_s: float | None = None, progress: bool =
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
         guard = RunGuard(model, variant, t_end, budget - build_s, progress)
-        _solve(mbs, variant, t_end, guard)
-        meta.update(solver_counts(mbs))
+        log = SensorLog(mbs, {**sensors, **{f"state/{k}": v for k, v in states.items()}})
+        counts = _solve_chunk(mbs, variant, 0.0, t_end, guard, log, {})
+        if until_settled:
+            t_end, counts = _continue_until_settled(mbs, model, variant, sensors, guard, log, counts, meta)
+        guard.bar.close()
+        meta.update(counts, t_end_s=t_end)
+        mbs = log  # the signals below read every chunk's sensor data
         if guard.economy is not None:  # the Jacobians it asked for, a Jacobian's cost as measured (flexgear.mbs.newton)
             meta.update(jacobian_requests=guard.economy.requests,
                         jacobian_cost_iterations_measured=guard.economy.measured_ratio)

@@ -12,7 +12,15 @@ import pandas as pd
 from flexgear.report.figures import fmt
 from flexgear.results import RunResult, load_result
 from flexgear.spec import GearboxSpec, ScreeningSettings, SpecError, load_gearbox
-from flexgear.study.screening import DecisionLines, Screening, Selection, Window, analysis_window, screen
+from flexgear.study.screening import (
+    DecisionLines,
+    Screening,
+    Selection,
+    UnsettledReference,
+    Window,
+    analysis_window,
+    screen,
+)
 from flexgear.study.sweep import SweepResult
 
 DEFAULT_GEARBOX = Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml"
@@ -32,6 +40,7 @@ class ReportData:
     study: Screening                    # the study's mode: Bias against theory
     reference: Screening | None         # against a reference variant, if one was used or configured
     sweep: SweepResult | None = None
+    refused: str = ""                   # why the reference screening was refused (its reference has not settled)
 
     @property
     def primary(self) -> Screening:
@@ -91,10 +100,16 @@ def gather(results_dir: str | Path) -> ReportData:
     recorded = results_dir / "screening.json"
     ref_name = json.loads(recorded.read_text()).get("reference", "") if recorded.exists() else settings.reference
     study = screen(runs.values(), settings, reference="")
-    reference = screen(runs.values(), settings, reference=ref_name) if ref_name and ref_name in runs else None
+    reference, refused = None, ""
+    if ref_name and ref_name in runs:
+        try:
+            reference = screen(runs.values(), settings, reference=ref_name)
+        except UnsettledReference as exc:
+            refused = str(exc)
     sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
     sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)
-    return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep)
+    return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep,
+                      refused)
 
 
 def _split_comment(line: str) -> tuple[str, str]:

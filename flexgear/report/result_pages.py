@@ -108,9 +108,9 @@ def screening_pages(d: ReportData) -> list[Page]:
         ind = s.indicators
         order = [k for k in ALL_INDICATORS if k in set(ind["indicator"])]
         means = ind.pivot(index="indicator", columns="variant", values="mean").reindex(order)
-        bias = ind.pivot(index="indicator", columns="variant", values="bias_pct").reindex(order)
+        bias = ind.pivot(index="indicator", columns="variant", values="bias").reindex(order)
         first = ind.drop_duplicates("indicator").set_index("indicator").reindex(order)
-        head = pd.DataFrame({"indicator": order, "TEa [%]": first["tea_pct"].to_numpy(),
+        head = pd.DataFrame({"indicator": order, "unit": first["unit"].to_numpy(), "TEa": first["tea"].to_numpy(),
                              "weight": first["weight"].to_numpy()})
         mean_tab = pd.concat([head, means.reset_index(drop=True)], axis=1)
         bias_tab = pd.concat([head, bias.reset_index(drop=True)], axis=1)
@@ -122,8 +122,8 @@ def screening_pages(d: ReportData) -> list[Page]:
             ax.text(0, y - 0.02, "Indicator means over each run's window (definitions and units: "
                     "flexgear.study.indicators)", fontsize=8.5, weight="bold", transform=ax.transAxes)
             y = draw_table(ax, mean_tab, top=y - 0.035, fontsize=6.5, wrap=30)
-            ax.text(0, y - 0.02, f"Bias [%] of each indicator against {'theory' if not s.reference else s.reference} "
-                    "(not yet scaled by its TEa)", fontsize=8.5, weight="bold", transform=ax.transAxes)
+            ax.text(0, y - 0.02, f"Bias of each indicator against {'theory' if not s.reference else s.reference} "
+                    "in its unit (not yet scaled by its TEa)", fontsize=8.5, weight="bold", transform=ax.transAxes)
             draw_table(ax, bias_tab, top=y - 0.035, fontsize=6.5, wrap=30)
         pages.append((f"Screening {mode}: composite points, indicators and selection", draw))
     return pages

@@ -21,17 +21,7 @@ gives its CV like the study's:
   its peak-to-peak: near integer overlap ratios the steady TE ripple vanishes (below 0.1 nm with
   the iso6336 law at eps_beta = 0.95, model 1) and a relative error of it is meaningless.
 
-Settled window (``[screening] window = "settled"``, :func:`settled_start`): after the STEP ramps
-the run is cut into blocks of ``settle_block_mesh_cycles`` mesh cycles. Each settling signal gets
-one value per block: the planet-mean mesh forces and the two speeds their block means (a drift),
-the mesh-force ripples and bearing accelerations RMS their block values (a decaying vibration).
-Its final value is the mean of the last ``settle_final_blocks`` blocks, and must differ from
-the mean of the blocks just before by at most the tolerance (else the run has not settled). The
-run has settled at the start of the first block after which every later block of every settling
-signal lies within the tolerance of its final value, if at least ``sample_count`` blocks remain:
-``settle_mean_tolerance_pct`` for the drifts, ``settle_amplitude_tolerance_pct`` for the
-vibrations. For y = A + B e^(-t/tau) this is the first block start t with |B| e^(-t/tau) <= tol |A|
-(to a block), tau·ln(|B| / (tol |A|)).
+The settled window is :mod:`flexgear.settling`'s test.
 """
 
 from __future__ import annotations
@@ -41,10 +31,11 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
+from flexgear.settling import mesh_forces, radial_rms, ripple_pct, segment_slices
 from flexgear.study.compare import harmonic_amplitudes
 
-__all__ = ["STUDY_INDICATORS", "DYNAMIC_INDICATORS", "ALL_INDICATORS", "segment_slices", "indicator_segments",
-           "settled_start", "SETTLING_SIGNALS"]
+__all__ = ["STUDY_INDICATORS", "DYNAMIC_INDICATORS", "ALL_INDICATORS", "LEVEL_FLOOR_M_PER_S2", "segment_slices",
+           "indicator_segments", "on_scale"]
 
 STUDY_INDICATORS: dict[str, str] = {
     "input_speed": "input speed",
@@ -70,45 +61,14 @@ DYNAMIC_INDICATORS: dict[str, str] = {
 
 ALL_INDICATORS = {**STUDY_INDICATORS, **DYNAMIC_INDICATORS}
 
-SETTLING_SIGNALS = {"mean": ("input_speed", "output_speed", "outer_mesh_force", "inner_mesh_force"),
-                    "amplitude": ("outer_mesh_ripple", "inner_mesh_ripple", "input_bearing_rms",
-                                  "output_bearing_rms")}
-"""Signals of the settling test: drifts (mean tolerance) and vibrations (amplitude tolerance). Not the
-loaded transmission error: it integrates the output-speed error, so the last 0.01 % of the speed's
-creep moves it by more than 0.05 % long after the speeds and forces have settled (impact law, quick
-runs: about 1 % over 0.1 s); it is screened over the window the other signals set."""
-
-
-def segment_slices(t: np.ndarray, start: float, end: float, count: int) -> list[slice]:
-    """Index ranges of ``count`` equal contiguous segments of [start, end] in the sorted times ``t``
-    (the end point joins the last segment)."""
-    edges = np.linspace(start, end, count + 1)
-    idx = np.searchsorted(t, edges, side="left")
-    idx[-1] = np.searchsorted(t, end, side="right")
-    return [slice(int(a), int(b)) for a, b in zip(idx[:-1], idx[1:], strict=True)]
-
-
-def _forces(signals: pd.DataFrame, mesh: str) -> np.ndarray:
-    cols = [c for c in signals.columns if c.startswith(f"{mesh}_mesh_force_") and c.endswith("_n")]
-    if not cols:
-        raise ValueError(f"signal table has no {mesh}_mesh_force_<i>_n columns")
-    return signals[cols].to_numpy()
-
-
-def _ripple(f: np.ndarray) -> float:
-    return float(np.mean(f.std(axis=0) / f.mean(axis=0)) * 100.0)
-
-
 def _sharing(fo: np.ndarray, fi: np.ndarray) -> float:
+    """K_gamma: the largest planet's mean mesh force over the mean of all planets, the larger of the two meshes."""
     return float(max((f.mean(axis=0).max() / f.mean()) for f in (fo, fi)))
 
 
 def _kv(fo: np.ndarray, fi: np.ndarray) -> float:
+    """K_v: a planet's peak mesh force over its own mean, the largest over planets and both meshes."""
     return float(max((f.max(axis=0) / f.mean(axis=0)).max() for f in (fo, fi)))
-
-
-def _rms(ax: np.ndarray, ay: np.ndarray) -> float:
-    return float(np.sqrt(np.mean((ax - ax.mean()) ** 2 + (ay - ay.mean()) ** 2)))
 
 
 def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequency_hz: float,
@@ -123,7 +83,7 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     cols = {k: signals[c].to_numpy() for k, c in (("input_speed", "input_speed_deg_per_s"),
                                                    ("output_speed", "output_speed_deg_per_s"),
                                                    ("transmission_ratio", "transmission_ratio"))}
-    fo, fi = _forces(signals, "outer"), _forces(signals, "inner")
+    fo, fi = mesh_forces(signals, "outer"), mesh_forces(signals, "inner")
     acc = {side: (signals[f"{side}_bearing_accel_x_m_per_s2"].to_numpy(),
                   signals[f"{side}_bearing_accel_y_m_per_s2"].to_numpy()) for side in ("input", "output")}
     t = signals["time_s"].to_numpy()
@@ -139,12 +99,12 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
         **{k: (lambda s, y=y: float(y[s].mean())) for k, y in cols.items()},
         "outer_mesh_force": lambda s: float(fo[s].mean()),
         "inner_mesh_force": lambda s: float(fi[s].mean()),
-        "outer_mesh_ripple": lambda s: _ripple(fo[s]),
-        "inner_mesh_ripple": lambda s: _ripple(fi[s]),
+        "outer_mesh_ripple": lambda s: ripple_pct(fo[s]),
+        "inner_mesh_ripple": lambda s: ripple_pct(fi[s]),
         "load_sharing": lambda s: _sharing(fo[s], fi[s]),
         "dynamic_factor": lambda s: _kv(fo[s], fi[s]),
-        "input_bearing_rms": lambda s: _rms(acc["input"][0][s], acc["input"][1][s]),
-        "output_bearing_rms": lambda s: _rms(acc["output"][0][s], acc["output"][1][s]),
+        "input_bearing_rms": lambda s: radial_rms(acc["input"][0][s], acc["input"][1][s]),
+        "output_bearing_rms": lambda s: radial_rms(acc["output"][0][s], acc["output"][1][s]),
         "input_bearing_mesh1x": one_x("input"),
         "output_bearing_mesh1x": one_x("output"),
     }
@@ -157,48 +117,27 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     return {k: np.array([funcs[k](s) for s in slices]) for k in wanted if k in funcs}
 
 
-def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: float, block_cycles: int,
-                  final_blocks: int, mean_tol_pct: float, amplitude_tol_pct: float,
-                  min_blocks: int = 1) -> tuple[float | None, str]:
-    """Start [s] of the settled part of a run (module docstring), or None if it does not settle.
+LEVEL_FLOOR_M_PER_S2 = 1e-9
+"""Smallest acceleration amplitude [m/s^2] taken to dB (-180 dB re 1 m/s^2): a variant that predicts no
+vibration where the reference has some is then far off in dB, not undefined."""
 
-    Returns (start, explanation); ``after_s`` is the end of the ramps. Besides the band test, the
-    final value itself must have stopped moving: the mean of the last ``final_blocks`` blocks may
-    differ from the mean of the ``final_blocks`` before them by at most the tolerance (for a decay
-    with a time constant near the two groups' length this bounds the residual to about 1.4
-    tolerances), and the settled part must hold at least ``min_blocks`` blocks (the screening
-    asks for one block per sample).
+
+def on_scale(key: str, scale: str, samples: np.ndarray) -> np.ndarray:
+    """An indicator's samples on the scale where it is judged (``[screening.reference_indicators]``):
+
+    - "relative": unchanged (the bias is then relative to the reference's value);
+    - "load": % of the mean tooth load: the ripples are that already (RMS alternating load / mean load), a load
+      factor K (K_gamma, K_v) becomes 100 K, so that a difference is the extra load in % of the mean load;
+    - "db": 20 log10(x / 1 m/s^2), vibration level in dB (amplitudes below LEVEL_FLOOR_M_PER_S2 at the floor);
+    - "um": the displacement in um.
     """
-    t = signals["time_s"].to_numpy()
-    block = block_cycles / mesh_frequency_hz
-    count = int((t[-1] - after_s) // block)
-    if count < max(2 * final_blocks, min_blocks):
-        return None, (f"not settled: only {max(count, 0)} blocks of {block_cycles} mesh cycles ({1e3 * block:.3g} "
-                      f"ms) after the ramps at {after_s:g} s; the settling test needs "
-                      f"{max(2 * final_blocks, min_blocks)}")
-    starts = t[-1] - block * np.arange(count, 0, -1)
-    slices = [slice(int(a), int(b)) for a, b in zip(np.searchsorted(t, starts), np.searchsorted(t, starts + block),
-                                                    strict=True)]
-    keys = SETTLING_SIGNALS["mean"] + SETTLING_SIGNALS["amplitude"]
-    values = indicator_segments(signals, slices, mesh_frequency_hz, keys)   # TE only if recorded
-    first_ok = 0
-    slowest = ""
-    for kind, tol in (("mean", mean_tol_pct), ("amplitude", amplitude_tol_pct)):
-        for key in (k for k in SETTLING_SIGNALS[kind] if k in values):
-            v = values[key]
-            final = v[-final_blocks:].mean()
-            if abs(final - v[-2 * final_blocks:-final_blocks].mean()) > tol / 100.0 * abs(final):
-                return None, (f"not settled: the final value of {key} still moves by more than {tol:g} % between "
-                              f"the last two groups of {final_blocks} blocks of {block_cycles} mesh cycles")
-            bad = np.flatnonzero(np.abs(v - final) > tol / 100.0 * abs(final))
-            k = int(bad[-1]) + 1 if bad.size else 0
-            if k > first_ok:
-                first_ok, slowest = k, key
-    if count - first_ok < min_blocks:
-        return None, (f"not settled: {slowest} settles {count - first_ok} blocks of {block_cycles} mesh cycles "
-                      f"before the end; the window needs {min_blocks}")
-    start = float(starts[first_ok])
-    why = (f"settled at {start:.4g} s: every later block of {block_cycles} mesh cycles within "
-           f"{mean_tol_pct:g} % (speeds, mean forces) and {amplitude_tol_pct:g} % (ripple, bearing RMS) of its "
-           f"final value" + (f"; slowest: {slowest}" if slowest else ""))
-    return start, why
+    x = np.asarray(samples, dtype=float)
+    if scale == "relative":
+        return x
+    if scale == "load":
+        return x if key.endswith("_ripple") else 100.0 * x
+    if scale == "db":
+        return 20.0 * np.log10(np.maximum(np.abs(x), LEVEL_FLOOR_M_PER_S2))
+    if scale == "um":
+        return 1e6 * x
+    raise ValueError(f"unknown indicator scale {scale!r}; allowed: relative, load, db, um")

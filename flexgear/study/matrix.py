@@ -47,7 +47,7 @@ from flexgear.cache import atomic_write_bytes, remove_stale_temporaries
 from flexgear.progress import Progress, say
 from flexgear.results import RunResult, load_result, save_result
 from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant, spec_hash
-from flexgear.study.screening import screening_tables
+from flexgear.study.screening import Selection, UnsettledReference, screening_tables
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
@@ -58,10 +58,16 @@ _HEARTBEAT_S = 60.0
 _POLL_S = 0.2
 
 
-def run_input_hash(variant: Variant, t_end_s: float) -> str:
-    """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``), t_end."""
+def run_input_hash(variant: Variant, t_end_s: float | str) -> str:
+    """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``, except the settling
+    test's fields for a run continued until it settles), t_end (s, or "settled")."""
     gearbox = dataclasses.replace(variant.gearbox, screening=None)
-    return spec_hash(dataclasses.replace(variant, gearbox=gearbox), float(t_end_s), "exudyn")
+    extra: tuple = (float(t_end_s),)
+    if t_end_s == "settled":
+        sc = variant.gearbox.screening
+        extra = ("settled", sc.settle_block_mesh_cycles, sc.settle_final_blocks, sc.settle_mean_tolerance_pct,
+                 sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s)
+    return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn")
 
 
 def _default_runner() -> Runner:
@@ -84,7 +90,7 @@ class RunTask:
     variant_text: str
     gearbox_file: str
     gearbox_text: str
-    t_end_s: float | None
+    t_end_s: float | str | None
     input_hash: str
     time_budget_s: float | None = None
 
@@ -94,9 +100,11 @@ class RunTask:
                 Path(self.gearbox_file).name: self.gearbox_text.encode()}
 
 
-def make_task(variant: Variant, t_end_s: float | None, time_budget_s: float | None = None) -> RunTask:
-    """The task of a loaded variant: reads its two files once, on the caller's side."""
-    t_end = variant.gearbox.load_case.end_time_s if t_end_s is None else float(t_end_s)
+def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None) -> RunTask:
+    """The task of a loaded variant: reads its two files once, on the caller's side; ``t_end_s`` in s, "settled"
+    or None (the load case's end: ``end_time_s``, or "settled" with ``[load_case] end = "settled"``)."""
+    lc = variant.gearbox.load_case
+    t_end = t_end_s if t_end_s is not None else ("settled" if lc.end == "settled" else lc.end_time_s)
     return RunTask(variant.name, str(variant.source), Path(variant.source).read_text(),
                    str(variant.gearbox.source), Path(variant.gearbox.source).read_text(), t_end_s,
                    run_input_hash(variant, t_end), time_budget_s)
@@ -220,13 +228,20 @@ def _row(name: str, meta: dict, resumed: bool) -> dict[str, Any]:
 def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSettings,
                      progress: bool = False, reference: str | None = None) -> pd.DataFrame:
     """Screen saved runs ``out_dir/<name>`` and write the screening tables and ``selection.txt``;
-    ``reference``: a variant name to screen against (default ``settings.reference``)."""
+    ``reference``: a variant name to screen against (default ``settings.reference``). A reference that has not
+    settled is refused: ``selection.txt`` then says so in one line and nothing is selected."""
     results = [load_result(out_dir / n) if (out_dir / n / "run.json").exists()
                else _failed(n, "no saved run") for n in names]
-    table, indicators, selection = screening_tables(results, settings, reference)
+    ref = settings.reference if reference is None else reference
+    try:
+        table, indicators, selection = screening_tables(results, settings, reference)
+    except UnsettledReference as exc:
+        table = pd.DataFrame({"variant": [r.name for r in results], "status": "not screened", "reason": str(exc),
+                              "selected": False})
+        indicators = pd.DataFrame(columns=["variant", "indicator"])
+        selection = Selection(None, settings.selection, str(exc))
     write_table(table, out_dir / "screening")
     write_table(indicators, out_dir / "screening_indicators")
-    ref = settings.reference if reference is None else reference
     atomic_write_bytes(out_dir / "screening.json", json.dumps({"reference": ref}).encode())
     text = (f"selected: {selection.variant}\nrule: {selection.rule}\nreference: {ref or 'theory'}\n"
             f"{selection.reasoning}\n")
@@ -261,7 +276,7 @@ def _run_order(variants: dict[str, Variant]) -> list[str]:
     return sorted(variants, key=lambda name: -costs[name])
 
 
-def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | None = None,
+def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | str | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
                runner: Runner | None = None, time_budget_s: float | None = None,
                reference: str | None = None) -> pd.DataFrame:
@@ -321,5 +336,6 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     if settings is None:
         settings = load_gearbox(Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml").screening
     screening = screen_directory(out_dir, names, settings, progress, reference)
-    cols = ["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "selected"]
-    return table.merge(screening[cols], on="variant", how="left")
+    screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
+                                           "selected"])
+    return table.merge(screening, on="variant", how="left")

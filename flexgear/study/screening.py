@@ -50,8 +50,9 @@ import numpy as np
 import pandas as pd
 
 from flexgear.results import RunResult
+from flexgear.settling import SettleRule, Settling, settled_start
 from flexgear.spec import ScreeningSettings
-from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, segment_slices, settled_start
+from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, on_scale, segment_slices
 from flexgear.study.selection import DecisionLines, Selection, select_variant
 
 __all__ = [
@@ -72,6 +73,9 @@ __all__ = [
     "screen_result",
     "screening_tables",
     "select_variant",
+    "scaled_bias_cv",
+    "reference_means",
+    "UnsettledReference",
 ]
 
 INDICATORS: dict[str, str] = STUDY_INDICATORS
@@ -97,12 +101,14 @@ def sigma_metric(bias: float, cv: float, tea: float) -> float:
 # --------------------------------------------------------------------------- samples
 @dataclass(frozen=True)
 class Window:
-    """Analysis window [start_s, end_s]; ``steady`` is False when the run ended before the ramps."""
+    """Analysis window [start_s, end_s]; ``steady`` is False when the run ended before the ramps or (window
+    "settled") has not settled, ``settling`` the settling test's outcome then."""
 
     start_s: float
     end_s: float
     steady: bool
     rule: str
+    settling: Settling | None = None
 
 
 def analysis_window(meta: dict, t_first: float, t_last: float, settings: ScreeningSettings,
@@ -116,13 +122,11 @@ def analysis_window(meta: dict, t_first: float, t_last: float, settings: Screeni
         ramp = float(meta.get("ramp_time_s", 0.0)) + settings.after_ramp_delay_s
         f_mesh = float((meta.get("theory") or {}).get("mesh_frequency_hz", 0.0))
         if ramp < t_last and f_mesh > 0:
-            start, why = settled_start(signals, max(ramp, t_first), f_mesh, settings.settle_block_mesh_cycles,
-                                       settings.settle_final_blocks, settings.settle_mean_tolerance_pct,
-                                       settings.settle_amplitude_tolerance_pct, settings.sample_count)
-            if start is not None:
-                return Window(start, t_last, True, why)
+            test = settled_start(signals, max(ramp, t_first), f_mesh, SettleRule.from_settings(settings))
+            if test.settled:
+                return Window(test.start_s, t_last, True, test.reason, test)
             return Window(max(ramp, t_first), t_last, False, f"after the ramps, {ramp:g}-{t_last:g} s, NOT steady: "
-                          + why)
+                          + test.reason, test)
     if settings.window == "fixed":
         start, end = max(settings.window_start_s, t_first), min(settings.window_end_s, t_last)
         if end <= start:
@@ -167,16 +171,18 @@ def cv_pct(samples: np.ndarray) -> float:
 # --------------------------------------------------------------------------- one variant
 @dataclass(frozen=True)
 class IndicatorResult:
-    """One indicator of one run: theory, mean of the samples, Bias %, CV % and the samples."""
+    """One indicator of one run on its judging scale: target (theory or the reference), mean of the samples,
+    Bias, CV and TEa in ``unit`` ("%" relative to the target, "% of load", "dB", "um"), and the samples."""
 
     name: str
     theory: float
     mean: float
-    bias_pct: float
-    cv_pct: float
+    bias: float
+    cv: float
     samples: tuple[float, ...]
-    tea_pct: float = math.nan
+    tea: float = math.nan
     weight: float = math.nan
+    unit: str = "%"
 
 
 @dataclass(frozen=True)
@@ -206,15 +212,28 @@ def indicator_samples(result: RunResult, settings: ScreeningSettings, keys: tupl
     return window, indicator_segments(result.signals, slices, f_mesh, keys)
 
 
+_UNITS = {"relative": "%", "load": "% of load", "db": "dB", "um": "um"}
+
+
+def scaled_bias_cv(samples: np.ndarray, target: float, scale: str) -> tuple[float, float]:
+    """Bias and CV of samples already on their judging scale (indicators.on_scale): relative to the target in %
+    for the "relative" scale (Bias = |mean - target| / |target| 100, CV = s / |mean| 100), otherwise absolute in
+    the scale's unit (Bias = |mean - target|, CV = s), s the sample standard deviation (ddof = 1)."""
+    mean = float(np.mean(samples))
+    if scale == "relative":
+        return bias_pct(mean, target), cv_pct(samples)
+    return abs(mean - target), float(np.std(samples, ddof=1))
+
+
 def screen_result(result: RunResult, settings: ScreeningSettings,
                   reference: dict[str, float] | None = None) -> VariantScreening:
     """Screen one finished run.
 
     ``reference`` None: the study's mode, the five indicators against ``result.meta["theory"]``,
-    composite Bias and CV the weighted sums in %. Otherwise the reference variant's indicator means
-    (key -> value): every indicator both runs have, each Bias and CV divided by its own TEa
-    (``[screening.reference_indicators]``), composite = weighted sum in % of TEa (weights of the
-    indicators present, rescaled to sum 1).
+    composite Bias and CV the weighted sums in %. Otherwise the reference variant's indicator means on their
+    judging scales (:func:`reference_means`): every indicator both runs have, each Bias and CV on its scale and
+    divided by its own TEa (``[screening.reference_indicators]``), composite = weighted sum in % of TEa (weights
+    of the indicators present, rescaled to sum 1).
     """
     lines = DecisionLines.from_settings(settings, "ref" if reference is not None else "")
     if reference is None:
@@ -222,23 +241,24 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
         theory = result.meta["theory"]
         targets = {k: float(theory[_THEORY_KEYS[k]]) for k in samples}
         weights = dataclasses.asdict(settings.weights)
-        teas = dict.fromkeys(samples, settings.allowable_total_error_pct)
+        tols = dict.fromkeys(samples, (settings.allowable_total_error_pct, "relative"))
     else:
         window, samples = indicator_samples(result, settings)
-        samples = {k: v for k, v in samples.items() if k in reference}
+        tol = {k: getattr(settings.reference_indicators, k) for k in samples if k in reference}
+        samples = {k: on_scale(k, tol[k].scale, v) for k, v in samples.items() if k in tol}
         targets = {k: float(reference[k]) for k in samples}
-        tol = {k: getattr(settings.reference_indicators, k) for k in samples}
         total = sum(t.weight for t in tol.values())
         weights = {k: t.weight / total for k, t in tol.items()}
-        teas = {k: t.tea_pct for k, t in tol.items()}
+        tols = {k: (t.tea, t.scale) for k, t in tol.items()}
     indicators = {}
     for key, x in samples.items():
-        mean = float(np.mean(x))
-        indicators[key] = IndicatorResult(key, targets[key], mean, bias_pct(mean, targets[key]), cv_pct(x),
-                                          tuple(map(float, x)), teas[key], weights[key])
-    scale = {k: (100.0 / r.tea_pct if lines.normalised else 1.0) for k, r in indicators.items()}
-    bias = sum(weights[k] * r.bias_pct * scale[k] for k, r in indicators.items())
-    cv = sum(weights[k] * r.cv_pct * scale[k] for k, r in indicators.items())
+        tea, scale = tols[key]
+        bias, cv = scaled_bias_cv(x, targets[key], scale)
+        indicators[key] = IndicatorResult(key, targets[key], float(np.mean(x)), bias, cv, tuple(map(float, x)), tea,
+                                          weights[key], _UNITS[scale])
+    norm = {k: (100.0 / r.tea if lines.normalised else 1.0) for k, r in indicators.items()}
+    bias = sum(weights[k] * r.bias * norm[k] for k, r in indicators.items())
+    cv = sum(weights[k] * r.cv * norm[k] for k, r in indicators.items())
     return VariantScreening(result.name, window, indicators, bias, cv, math.hypot(bias, cv),
                             sigma_metric(bias, cv, lines.tea_pct), lines.zone(bias, cv), lines.rank(bias, cv))
 
@@ -269,15 +289,39 @@ class Screening:
         return decision_diagram(ax, self.table, self.lines, xlim, ylim, title)
 
 
-def _reference_means(results: list[RunResult], name: str, settings: ScreeningSettings) -> dict[str, float]:
+class UnsettledReference(ValueError):
+    """The screening's reference has not settled: nothing can be screened against it."""
+
+
+def _unsettled_reason(result: RunResult, settings: ScreeningSettings) -> str:
+    """Why a finished run cannot be screened as settled ('' when it can): the runner's own settling test
+    (``[load_case] end = "settled"``) or, with ``window = "settled"``, the window's."""
+    if result.meta.get("settled") is False:
+        return str(result.meta.get("settle_reason") or "not settled")
+    if settings.window != "settled" or result.signals is None:
+        return ""
+    t = result.signals["time_s"].to_numpy()
+    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings, result.signals)
+    return "" if window.steady else (window.settling.reason if window.settling else window.rule)
+
+
+def reference_means(results: list[RunResult], name: str, settings: ScreeningSettings) -> dict[str, float]:
+    """The reference variant's indicator means on their judging scales (indicators.on_scale). Raises when it is
+    missing or failed, and :class:`UnsettledReference` with a one-line reason when it has not settled."""
     ref = next((r for r in results if r.name == name), None)
     if ref is None:
         raise ValueError(f"screening reference {name!r} is not among the runs "
                          f"({', '.join(r.name for r in results) or 'none'})")
     if not ref.ok:
         raise ValueError(f"screening reference {name!r} did not finish ({ref.meta.get('reason')})")
+    why = _unsettled_reason(ref, settings)
+    if why:
+        raise UnsettledReference(f"not screened: reference {name} has not settled by "
+                                 f"{float(ref.meta.get('t_end_s', math.nan)):.4g} s ({why}); run it longer "
+                                 "(--t-end settled)")
     _, samples = indicator_samples(ref, settings)
-    return {k: float(np.mean(v)) for k, v in samples.items()}
+    tol = settings.reference_indicators
+    return {k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()}
 
 
 def _reference_reasoning(table: pd.DataFrame, indicators: pd.DataFrame, name: str) -> str:
@@ -285,11 +329,11 @@ def _reference_reasoning(table: pd.DataFrame, indicators: pd.DataFrame, name: st
     parts = []
     for row in table[(table["status"] == "ok") & (table["variant"] != name)].itertuples():
         ind = indicators[indicators["variant"] == row.variant]
-        share = (ind["weight"] * ind["bias_pct"] / ind["tea_pct"]).sort_values(ascending=False)
+        share = (ind["weight"] * ind["bias"] / ind["tea"]).sort_values(ascending=False)
         top = [ind.loc[i] for i in share.index[:2]]
         parts.append(f"{row.variant} at distance {row.distance_pct:.3g} % of TEa"
-                     + (" (largest: " + ", ".join(f"{t['indicator']} {t['bias_pct']:.3g} % off (TEa {t['tea_pct']:g} %)"
-                                                  for t in top) + ")" if top else ""))
+                     + (" (largest: " + ", ".join(f"{t['indicator']} {t['bias']:.3g} {t['unit']} off (TEa "
+                                                  f"{t['tea']:g} {t['unit']})" for t in top) + ")" if top else ""))
     return (f" Against reference {name} (Bias 0 by definition): " + "; ".join(parts) + ".") if parts else ""
 
 
@@ -297,19 +341,24 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
     """Screen runs in the study's mode (``reference`` "") or against a reference variant (its name);
     default ``settings.reference``.
 
-    Failed runs, and runs whose signals cannot be screened, get a row with status "failed" and
-    their reason; they are not candidates for selection. A missing or failed reference raises.
+    Failed runs, and runs whose signals cannot be screened, get a row with status "failed" and their reason;
+    runs that have not settled (:func:`_unsettled_reason`) get status "unsettled" and are not scored. None of
+    them is a candidate for selection. A missing or failed reference raises ValueError, an unsettled one
+    :class:`UnsettledReference`.
     """
     results = list(results)
     ref_name = settings.reference if reference is None else reference
     lines = DecisionLines.from_settings(settings, ref_name)
-    ref = _reference_means(results, ref_name, settings) if ref_name else None
+    ref = reference_means(results, ref_name, settings) if ref_name else None
     rows, ind_rows = [], []
     for res in results:
         row = {"variant": res.name, "status": res.meta.get("status", "failed"),
                "reason": res.meta.get("reason") or "", "time_s": _run_time(res.meta),
                "t_end_s": res.meta.get("t_end_s", math.nan)}
-        if res.ok:
+        why = _unsettled_reason(res, settings) if res.ok else ""
+        if why:
+            row.update(status="unsettled", reason=why)
+        elif res.ok:
             try:
                 s = screen_result(res, settings, ref)
             except (ValueError, KeyError) as exc:
@@ -319,18 +368,17 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
                            zone=s.zone, zone_rank=s.zone_rank, steady_window=s.window.steady,
                            window_start_s=s.window.start_s, window_end_s=s.window.end_s, window_rule=s.window.rule)
                 for r in s.indicators.values():
-                    tea = r.tea_pct
                     ind_rows.append({"variant": res.name, "indicator": r.name, "target": r.theory, "mean": r.mean,
-                                     "bias_pct": r.bias_pct, "cv_pct": r.cv_pct, "tea_pct": tea,
-                                     "weight": r.weight, "sigma": sigma_metric(r.bias_pct, r.cv_pct, tea),
-                                     "zone": DecisionLines(tea, lines.multipliers).zone(r.bias_pct, r.cv_pct)})
+                                     "bias": r.bias, "cv": r.cv, "tea": r.tea, "unit": r.unit,
+                                     "weight": r.weight, "sigma": sigma_metric(r.bias, r.cv, r.tea),
+                                     "zone": DecisionLines(r.tea, lines.multipliers).zone(r.bias, r.cv)})
         rows.append(row)
     columns = ["variant", "status", "reason", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone", "zone_rank",
                "time_s", "t_end_s", "steady_window", "window_start_s", "window_end_s", "window_rule"]
     table = pd.DataFrame(rows).reindex(columns=columns)
-    indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "target", "mean", "bias_pct", "cv_pct",
-                                                 "tea_pct", "weight", "sigma", "zone"])
-    selection = select_variant(table, settings.selection, lines)
+    indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "target", "mean", "bias", "cv", "tea", "unit",
+                                                 "weight", "sigma", "zone"])
+    selection = select_variant(table, settings.selection, lines, ref_name)
     if ref_name:
         selection = Selection(selection.variant, selection.rule,
                               selection.reasoning + _reference_reasoning(table, indicators, ref_name))

@@ -77,39 +77,50 @@ def _pick(candidates: pd.DataFrame, keys: Sequence[str]) -> pd.Series:
     return candidates.sort_values(list(keys), kind="stable").iloc[0]
 
 
-def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines) -> Selection:
+def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines, reference: str = "") -> Selection:
     """Apply a selection rule to a screening table (columns: variant, status, zone_rank, time_s,
     distance_pct) and explain the choice.
 
-    - ``fastest_in_best_zone``: among the variants in the best zone reached, the fastest; ties
+    Only acceptable variants are candidates: those meeting at least the first decision line (zone above
+    non-conforming). When none is acceptable, nothing is selected; when only the ``reference`` variant is, the
+    verdict is "only the reference is acceptable" (it is selected, never the fastest non-conforming variant).
+
+    - ``fastest_in_best_zone``: among the acceptable variants in the best zone reached, the fastest; ties
       (equal time) by distance from the origin. This is the study's reasoning (section 2.2: of
       models 4, 6, 7 in the excellent zone, model 4 is the cheapest).
-    - ``closest_to_origin``: the smallest relative error distance; ties by time.
-    - ``fastest_acceptable``: the fastest variant that is not non-conforming; ties by distance.
+    - ``closest_to_origin``: the acceptable variant with the smallest relative error distance; ties by time.
+    - ``fastest_acceptable``: the fastest acceptable variant; ties by distance.
     """
+    if rule not in ("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable"):
+        raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
+                         "fastest_acceptable")
     ok = table[table["status"] == "ok"]
-    failed = table[table["status"] != "ok"]
-    notes = f" Not screened (failed): {_names(failed)}." if len(failed) else ""
+    notes = "".join(f" Not screened ({status}): {_names(table[table['status'] == status])}."
+                    for status in ("unsettled", "failed") if (table["status"] == status).any())
     tea = (f"TEa = {lines.tea_pct:g} %" if not lines.normalised
            else "each indicator scaled by its own TEa, composite TEa = 100 %")
     if ok.empty:
-        return Selection(None, rule, "No variant finished, nothing to select." + notes)
+        return Selection(None, rule, "No variant was screened, nothing to select." + notes)
+    acceptable = ok[ok["zone_rank"] >= 1]
+    first = f"Bias + {lines.multipliers[0]} CV <= {tea}"
+    if acceptable.empty:
+        return Selection(None, rule, f"No variant is acceptable: none meets {first}; nothing is selected." + notes)
+    others = acceptable[acceptable["variant"] != reference]
+    if reference and others.empty:
+        return Selection(reference, rule, f"Only the reference {reference} is acceptable: no other variant meets "
+                                          f"{first}." + notes)
     if rule == "closest_to_origin":
-        best = _pick(ok, ("distance_pct", "time_s"))
+        best = _pick(acceptable, ("distance_pct", "time_s"))
         why = (f"Rule closest_to_origin: {best['variant']} has the smallest relative error distance "
                f"({best['distance_pct']:.4g} %, zone {best['zone']}, {tea}).")
     elif rule == "fastest_acceptable":
-        acceptable = ok[ok["zone_rank"] >= 1]
-        if acceptable.empty:
-            return Selection(None, rule, f"Rule fastest_acceptable: no variant meets Bias + 2 CV <= {tea}; "
-                                         "none is selected." + notes)
         best = _pick(acceptable, ("time_s", "distance_pct"))
-        why = (f"Rule fastest_acceptable: variants meeting Bias + 2 CV <= {tea}: {_names(acceptable)}; "
+        why = (f"Rule fastest_acceptable: variants meeting {first}: {_names(acceptable)}; "
                f"the fastest is {best['variant']} ({best['time_s']:.4g} s, zone {best['zone']}).")
-    elif rule == "fastest_in_best_zone":
-        top = int(ok["zone_rank"].max())
+    else:
+        top = int(acceptable["zone_rank"].max())
         zone = lines.zone_names[top]
-        in_zone = ok[ok["zone_rank"] == top]
+        in_zone = acceptable[acceptable["zone_rank"] == top]
         best = _pick(in_zone, ("time_s", "distance_pct"))
         why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {_names(in_zone)}; "
                f"the fastest of them is {best['variant']} ({best['time_s']:.4g} s, distance "
@@ -118,10 +129,4 @@ def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines) -> Sele
             slower = in_zone[in_zone["variant"] != best["variant"]]
             why += " It is as accurate as zone '" + zone + "' asks while " + ", ".join(
                 f"{r.variant} takes {r.time_s / best['time_s']:.3g}x as long" for r in slower.itertuples()) + "."
-        if top == 0:
-            why += (f" WARNING: no variant meets even Bias + {lines.multipliers[0]} CV <= {tea}: "
-                    "the selection is not an acceptable model.")
-    else:
-        raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
-                         "fastest_acceptable")
     return Selection(str(best["variant"]), rule, why + notes)

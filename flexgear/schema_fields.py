@@ -1,0 +1,37 @@
+"""Field helpers of the schema: each field carries its check (range, integer, choices) in its metadata, applied
+by :func:`flexgear.spec.load_gearbox`; :class:`SpecError` names the file, the field and what is allowed."""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import field
+from pathlib import Path
+from typing import Any
+
+__all__ = ["SpecError", "_num", "_choice", "_text"]
+
+
+class SpecError(ValueError):
+    """A specification file is wrong: the message names the file, the field and what is allowed."""
+
+    def __init__(self, path: str | Path, fieldname: str, allowed: str, got: Any = None):
+        self.path, self.field, self.allowed = str(path), fieldname, allowed
+        got_text = "" if got is None else f", got {got!r}"
+        super().__init__(f"{path}: field '{fieldname}': {allowed}{got_text}")
+
+
+def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
+    """Field with a numeric range check (validated on load); optional when ``default`` is given."""
+    return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
+
+
+def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:
+    meta = {"choices": choices, "doc": doc}
+    return field(metadata=meta) if default is None else field(default=default, metadata=meta)
+
+
+def _text(doc: str = "", default: str | None = None) -> Any:
+    if default is None:
+        return field(metadata={"doc": doc})
+    return field(default=default, metadata={"doc": doc})
