@@ -2,10 +2,20 @@
 
 :func:`linearize` (flexgear.modal.linear): the multibody model of any variant, rigid or flexible, linearised at its
 static equilibrium under the load torque at the input speed; :func:`modes` (flexgear.modal.modes): its natural
-frequencies, damping ratios, mode shapes, cyclic-symmetry kinds and energy shares per component.
+frequencies, damping ratios, mode shapes, cyclic-symmetry kinds and energy shares per component. The names are
+imported on first use (PEP 562), so that the command line's parser (flexgear.modal.cli) stays light.
 """
 
-from flexgear.modal.linear import Coordinate, LinearModel, linearize
-from flexgear.modal.modes import Modes, modes
+from importlib import import_module
+
+_LAZY = {"Coordinate": "linear", "LinearModel": "linear", "linearize": "linear", "Modes": "modes", "modes": "modes"}
 
 __all__ = ["Coordinate", "LinearModel", "Modes", "linearize", "modes"]
+
+
+def __getattr__(name: str):
+    if name in _LAZY:
+        value = getattr(import_module(f"flexgear.modal.{_LAZY[name]}"), name)
+        globals()[name] = value
+        return value
+    raise AttributeError(f"module 'flexgear.modal' has no attribute {name!r}")
