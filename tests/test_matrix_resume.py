@@ -45,7 +45,7 @@ def _start(tmp_path: Path, out: Path, paths: list[Path], slow_s: float) -> subpr
     env = dict(os.environ, FLEXGEAR_TEST_PID_DIR=str(tmp_path), FLEXGEAR_TEST_SLOW_S=str(slow_s))
     script = MATRIX_SCRIPT.format(tests=str(TESTS))
     return subprocess.Popen([sys.executable, "-c", script, str(out), *map(str, paths)], cwd=ROOT, env=env,
-                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, process_group=0)
 
 
 def _wait_for(path: Path, proc: subprocess.Popen, timeout_s: float = 120.0) -> None:

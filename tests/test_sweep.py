@@ -59,7 +59,7 @@ def test_sweep_runs_resumes_after_sigkill_and_appears_in_the_report(tmp_path):
     code = ("import sys; from synthetic import slow_runner; from flexgear.study.sweep import load_sweep, run_sweep; "
             f"run_sweep(load_sweep({str(sweep)!r}), {str(out)!r}, workers=1, runner=slow_runner, progress=False)")
     env = dict(os.environ, PYTHONPATH=os.pathsep.join([str(ROOT / "tests"), str(ROOT)]))
-    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, env=env, start_new_session=True)
+    proc = subprocess.Popen([sys.executable, "-c", code], cwd=ROOT, env=env, process_group=0)
     deadline = time.monotonic() + 120
     while time.monotonic() < deadline and not list(out.glob("*/run.json")):
         time.sleep(0.1)

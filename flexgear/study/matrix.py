@@ -62,8 +62,9 @@ def run_input_hash(variant: Variant, t_end_s: float | str) -> str:
     """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``, except the settling
     test's fields for a run continued until it settles), t_end (s, or "settled")."""
     gearbox = dataclasses.replace(variant.gearbox, screening=None)
-    extra: tuple = (float(t_end_s),)
-    if t_end_s == "settled":
+    if t_end_s != "settled":
+        extra: tuple = (float(t_end_s),)
+    else:
         sc = variant.gearbox.screening
         extra = ("settled", sc.settle_block_mesh_cycles, sc.settle_final_blocks, sc.settle_mean_tolerance_pct,
                  sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s)

@@ -1,0 +1,58 @@
+"""Runs continued until they settle: a run solved in chunks is the run solved at once, and the settling test
+decides when to stop (flexgear.mbs.run, flexgear.settling)."""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from flexgear.mbs.run import run_variant
+from flexgear.settling import SettleRule, radial_rms, settled_start
+
+
+def _short(model1, **load_case):
+    gb = model1.gearbox.with_fields("load_case", ramp_time_s=0.01, **load_case)
+    return dataclasses.replace(model1, gearbox=gb)
+
+
+@pytest.mark.slow
+def test_a_run_continued_in_chunks_is_the_run_solved_at_once(model1):
+    """Model 1, ramps 10 ms; the settled mode cannot pass by 40 ms (too few blocks after the ramps), so the run is
+    solved as 0-20, 20-30, 30-40 ms. Against one solve to 40 ms on the same time grid: every signal equal before
+    the first restart, mean mesh forces within 1e-5 and the bearing RMS of the last 10 ms within 1 % after it
+    (generalized-alpha restarts from consistent accelerations: a one-step transient in the accelerations)."""
+    chunked = run_variant(_short(model1, end_time_s=0.02, end="settled", settle_chunk_s=0.01, settle_max_time_s=0.04))
+    once = run_variant(_short(model1, end_time_s=0.04))
+    assert chunked.ok and once.ok, (chunked.meta.get("reason"), once.meta.get("reason"))
+    assert chunked.meta["t_end_s"] == pytest.approx(0.04) and chunked.meta["settled"] is False
+    assert "not settled" in chunked.meta["settle_reason"]
+    a, b = chunked.signals, once.signals
+    assert len(a) == len(b)
+    np.testing.assert_allclose(a["time_s"], b["time_s"], rtol=0, atol=1e-12)
+    before = a["time_s"].to_numpy() <= 0.02
+    for col in ("outer_mesh_force_1_n", "input_bearing_accel_x_m_per_s2", "output_speed_deg_per_s"):
+        np.testing.assert_array_equal(a[col].to_numpy()[before], b[col].to_numpy()[before])
+    after = a["time_s"].to_numpy() > 0.03
+    for col in ("outer_mesh_force_1_n", "inner_mesh_force_3_n"):
+        assert a[col][after].mean() == pytest.approx(b[col][after].mean(), rel=1e-5)
+    rms = [radial_rms(r["input_bearing_accel_x_m_per_s2"].to_numpy()[after],
+                      r["input_bearing_accel_y_m_per_s2"].to_numpy()[after]) for r in (a, b)]
+    assert rms[0] == pytest.approx(rms[1], rel=0.01)
+
+
+@pytest.mark.slow
+def test_a_settled_run_stops_where_the_settling_test_passes(model1):
+    """Model 1, ramps 10 ms, first chunk to 40 ms, then 20 ms chunks: the run stops settled, and the settling test
+    on its own signals agrees (settled, before the end, with one block per screening sample after it)."""
+    v = _short(model1, end_time_s=0.04, end="settled", settle_chunk_s=0.02, settle_max_time_s=0.5)
+    res = run_variant(v)
+    assert res.ok and res.meta["settled"] is True, res.meta.get("settle_reason")
+    screening = v.gearbox.screening
+    rule = SettleRule.from_settings(screening)
+    test = settled_start(res.signals, 0.01, res.meta["theory"]["mesh_frequency_hz"], rule)
+    assert test.settled and test.start_s == pytest.approx(res.meta["settled_at_s"])
+    block = rule.block_mesh_cycles / res.meta["theory"]["mesh_frequency_hz"]
+    assert res.meta["t_end_s"] - test.start_s >= rule.min_blocks * block - 1e-9
+    assert res.meta["t_end_s"] < 0.5
