@@ -14,13 +14,15 @@ e_g = Re(q_g^H (M q)_g) / Re(q^H M q) and strain s_g = Re(q_g^H (K_s q)_g) / Re(
 of K) for each group g of coordinates, so that each row sums to 1. Groups: every component's frame (its rigid motion;
 a rigid body that joins a gear and its shaft shares it out by their 6x6 mass matrices), every flexible component's
 elastic coordinates (``_elastic``), the sun-planet (``outer_mesh``) and planet-ring (``inner_mesh``) contact
-deflections and the gears' residual compliance (``residual``). The strain of a frame is that of its bearing.
+deflections (strain only: massless) and the gears' residual compliance with its Ritz mass (``residual``, flexgear.
+mbs.residual, where the variant has one). The strain of a frame is that of its bearing.
 
 Kinds (cyclic symmetry of a planetary set with N equally spaced planets: Lin & Parker 1999 for spur gears,
 Eritenel & Parker 2009 for the 6-DOF-per-body helical model), from the kinetic energy of the central members
 (sun, ring and shafts; the carrier is fixed):
 
-- ``planet``: central members at rest (share < ``tolerance``), multiplicity N - 3 (N - 1 ... in the torsional model);
+- ``planet``: central members' frames at rest (share < ``tolerance``), multiplicity N - 3 (N - 1 in the torsional
+  model); an elastic central member may deform in them (Wu & Parker 2008, elastic ring);
 - ``rotational``: central members only spin and move axially (rotational-axial modes, single);
 - ``translational``: central members only translate in-plane and tilt (translational-tilting modes, pairs);
 - ``elastic_<component>``: the elastic strain of one flexible component holds most (> 1/2) of the mode's strain;
@@ -168,10 +170,9 @@ def _kind(model: LinearModel, kinetic: dict[str, np.ndarray], spin_axial: np.nda
         best = max(elastic, key=elastic.get)
         if elastic[best] > 0.5:
             return f"elastic_{best}"
-    central = sum(kinetic[c][j] + kinetic.get(f"{c}_elastic", np.zeros(j + 1))[j] for c in CENTRAL if c in kinetic)
-    if central < tolerance:
-        return "planet"
     frame = sum(kinetic[c][j] for c in CENTRAL if c in kinetic)
+    if frame < tolerance:
+        return "planet"
     if frame - spin_axial[j] < tolerance:
         return "rotational"
     if spin_axial[j] < tolerance:
@@ -216,7 +217,7 @@ def modes(model: LinearModel, f_max_hz: float | None = None, *, tolerance: float
     columns = {}
     for prefix, shares in (("kinetic", kinetic), ("strain", strain)):
         for name, values in shares.items():
-            if prefix == "kinetic" and name in ("outer_mesh", "inner_mesh", "residual"):
+            if prefix == "kinetic" and name in ("outer_mesh", "inner_mesh"):
                 continue  # massless
             if name == "residual" and not groups["residual"].any():
                 continue
