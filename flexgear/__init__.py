@@ -42,6 +42,8 @@ _LAZY = {
     "Recorder": "mbs.recording", "solve": "mbs.recording", "solver_settings": "mbs.recording",
     # the study's gearbox
     "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox", "run_variant": "mbs.run",
+    # modal analysis at the operating point
+    "linearize": "modal.linear", "LinearModel": "modal.linear", "modes": "modal.modes", "Modes": "modal.modes",
 }
 
 __all__ = [

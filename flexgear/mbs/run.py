@@ -32,7 +32,7 @@ from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import Variant, as_dict, spec_hash
 
-__all__ = ["GUARD_EVERY_STEPS", "RunGuard", "ramp_warning", "run_variant"]
+__all__ = ["GUARD_EVERY_STEPS", "RunGuard", "SensorLog", "numerical_error_windows", "ramp_warning", "run_variant"]
 
 GUARD_EVERY_STEPS = 50
 """Steps between two checks of the divergence guard (each reads two node velocities and the clock)."""
@@ -184,9 +184,10 @@ def ramp_warning(variant: Variant, t_end: float) -> str:
     return ""
 
 
-def _solve(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard) -> None:
-    """SolveDynamic from ``t_start`` to ``t_end`` [s] with Exudyn's console output off, leaving the final state
-    as the initial state of a continuation; raises with the guard's or the solver's reason."""
+def _solve(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard, step_s: float | None = None) -> None:
+    """SolveDynamic from ``t_start`` to ``t_end`` [s] at the load case's step (or ``step_s``) with Exudyn's console
+    output off, leaving the final state as the initial state of a continuation; raises with the guard's or the
+    solver's reason."""
     import exudyn as exu
     import exudyn.solver as exu_solver
 
@@ -201,7 +202,7 @@ def _solve(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard)
     if guard.economy is not None:
         guard.economy.new_solve()
     settings = simulation_settings(variant, t_end, False)
-    step = variant.gearbox.load_case.step_size_s
+    step = variant.gearbox.load_case.step_size_s if step_s is None else step_s
     settings.timeIntegration.startTime = t_start
     settings.timeIntegration.numberOfSteps = max(1, round((t_end - t_start) / step))
     was_printing = exu.config.printToConsole
@@ -235,6 +236,27 @@ def _solve_chunk(mbs, variant: Variant, t_start: float, t_end: float, guard: Run
     _solve(mbs, variant, t_start, t_end, guard)
     log.collect()
     return {k: counts.get(k, 0) + v for k, v in solver_counts(mbs).items()}
+
+
+def numerical_error_windows(mbs, model: GearboxModel, variant: Variant, sensors: dict[str, int], guard: RunGuard,
+                            t_end: float, window_s: float) -> dict[str, pd.DataFrame]:
+    """The numerical error of a run at its final state: the window [t_end, t_end + window_s] solved twice from
+    that same state, at the load case's step h and at h/2 (generalized-alpha is second-order accurate, so the
+    difference of the two estimates the error of the h solution within a factor 4/3). Returns their signal
+    tables as ``error_step`` and ``error_half_step``; the run's own signals are not changed."""
+    import exudyn as exu
+
+    state = mbs.systemData.GetSystemState()
+    h = variant.gearbox.load_case.step_size_s
+    out = {}
+    guard.bar.extend(t_end + 2 * window_s)
+    for name, step in (("error_step", h), ("error_half_step", h / 2)):
+        mbs.systemData.SetSystemState(systemStateList=state, configuration=exu.ConfigurationType.Initial)
+        log = SensorLog(mbs, sensors)
+        _solve(mbs, variant, t_end, t_end + window_s, guard, step)
+        log.collect()
+        out[name] = _signals(log, model, sensors)
+    return out
 
 
 def _continue_until_settled(mbs, model: GearboxModel, variant: Variant, sensors: dict[str, int], guard: RunGuard,
@@ -275,13 +297,16 @@ def solver_counts(mbs) -> dict[str, int]:
 
 def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: bool = False,
                 mass_source: MassSource | None = None, reduced_source: ReducedSource | None = None,
-                time_budget_s: float | None = None, record_states_every: int = 0) -> RunResult:
+                time_budget_s: float | None = None, record_states_every: int = 0,
+                error_window_s: float = 0.0) -> RunResult:
     """Run ``variant`` for ``t_end_s`` [s] (default: the load case's end), or until it has settled.
 
     ``t_end_s = "settled"`` (or ``[load_case] end = "settled"`` with ``t_end_s`` None): the run goes to the load
     case's ``end_time_s``, then continues in chunks of ``settle_chunk_s`` at the steady operating point until the
     settling test of :mod:`flexgear.settling` (``[screening]`` settle_* fields) passes or ``settle_max_time_s`` is
     reached; the metadata records ``settled``, ``settled_at_s`` and the test's reason either way.
+    ``error_window_s`` > 0: then also :func:`numerical_error_windows` from the final state (extra tables
+    ``error_step`` and ``error_half_step``, for the screening's numerical error bars).
     ``time_budget_s`` overrides ``[solver_assumed] wall_time_budget_s``. ``record_states_every`` > 0 also
     records the bodies' states every that many steps (extra table ``states``, flexgear.mbs.states; for
     ``flexgear animate``). Never raises for a model or solver failure: the result then has status
@@ -316,6 +341,9 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
         counts = _solve_chunk(mbs, variant, 0.0, t_end, guard, log, {})
         if until_settled:
             t_end, counts = _continue_until_settled(mbs, model, variant, sensors, guard, log, counts, meta)
+        if error_window_s > 0:
+            extra.update(numerical_error_windows(mbs, model, variant, sensors, guard, t_end, error_window_s))
+            meta.update(error_window_s=error_window_s)
         guard.bar.close()
         meta.update(counts, t_end_s=t_end)
         mbs = log  # the signals below read every chunk's sensor data
