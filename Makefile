@@ -15,6 +15,8 @@ PYTHON_CANDIDATES := $(PYTHON) python3 python3.13 python3.12 python3.11 /usr/bin
 VARIANTS := $(sort $(wildcard model_variants/model*.toml))
 QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 RESULTS ?= results
+# pytest-xdist worker processes of `make test` (the machine's 2 cores; `make test TEST_WORKERS=auto` for all)
+TEST_WORKERS ?= 2
 
 .PHONY: quick install venv test test-heavy lint meshes matrix report lpm bench clean distclean
 
@@ -40,7 +42,7 @@ lint: install
 	$(PY) -c "from importlinter.cli import lint_imports; raise SystemExit(lint_imports(no_cache=True, no_logo=True))"
 
 test: lint
-	$(PY) -m pytest -q
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadscope
 
 test-heavy: install
 	$(PY) -m pytest -q -m heavy

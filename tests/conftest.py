@@ -1,4 +1,10 @@
-"""Shared fixtures: the study's gearbox and variant files."""
+"""Shared fixtures: the study's gearbox and variant files.
+
+``make test`` runs the suite in two pytest-xdist worker processes (``-n 2 --dist loadscope``: the tests of a
+module go to one worker, so that a module-scoped fixture, a simulation run or an FE model, is built once).
+The mesh cache (``meshes/`` or ``$FLEXGEAR_CACHE_DIR``) is shared by the workers: a missing mesh or reduced
+body is built by the first worker that needs it while the other waits for it (flexgear.cache.load_or_build).
+"""
 
 import dataclasses
 from pathlib import Path

@@ -27,7 +27,7 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 @pytest.fixture(scope="module")
-def cache(tmp_path_factory, gearbox):
+def cached(tmp_path_factory, gearbox):
     """A cache folder holding the component's solid, meshes and reduced body, and the intact body."""
     folder = tmp_path_factory.mktemp("cache")
     with pytest.MonkeyPatch.context() as mp:
@@ -70,8 +70,8 @@ def _reduced_path(folder: Path) -> Path:
     return _entry(folder, "reduced-*.npz")
 
 
-def test_truncated_reduced_body_is_rebuilt_with_a_warning(cache, gearbox, monkeypatch):
-    folder, intact = cache
+def test_truncated_reduced_body_is_rebuilt_with_a_warning(cached, gearbox, monkeypatch):
+    folder, intact = cached
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(folder))
     path = _reduced_path(folder)
     _truncate(path)
@@ -81,8 +81,8 @@ def test_truncated_reduced_body_is_rebuilt_with_a_warning(cache, gearbox, monkey
         _same_body(component_reduced_body(gearbox, COMPONENT, LEVEL), intact)
 
 
-def test_overwritten_reduced_body_is_rebuilt_when_its_mass_is_asked_for(cache, gearbox, monkeypatch):
-    folder, intact = cache
+def test_overwritten_reduced_body_is_rebuilt_when_its_mass_is_asked_for(cached, gearbox, monkeypatch):
+    folder, intact = cached
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(folder))
     path = _reduced_path(folder)
     path.write_bytes(b"\0" * 4096)
@@ -93,10 +93,10 @@ def test_overwritten_reduced_body_is_rebuilt_when_its_mass_is_asked_for(cache, g
 
 
 @pytest.mark.parametrize("pattern", ["mesh-*-o1-*.npz", "mesh-*-o1-*.vol.gz", "mesh-*-o1-*.json", "solid-*.brep"])
-def test_truncated_mesh_file_under_a_missing_reduced_body_is_rebuilt(cache, gearbox, monkeypatch, pattern):
+def test_truncated_mesh_file_under_a_missing_reduced_body_is_rebuilt(cached, gearbox, monkeypatch, pattern):
     """The reduction reads the first-order mesh and the solid (Netgen would crash on the truncated ``.vol.gz``
     and OCC hang on the truncated ``.brep``: both are checked before they are read)."""
-    folder, intact = cache
+    folder, intact = cached
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(folder))
     reduced = _reduced_path(folder)
     reduced.unlink()
@@ -106,8 +106,8 @@ def test_truncated_mesh_file_under_a_missing_reduced_body_is_rebuilt(cache, gear
     assert reduced.exists()
 
 
-def test_damaged_second_order_mesh_is_rebuilt_equal(cache, gearbox, monkeypatch):
-    folder, _ = cache
+def test_damaged_second_order_mesh_is_rebuilt_equal(cached, gearbox, monkeypatch):
+    folder, _ = cached
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(folder))
     intact = component_mesh(gearbox, COMPONENT, LEVEL)
     assert intact.order == 2
@@ -119,8 +119,8 @@ def test_damaged_second_order_mesh_is_rebuilt_equal(cache, gearbox, monkeypatch)
     assert np.array_equal(mesh.elements, intact.elements) and mesh.regions.keys() == intact.regions.keys()
 
 
-def test_solid_without_its_digest_is_rebuilt(cache, gearbox, monkeypatch):
-    folder, _ = cache
+def test_solid_without_its_digest_is_rebuilt(cached, gearbox, monkeypatch):
+    folder, _ = cached
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(folder))
     brep = component_brep(gearbox, COMPONENT)
     Path(f"{brep}.sha256").unlink()
