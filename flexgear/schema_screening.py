@@ -116,3 +116,5 @@ class ScreeningSettings:
     settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
     # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
     reference: str = _text(default="")
+    # numerical error bars: the reference's final state solved over this window at h and at h/2 (0: none)
+    error_window_s: float = _num(0.0, default=0.05)

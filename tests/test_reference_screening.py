@@ -158,3 +158,40 @@ def test_a_near_zero_quantity_does_not_make_a_variant_non_conforming(settings):
     ind = scr.indicators.set_index(["variant", "indicator"])
     assert ind.loc[("other", "outer_mesh_ripple"), "bias"] == pytest.approx(0.4, rel=0.02)
     assert ind.loc[("other", "outer_mesh_ripple"), "zone"] != "non-conforming"
+
+
+def _scaled_forces(res, factor: float, kinds=("outer",)):
+    for kind in kinds:
+        cols = [c for c in res.signals.columns if c.startswith(f"{kind}_mesh_force_")]
+        res.signals[cols] *= factor
+    return res
+
+
+def test_a_verdict_within_the_numerical_error_is_not_resolved(settings):
+    """The reference's window at h/2 has its mean outer mesh force x higher than at h: the composite numerical
+    error is w_F / W 100 x / TEa_F 100 (% of TEa; W the weights without the absent TE). A faster variant whose
+    Bias sits 1 % of TEa inside the decision lines (its outer force y higher) is selected, but its zone changes
+    within Bias -/+ error: the verdict is "not resolved". Without the error it is resolved."""
+    tol = settings.reference_indicators
+    share = tol.outer_mesh_force.weight / (1.0 - tol.transmission_error.weight)
+    y = 99.0 / (share * 100.0 / tol.outer_mesh_force.tea_pct * 100.0)     # composite Bias 99 % of TEa
+    x = 5.0 / (share * 100.0 / tol.outer_mesh_force.tea_pct * 100.0)      # composite error 5 % of TEa
+
+    def runs(error: float):
+        ref = _decaying(0.01, 0.0)
+        ref.meta.update(variant="ref", wall_time_s=100.0)
+        window = ref.signals[ref.signals["time_s"] >= 0.55].reset_index(drop=True)
+        ref.extra.update(error_step=window.copy(), error_half_step=_scaled_forces(
+            type(ref)(ref.meta, window.copy()), 1.0 + error).signals)
+        near = _scaled_forces(_decaying(0.01, 0.0), 1.0 + y)
+        near.meta.update(variant="near", wall_time_s=10.0)
+        return [ref, near]
+
+    s = screen(runs(x), settings, reference="ref")
+    tab = s.table.set_index("variant")
+    assert tab.loc["near", "bias_pct"] == pytest.approx(99.0, rel=1e-6)
+    assert tab.loc["near", "error_pct"] == pytest.approx(5.0, rel=1e-6)
+    assert s.selection.variant == "near" and not s.selection.resolved and not tab.loc["near", "resolved"]
+    assert s.selection.reasoning.startswith("NOT RESOLVED")
+    clean = screen(runs(0.0), settings, reference="ref")
+    assert clean.selection.variant == "near" and clean.selection.resolved

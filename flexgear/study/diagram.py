@@ -7,10 +7,12 @@ greedily so that no two overlap (the numbers are explained by the legend lines r
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
-from matplotlib.patches import Patch, Polygon
+from matplotlib.patches import Ellipse, Patch, Polygon
 from matplotlib.ticker import MaxNLocator
 
 __all__ = ["ZONE_COLOURS", "decision_diagram", "place_labels"]
@@ -94,6 +96,10 @@ def decision_diagram(ax: Axes, screening: pd.DataFrame, lines, xlim: float | Non
         disp = ax.transData.transform(pts)
         px = ax.figure.dpi / 72.0
         for _, row in inside.iterrows():
+            error = float(row.get("error_pct", math.nan))
+            if math.isfinite(error) and error > 0:   # the numerical error as the point's size (Bias -/+ error)
+                ax.add_patch(Ellipse((row.bias_pct, row.cv_pct), 2 * error, 2 * error, fc="none", ec="#555555",
+                                     ls="--", lw=0.8, zorder=4))
             ax.plot(row.bias_pct, row.cv_pct, "o", ms=6, mfc="#d62728" if row.selected else "#1f4e99", mec="k",
                     clip_on=False, zorder=5)
         groups = _clusters(disp, _CLUSTER_PT * px)

@@ -58,9 +58,9 @@ _HEARTBEAT_S = 60.0
 _POLL_S = 0.2
 
 
-def run_input_hash(variant: Variant, t_end_s: float | str) -> str:
+def run_input_hash(variant: Variant, t_end_s: float | str, error_window_s: float = 0.0) -> str:
     """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``, except the settling
-    test's fields for a run continued until it settles), t_end (s, or "settled")."""
+    test's fields for a run continued until it settles), t_end (s, or "settled"), the error windows' length."""
     gearbox = dataclasses.replace(variant.gearbox, screening=None)
     if t_end_s != "settled":
         extra: tuple = (float(t_end_s),)
@@ -68,6 +68,8 @@ def run_input_hash(variant: Variant, t_end_s: float | str) -> str:
         sc = variant.gearbox.screening
         extra = ("settled", sc.settle_block_mesh_cycles, sc.settle_final_blocks, sc.settle_mean_tolerance_pct,
                  sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s)
+    if error_window_s > 0:
+        extra = (*extra, "error_window", float(error_window_s))
     return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn")
 
 
@@ -94,6 +96,7 @@ class RunTask:
     t_end_s: float | str | None
     input_hash: str
     time_budget_s: float | None = None
+    error_window_s: float = 0.0   # > 0: the run also solves its numerical error windows (the screening reference)
 
     def inputs(self) -> dict[str, bytes]:
         """The input files for ``inputs/`` of the run folder."""
@@ -101,14 +104,15 @@ class RunTask:
                 Path(self.gearbox_file).name: self.gearbox_text.encode()}
 
 
-def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None) -> RunTask:
+def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None,
+              error_window_s: float = 0.0) -> RunTask:
     """The task of a loaded variant: reads its two files once, on the caller's side; ``t_end_s`` in s, "settled"
     or None (the load case's end: ``end_time_s``, or "settled" with ``[load_case] end = "settled"``)."""
     lc = variant.gearbox.load_case
     t_end = t_end_s if t_end_s is not None else ("settled" if lc.end == "settled" else lc.end_time_s)
     return RunTask(variant.name, str(variant.source), Path(variant.source).read_text(),
                    str(variant.gearbox.source), Path(variant.gearbox.source).read_text(), t_end_s,
-                   run_input_hash(variant, t_end), time_budget_s)
+                   run_input_hash(variant, t_end, error_window_s), time_budget_s, error_window_s)
 
 
 def run_task(task: RunTask, runner: Runner | None = None) -> RunResult:
@@ -117,7 +121,9 @@ def run_task(task: RunTask, runner: Runner | None = None) -> RunResult:
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
         variant = load_variant(task.variant_file, task.variant_text, task.gearbox_text)
-        extra = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
+        extra: dict[str, Any] = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
+        if task.error_window_s > 0:
+            extra["error_window_s"] = task.error_window_s
         result = (runner or _default_runner())(variant, t_end_s=task.t_end_s, progress=False, **extra)
     except Exception as exc:  # recorded, not raised: the other variants go on
         result = _failed(task.name, f"{type(exc).__name__}: {exc}")
@@ -317,7 +323,9 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
             raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
         names.append(name)
         settings = settings or variant.gearbox.screening
-        task = make_task(variant, t_end_s, time_budget_s)
+        ref = reference if reference is not None else settings.reference
+        task = make_task(variant, t_end_s, time_budget_s,
+                         settings.error_window_s if ref and name == ref else 0.0)
         run_dir = out_dir / name
         if (run_dir / "run.json").exists():
             old = load_result(run_dir).meta

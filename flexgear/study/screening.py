@@ -53,7 +53,7 @@ from flexgear.results import RunResult
 from flexgear.settling import SettleRule, Settling, settled_start
 from flexgear.spec import ScreeningSettings
 from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, on_scale, segment_slices
-from flexgear.study.selection import DecisionLines, Selection, select_variant
+from flexgear.study.selection import DecisionLines, Selection, select_variant, variant_names
 
 __all__ = [
     "INDICATORS",
@@ -76,6 +76,7 @@ __all__ = [
     "scaled_bias_cv",
     "reference_means",
     "UnsettledReference",
+    "numerical_error",
 ]
 
 INDICATORS: dict[str, str] = STUDY_INDICATORS
@@ -289,6 +290,49 @@ class Screening:
         return decision_diagram(ax, self.table, self.lines, xlim, ylim, title)
 
 
+def numerical_error(reference: RunResult, settings: ScreeningSettings) -> tuple[float, dict[str, float]]:
+    """The reference's numerical error: its final state's window solved at h and at h/2 (extra tables
+    ``error_step``, ``error_half_step`` of flexgear.mbs.run.numerical_error_windows). Per indicator, the change
+    of its window mean on its judging scale (absolute, or in % for the relative scale); composite e = sum_i w_i
+    e_i / TEa_i 100 in % of TEa, with the reference screening's weights. (nan, {}) without the two windows."""
+    coarse, fine = reference.extra.get("error_step"), reference.extra.get("error_half_step")
+    if coarse is None or fine is None:
+        return math.nan, {}
+    f_mesh = float(reference.meta["theory"]["mesh_frequency_hz"])
+    tol = settings.reference_indicators
+    means = []
+    for table in (coarse, fine):
+        t = table["time_s"].to_numpy()
+        samples = indicator_segments(table, segment_slices(t, float(t[0]), float(t[-1]), settings.sample_count),
+                                     f_mesh)
+        means.append({k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()})
+    errors = {k: scaled_bias_cv(np.array([means[1][k], means[1][k]]), means[0][k], getattr(tol, k).scale)[0]
+              for k in means[0] if k in means[1]}
+    total = sum(getattr(tol, k).weight for k in errors)
+    return sum(getattr(tol, k).weight / total * e / getattr(tol, k).tea * 100.0 for k, e in errors.items()), errors
+
+
+def _resolution(table: pd.DataFrame, lines: DecisionLines, error: float, selection: Selection) -> Selection:
+    """Mark each variant's zone resolved when Bias -/+ the numerical error keeps it, and the verdict not resolved
+    when the selected variant's zone, or that of a faster screened variant, is not."""
+    ok = table["status"] == "ok"
+    table["error_pct"] = np.where(ok, error, math.nan)
+    table["resolved"] = [bool(not r.status == "ok" or not math.isfinite(error)
+                              or lines.rank(r.bias_pct + error, r.cv_pct) == lines.rank(max(r.bias_pct - error, 0.0),
+                                                                                      r.cv_pct))
+                         for r in table.itertuples()]
+    if selection.variant is None or not math.isfinite(error):
+        return selection
+    chosen = table[table["variant"] == selection.variant]
+    deciding = table[ok & (table["time_s"] <= float(chosen["time_s"].iloc[0]))]
+    open_ = deciding[~deciding["resolved"]]
+    if open_.empty:
+        return selection
+    why = (f"NOT RESOLVED: the zone of {variant_names(open_)} lies within the numerical error ({error:.3g} % of "
+           "TEa, reference at h and h/2). ")
+    return Selection(selection.variant, selection.rule, why + selection.reasoning, False)
+
+
 class UnsettledReference(ValueError):
     """The screening's reference has not settled: nothing can be screened against it."""
 
@@ -382,6 +426,8 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
     if ref_name:
         selection = Selection(selection.variant, selection.rule,
                               selection.reasoning + _reference_reasoning(table, indicators, ref_name))
+        error, _ = numerical_error(next(r for r in results if r.name == ref_name), settings)
+        selection = _resolution(table, lines, error, selection)
     table["selected"] = table["variant"] == selection.variant
     return Screening(table, indicators, selection, lines, ref_name)
 

@@ -11,7 +11,7 @@ import pandas as pd
 
 from flexgear.schema import ScreeningSettings
 
-__all__ = ["DecisionLines", "Selection", "select_variant"]
+__all__ = ["DecisionLines", "Selection", "select_variant", "variant_names"]
 
 _ZONE_NAMES = {
     (2, 3, 4): ("non-conforming", "critical", "good", "excellent"),
@@ -67,9 +67,10 @@ class Selection:
     variant: str | None
     rule: str
     reasoning: str
+    resolved: bool = True   # False: a zone that decides the verdict lies within the numerical error
 
 
-def _names(df: pd.DataFrame) -> str:
+def variant_names(df: pd.DataFrame) -> str:
     return ", ".join(df["variant"].astype(str)) or "none"
 
 
@@ -95,7 +96,7 @@ def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines, referen
         raise ValueError(f"unknown selection rule {rule!r}; allowed: fastest_in_best_zone, closest_to_origin, "
                          "fastest_acceptable")
     ok = table[table["status"] == "ok"]
-    notes = "".join(f" Not screened ({status}): {_names(table[table['status'] == status])}."
+    notes = "".join(f" Not screened ({status}): {variant_names(table[table['status'] == status])}."
                     for status in ("unsettled", "failed") if (table["status"] == status).any())
     tea = (f"TEa = {lines.tea_pct:g} %" if not lines.normalised
            else "each indicator scaled by its own TEa, composite TEa = 100 %")
@@ -115,14 +116,14 @@ def select_variant(table: pd.DataFrame, rule: str, lines: DecisionLines, referen
                f"({best['distance_pct']:.4g} %, zone {best['zone']}, {tea}).")
     elif rule == "fastest_acceptable":
         best = _pick(acceptable, ("time_s", "distance_pct"))
-        why = (f"Rule fastest_acceptable: variants meeting {first}: {_names(acceptable)}; "
+        why = (f"Rule fastest_acceptable: variants meeting {first}: {variant_names(acceptable)}; "
                f"the fastest is {best['variant']} ({best['time_s']:.4g} s, zone {best['zone']}).")
     else:
         top = int(acceptable["zone_rank"].max())
         zone = lines.zone_names[top]
         in_zone = acceptable[acceptable["zone_rank"] == top]
         best = _pick(in_zone, ("time_s", "distance_pct"))
-        why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {_names(in_zone)}; "
+        why = (f"Rule fastest_in_best_zone: best zone reached ({tea}) is '{zone}', holding {variant_names(in_zone)}; "
                f"the fastest of them is {best['variant']} ({best['time_s']:.4g} s, distance "
                f"{best['distance_pct']:.4g} %).")
         if len(in_zone) > 1:
