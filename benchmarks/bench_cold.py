@@ -1,12 +1,22 @@
-"""Benchmark (issue 16): cold coarse meshes and reductions, and the peak memory of the quick ``make``.
+"""How long does a cold build take and how much memory does it need: the coarse meshes and reduced bodies of
+every component (goal <= 90 s on the 2-core machine), a first ``make`` (goal <= 2 GB), and what each mesh
+level gives (size, shape quality, mass against the exact solid)?
 
-Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold make] [--make-target quick]
+Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold make meshes] [--make-target quick]
+     nice -n 5 python benchmarks/bench_cold.py --sections meshes [--runs coarse coarse:2 default]
+                                               [--components sun ring ...] [--keep DIR]
 
 - cold: ``python -m flexgear.cli meshes --level coarse`` (OCC solids, Netgen meshes and reduced bodies
-  of every component) in a fresh, empty temporary ``FLEXGEAR_CACHE_DIR``: wall time (goal <= 90 s on
-  the 2-core machine) and the peak memory of the process tree;
+  of every component) in a fresh, empty temporary ``FLEXGEAR_CACHE_DIR``: wall time and the peak memory of the
+  process tree;
 - make: ``make <target> PY=<this python> RESULTS=<temporary folder>`` in the project folder, again with
-  an empty cache folder (what a first ``make`` does): wall time and peak memory (goal <= 2 GB).
+  an empty cache folder (what a first ``make`` does): wall time and peak memory;
+- meshes (once, not repeated): in a fresh cache folder, per component the solid is built
+  (flexgear.fe.mesh.component_brep) and meshed at each of ``--runs`` (level, optionally ``:order``). One row
+  per component and run: tetrahedra, nodes, solid time, mesh time (Netgen, from reading the ``.brep`` to the
+  last node), the smallest shape quality of the vertex tetrahedra (mean ratio 12 (3V)^(2/3) / sum of squared
+  edge lengths: 1 regular, 0 flat) and the mesh-vs-exact differences of mass and Izz
+  (flexgear.fe.mesh.mass_check); the solid's own OCC mass against the exact section integrals once per component.
 
 CPU time is the sum over the command's processes (user + system; on a busy machine the steadier figure,
 but parallel work counts once per core). Peak memory is the largest maximum resident set size among the
@@ -32,10 +42,11 @@ import threading
 import time
 from pathlib import Path
 
-from speed_common import figure_line, load_average
+from bench_speed import figure_line, load_average
 
 ROOT = Path(__file__).resolve().parents[1]
-_SAMPLE_S = 0.5  # s between memory samples (each reads /proc of every process; 0.2 s took ~10 % of a core)
+_SAMPLE_S = 0.5  # s between memory samples (each sample reads /proc of every process: shorter costs CPU)
+COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft")
 
 
 def _pss(pid: int) -> int:
@@ -129,15 +140,79 @@ def measure(cmd: list[str], cache_dir: Path) -> dict:
     return res
 
 
+def shape_quality(nodes, elements) -> float:
+    """Smallest mean-ratio quality of the tetrahedra spanned by the first four nodes of each element."""
+    import numpy as np
+
+    p = nodes[elements[:, :4]]
+    a, b, c = p[:, 1] - p[:, 0], p[:, 2] - p[:, 0], p[:, 3] - p[:, 0]
+    volume = np.abs(np.einsum("ij,ij->i", a, np.cross(b, c))) / 6
+    edges2 = sum(np.sum((p[:, i] - p[:, j]) ** 2, axis=1) for i in range(4) for j in range(i + 1, 4))
+    return float((12 * (3 * volume) ** (2 / 3) / edges2).min())
+
+
+def mesh_table(a: argparse.Namespace) -> None:
+    """The ``meshes`` section (module docstring), built in ``--keep`` or a temporary folder."""
+    folder = Path(a.keep) if a.keep else Path(tempfile.mkdtemp(prefix="flexgear-bench-meshes-"))
+    os.environ["FLEXGEAR_CACHE_DIR"] = str(folder)
+
+    import netgen.occ as occ
+
+    from flexgear.fe.mesh import component_brep, component_mesh, mass_check
+    from flexgear.geometry.layout import exact_mass_properties
+    from flexgear.spec import load_gearbox
+
+    spec = load_gearbox(a.gearbox)
+    rho = spec.material_assumed.density_kg_m3
+    print(f"meshes: cache folder {folder} (cold)", flush=True)
+    header = (f"{'component':<13}{'level':<8}{'order':>5}{'tets':>9}{'nodes':>9}{'solid s':>9}{'mesh s':>8}"
+              f"{'q_min':>7}{'mass err %':>12}{'Izz err %':>11}")
+    rows = []
+    try:
+        for name in a.components:
+            t0 = time.perf_counter()
+            brep = component_brep(spec, name)
+            t_solid = time.perf_counter() - t0
+            shape = occ.OCCGeometry(str(brep)).shape
+            exact = exact_mass_properties(spec, name)
+            print(f"{name}: solid {t_solid:.1f} s, {len(shape.faces)} faces, OCC mass vs exact "
+                  f"{100 * (rho * shape.mass / exact.mass - 1):+.5f} %", flush=True)
+            for run in a.runs:
+                level, _, order = run.partition(":")
+                mesh = component_mesh(spec, name, level, order=int(order) if order else None)
+                err = mass_check(spec, mesh)
+                row = (f"{name:<13}{level:<8}{mesh.order:>5}{mesh.n_elements:>9}{mesh.n_nodes:>9}{t_solid:>9.1f}"
+                       f"{mesh.build_time_s:>8.1f}{shape_quality(mesh.nodes, mesh.elements):>7.3f}"
+                       f"{100 * err['mass']:>+12.4f}{100 * err['izz']:>+11.4f}")
+                rows.append(row)
+                print(row, flush=True)
+    finally:
+        if not a.keep:
+            shutil.rmtree(folder, ignore_errors=True)
+    print()
+    print(header)
+    print("\n".join(rows))
+
+
 def main() -> None:
     if len(sys.argv) > 1 and sys.argv[1] == "--child":
         _child(sys.argv[2:])
         return
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--repeat", type=int, default=3)
-    ap.add_argument("--sections", nargs="+", default=["cold", "make"], choices=["cold", "make"])
+    ap.add_argument("--sections", nargs="+", default=["cold", "make"], choices=["cold", "make", "meshes"])
     ap.add_argument("--make-target", default="quick")
+    ap.add_argument("--runs", nargs="+", default=["coarse", "coarse:2", "default"],
+                    help="meshes: mesh level, optionally :order")
+    ap.add_argument("--components", nargs="+", default=list(COMPONENTS), choices=COMPONENTS)
+    ap.add_argument("--gearbox", default=str(ROOT / "model_variants" / "gearbox.toml"))
+    ap.add_argument("--keep", help="meshes: build in this folder and keep it (default: a temporary folder, removed)")
     a = ap.parse_args()
+    if "meshes" in a.sections:
+        a.sections.remove("meshes")
+        mesh_table(a)
+        if not a.sections:
+            return
     print(f"bench_cold: {a.repeat} rounds of {a.sections}; {load_average()}", flush=True)
     commands = {"cold": [sys.executable, "-m", "flexgear.cli", "meshes", "--level", "coarse"]}
     walls: dict[str, list[float]] = {s: [] for s in a.sections}

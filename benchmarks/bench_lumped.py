@@ -1,6 +1,7 @@
-"""Benchmark of the lumped-parameter model: full Table 5 run time and integration-step convergence.
+"""How long does the lumped-parameter model take for the full Table 5 load case, and is its integration step
+converged (Table 7 with twice the RK4 substeps)?
 
-    python benchmarks/bench_lumped.py [model_variants/gearbox.toml] [--out DIR]
+Run: python benchmarks/bench_lumped.py [model_variants/gearbox.toml] [--out DIR]
 
 Prints the wall time of the full run (numba kernel already compiled: a warm-up run of 1 ms comes
 first and its time, which includes compiling or loading the cache, is printed separately), Tables 6

@@ -1,14 +1,15 @@
-"""Newton iterations and Jacobians per step over the load case, per Jacobian policy (issue 16: fewer iterations).
+"""How many Newton iterations and Jacobians per step does each Jacobian policy need over the load case, and where
+(which part of the ramps) does a policy pay?
 
 Run: nice -n 5 python benchmarks/bench_newton.py [--cases model1 floor] [--updates exudyn economy]
      [--ends 0.01 0.02 0.05 0.1 0.2 0.3 0.6]
 
 Each case runs once to the last of ``--ends`` (the full Table 5 load case, cut there) with each policy of
 ``[solver_assumed] jacobian_updates`` (flexgear.mbs.newton); the solver's running counts, read by the run's
-post-step function (speed_common.solver_marks) when it passes each end time, give the iterations
-and Jacobians per step in each window (one run: the economy's choices depend on measured times, so runs to
-different end times are not prefixes of each other). Shows where a policy pays: model 1 under Exudyn's own rule needs
-about 3 iterations per step at light load early in the ramps and 1 after 0.2 s.
+post-step function (bench_speed.solver_marks) when it passes each end time, give the iterations and Jacobians
+per step in each window (one run: the economy's choices depend on measured times, so runs to different end times
+are not prefixes of each other). ``floor``: model 1 with a constant mesh stiffness and no friction
+(bench_speed.floor_variant).
 """
 
 from __future__ import annotations
@@ -16,7 +17,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from speed_common import floor_variant, load_average, solver_marks, with_jacobian_updates
+from bench_speed import floor_variant, load_average, solver_marks, with_jacobian_updates
 
 from flexgear.mbs.run import run_variant
 from flexgear.spec import load_variant

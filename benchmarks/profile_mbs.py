@@ -1,10 +1,11 @@
-"""Profile one multibody run: Exudyn's CPU-time statistics per solver part, Newton counts, and cProfile.
+"""Where does a multibody run spend its time: Exudyn's CPU-time statistics per solver part, Newton iterations and
+Jacobians per step, and the Python functions (cProfile)?
 
 Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
-     [--trace-newton 6]
+     [--trace-newton 6] [--blas-threads 2]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
-stiffness and no friction, benchmarks/speed_common.floor_variant), warmed with a 1e-4 s run, then
+stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then
 solved as a run solves it (the Jacobian economy of ``[solver_assumed] jacobian_updates``, the collector's
 generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
 case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
@@ -26,7 +27,7 @@ import time
 import warnings
 from pathlib import Path
 
-from speed_common import floor_variant, load_average, shortened
+from bench_speed import floor_variant, load_average, shortened
 
 from flexgear.mbs.gearbox import build_star_gearbox
 from flexgear.mbs.newton import JacobianEconomy
