@@ -25,7 +25,7 @@ quick: install
 	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width
-	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf
+	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf --westgard-png docs/img/westgard.png
 
 install: $(STAMP)
 
@@ -52,7 +52,7 @@ meshes: install
 	$(PY) -m flexgear.cli meshes --level default --no-reduce
 
 matrix: install
-	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7
+	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7 --t-end settled
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
 
 report: install

@@ -214,6 +214,8 @@ def _args_report(p: argparse.ArgumentParser) -> None:
     p.add_argument("results", help="results folder of a matrix (matrix_results.csv, screening.csv, runs)")
     p.add_argument("--output", default="reports/screening_report.pdf", metavar="FILE",
                    help="PDF to write (default: %(default)s)")
+    p.add_argument("--westgard-png", default=None, metavar="FILE",
+                   help="also write the verdict's Westgard diagram as a PNG (default: none)")
 
 
 def cmd_report(a: argparse.Namespace) -> int:
@@ -221,7 +223,7 @@ def cmd_report(a: argparse.Namespace) -> int:
 
     if not Path(a.results).is_dir():
         raise FileNotFoundError(f"{a.results}: expected the results folder of a matrix")
-    path = build_report(Path(a.results), Path(a.output))
+    path = build_report(Path(a.results), Path(a.output), a.westgard_png)
     print(f"report -> {path}")
     return 0
 

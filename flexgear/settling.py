@@ -7,10 +7,13 @@ signal gets one value per block: the planet-mean mesh forces and the two speeds 
 drift), the mesh-force ripples and bearing accelerations RMS their block values (a decaying vibration).
 Its final value is the mean of the last ``final_blocks`` blocks, and must differ from the mean of the
 ``final_blocks`` blocks just before by at most the tolerance (else the run has not settled). The run has
-settled at the start of the first block after which every later block of every settling signal lies
-within the tolerance of its final value, if at least ``min_blocks`` blocks remain: ``mean_tolerance_pct``
-for the drifts, ``amplitude_tolerance_pct`` for the vibrations. For y = A + B e^(-t/tau) this is the first
-block start t with |B| e^(-t/tau) <= tol |A| (to a block), tau ln(|B| / (tol |A|)).
+settled at the start of the first block from which the mean over every later group of ``final_blocks``
+consecutive blocks of every settling signal lies within the tolerance of its final value, if at least
+``min_blocks`` blocks remain: ``mean_tolerance_pct`` for the drifts, ``amplitude_tolerance_pct`` for the
+vibrations. With a group of one revolution of the slowest member, a stationary modulation within a revolution
+(an asymmetric bolted part, a planet-pass pattern) averages out instead of being taken for a transient. For
+y = A + B e^(-t/tau) and groups of length W this is the first block start t with
+|B| (tau / W)(1 - e^(-W/tau)) e^(-t/tau) <= tol |A| (to a block).
 
 When a run has not settled, :func:`settled_start` also estimates how much longer it needs: from the
 geometric decay of the differences between consecutive groups of ``final_blocks`` blocks (ratio r of the
@@ -162,7 +165,11 @@ def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: floa
                                       f"% (> {tol_pct:g} %) between the last two groups of {rule.final_blocks} "
                                       f"blocks of {rule.block_mesh_cycles} mesh cycles at {t[-1]:.4g} s" + when,
                                 key, needed)
-            bad = np.flatnonzero(np.abs(v - final) > tol)
+            # the band test on the group-averaged value (a group of final_blocks blocks: one revolution of the
+            # slowest member with the default settings), so that a stationary modulation within a revolution is
+            # not taken for a transient
+            group_mean = np.convolve(v, np.full(rule.final_blocks, 1.0 / rule.final_blocks), mode="valid")
+            bad = np.flatnonzero(np.abs(group_mean - final) > tol)
             k = int(bad[-1]) + 1 if bad.size else 0
             if k > first_ok:
                 first_ok, slowest = k, key
@@ -172,7 +179,8 @@ def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: floa
                               f"mesh cycles before the end ({t[-1]:.4g} s); the window needs {rule.min_blocks}; "
                               f"about {needed:.3g} s needed", slowest, needed)
     start = float(starts[first_ok])
-    why = (f"settled at {start:.4g} s: every later block of {rule.block_mesh_cycles} mesh cycles within "
-           f"{rule.mean_tolerance_pct:g} % (speeds, mean forces) and {rule.amplitude_tolerance_pct:g} % (ripple, "
-           f"bearing RMS) of its final value" + (f"; slowest: {slowest}" if slowest else ""))
+    why = (f"settled at {start:.4g} s: from there every mean over {rule.final_blocks} blocks of "
+           f"{rule.block_mesh_cycles} mesh cycles within {rule.mean_tolerance_pct:g} % (speeds, mean forces) and "
+           f"{rule.amplitude_tolerance_pct:g} % (ripple, bearing RMS) of its final value"
+           + (f"; slowest: {slowest}" if slowest else ""))
     return Settling(start, why, slowest, float(t[-1]))

@@ -99,8 +99,9 @@ def test_settling_time_of_an_exponential_decay(settings):
     tol = settings.settle_mean_tolerance_pct / 100.0
     test = settled_start(res.signals, 0.5, f, dataclasses.replace(SettleRule.from_settings(settings), min_blocks=1))
     start, why = test.start_s, test.reason
-    # a block's mean deviation is rel e^(-t_k/tau) (tau/h)(1 - e^(-h/tau)); final value ~ A (e^-10 left)
-    t_star = 0.5 + tau * math.log(rel * (tau / block) * (1 - math.exp(-block / tau)) / tol)
+    # a group's mean deviation is rel e^(-t_k/tau) (tau/W)(1 - e^(-W/tau)), W = final_blocks blocks; final ~ A
+    group = settings.settle_final_blocks * block
+    t_star = 0.5 + tau * math.log(rel * (tau / group) * (1 - math.exp(-group / tau)) / tol)
     assert start is not None and "output_speed" in why
     assert t_star - 1e-9 <= start <= t_star + block + 1e-9
     # the same through the screening settings: a settled (steady) window from there to the end

@@ -54,15 +54,16 @@ def test_report_pages_and_key_text(results, tmp_path):
     # page numbers on every page, and the contents list the other pages
     for i, page in enumerate(pages, start=1):
         assert f"page {i} / {len(pages)}" in page
-    assert len(re.findall(r"page\s+\d+\s+\S", pages[0])) >= len(pages) - 1
+    assert len(re.findall(r"page\s+\d+\s+\S", pages[1])) >= len(pages) - 2   # page 1 the verdict, 2 the contents
     for key in ("Table 3", "Table 4", "Westgard decision diagram", "TEa = 1 %", "Table 6", "Table 7",
                 "face_width_mm", "allowable_total_error_pct", "exudyn", "ADAMS", "Bias + 2", "lumped"):
         assert key in text, key
     # the fake runner: model3 (2 flexible components: composite Bias 0.2 %, CV 0.12 %) and model6 (3: 0.15 %,
     # 0.12 %) both meet Bias + 4 CV <= 1 % (excellent); fastest_in_best_zone takes the faster, model3 (3 s vs
-    # 4 s); model1 (quick, 0.02 s: all ramp) is flagged; model9's bad file is reported with its field
-    assert "Selected model: model3" in pages[0] and "model6 takes 1.33x as long" in pages[0]
-    assert "CAUTION" in pages[0] and "model1" in pages[0]
+    # 4 s); model1 (quick, 0.02 s: all ramp) is not screened (unsettled); model9's bad file is reported with its
+    # field. Page 1: the verdict in at most three lines, the diagram and the small table.
+    assert "Verdict: model3" in pages[0] and "model1 (unsettled)" in pages[0] and "model9 (failed)" in pages[0]
+    assert "Selected model: model3" in pages[1] and "model6 takes 1.33x as long" in pages[1]
     assert "components.sun" in text and "model9" in text
     # theory (flexgear.theory): 798.21 N per planet, -11647.06 deg/s
     assert "798.21212" in text and "-11647.0588" in text

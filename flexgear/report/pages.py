@@ -82,6 +82,64 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
     return draw
 
 
+def verdict_lines(d: ReportData) -> list[str]:
+    """The verdict and its reason in at most three lines (the first page and ``flexgear report``'s output)."""
+    if d.refused:
+        return ["Verdict: none. " + d.refused[:200]]
+    sel, s = d.selection, d.primary
+    against = f"against the reference {s.reference}" if s.reference else "against theory (the study's mode)"
+    flag = "" if sel.resolved else " (NOT RESOLVED)"
+    lines = [f"Verdict: {sel.variant or 'none'}{flag}, screened {against}."]
+    tab = s.table
+    if sel.variant is not None:
+        row = tab[tab["variant"] == sel.variant].iloc[0]
+        ref_row = tab[tab["variant"] == s.reference]
+        faster = (f", {float(ref_row['time_s'].iloc[0]) / row['time_s']:.3g}x faster than {s.reference}"
+                  if len(ref_row) and sel.variant != s.reference else "")
+        lines.append(f"Zone '{row['zone']}', distance {row['distance_pct']:.3g} {s.lines.unit}{faster}.")
+    else:
+        lines.append(sel.reasoning.split(". ")[0][:180] + ".")
+    unscreened = tab[tab["status"] != "ok"]
+    if len(unscreened):
+        lines.append("Not screened: " + ", ".join(f"{r.variant} ({r.status})" for r in unscreened.itertuples()) + ".")
+    return lines[:3]
+
+
+def _verdict_page(d: ReportData) -> Callable[[Figure], None]:
+    """Page 1: the verdict in at most three lines, the Westgard diagram and a small table."""
+    s = d.primary
+    cols = {"variant": "variant", "zone": "zone", "distance_pct": f"distance [{s.lines.unit}]",
+            "error_pct": f"± error [{s.lines.unit}]", "time_s": "run time [s]", "status": "status"}
+    tab = s.table.reindex(columns=list(cols)).rename(columns=cols)
+    tab["settled"] = s.table["status"].isin(["ok"]) & s.table.get("steady_window", True).fillna(False).astype(bool)
+
+    def draw(fig: Figure) -> None:
+        fig.text(0.04, 0.90, "\n".join(verdict_lines(d)), fontsize=10.5, va="top", wrap=True)
+        ax = fig.add_axes([0.06, 0.08, 0.46, 0.68])
+        s.plot(ax, title="")
+        right = fig.add_axes([0.56, 0.08, 0.41, 0.68])
+        right.axis("off")
+        draw_table(right, tab.assign(**{c: [fmt(v, 4) if isinstance(v, float) else v for v in tab[c]]
+                                         for c in tab.columns}), top=1.0, fontsize=7.5, wrap=18)
+    return draw
+
+
+def write_westgard_png(d: ReportData, path: str | Path) -> Path:
+    """The Westgard diagram of the verdict's screening as a PNG (the README's picture)."""
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig = plt.figure(figsize=(7.0, 5.0))
+    ax = fig.add_axes([0.1, 0.1, 0.86, 0.8])
+    s = d.primary
+    s.plot(ax, title=f"{d.results_dir.name}: verdict {d.selection.variant or 'none'}"
+           + (f" (against {s.reference})" if s.reference else " (against theory)"))
+    tmp = path.with_name(f".{path.name}.tmp.png")
+    fig.savefig(tmp, dpi=110)
+    plt.close(fig)
+    tmp.replace(path)
+    return path
+
+
 def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
     g, lc, c = d.gearbox.gears, d.gearbox.load_case, d.gearbox.contact
     th = next((r.meta["theory"] for r in d.runs.values() if "theory" in r.meta), None)
@@ -167,24 +225,29 @@ def _provenance_pages(d: ReportData) -> list[Page]:
 
 
 
-def build_report(results_dir: str | Path, output: str | Path = Path("reports/screening_report.pdf")) -> Path:
-    """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF)."""
+def build_report(results_dir: str | Path, output: str | Path = Path("reports/screening_report.pdf"),
+                 westgard_png: str | Path | None = None) -> Path:
+    """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF): page 1 the verdict,
+    then the details, the assumptions in an appendix. ``westgard_png``: also the verdict's diagram as a PNG."""
     d = gather(results_dir)
     output = Path(output)
     created = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
     assumptions = documented_assumptions(d.gearbox_file)
-    body: list[Page] = [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
-    body += table_pages("Assumptions: every value the study does not give", assumptions,
-                        {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
-                        f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
-    body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
-    body += [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
+    body: list[Page] = [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
     if rp.shown_runs(d):
         body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d)]
     body += rp.sweep_pages(d)
+    body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
+    body += [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
+    body += table_pages("Appendix: assumptions, every value the study does not give", assumptions,
+                        {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
+                        f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
     body += _provenance_pages(d)
-    contents = [(i + 2, title) for i, (title, _) in enumerate(body)]
-    pages: list[Page] = [("flexgear screening report", _title_page(d, contents, created)), *body]
+    contents = [(i + 3, title) for i, (title, _) in enumerate(body)]
+    pages: list[Page] = [("flexgear screening report: verdict", _verdict_page(d)),
+                         ("Runs, screening rule and contents", _title_page(d, contents, created)), *body]
+    if westgard_png is not None:
+        write_westgard_png(d, westgard_png)
     output.parent.mkdir(parents=True, exist_ok=True)
     tmp = output.with_name(f".{output.name}.tmp")
     with PdfPages(tmp, metadata={"Title": "flexgear screening report", "Creator": "flexgear"}) as pdf:
