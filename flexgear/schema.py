@@ -18,7 +18,6 @@ from flexgear.schema_fields import SpecError, _choice, _num
 from flexgear.schema_screening import (
     IndicatorTolerance,
     IndicatorWeights,
-    LengthTolerance,
     LevelTolerance,
     LoadTolerance,
     ReferenceIndicators,
@@ -29,7 +28,7 @@ __all__ = [
     "SpecError", "GearSet", "GearSetAssumed", "Material", "ComponentsAssumed", "Bearing", "Bearings", "Contact",
     "ContactAssumed", "SupportsAssumed", "JointsAssumed", "LoadCase", "SolverSettings", "MeshingSettings",
     "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "LoadTolerance",
-    "LevelTolerance", "LengthTolerance", "ReferenceIndicators", "ScreeningSettings",
+    "LevelTolerance", "ReferenceIndicators", "ScreeningSettings",
     "LumpedAssumed", "GearboxSpec", "Variant", "COMPONENTS", "GEAR_COMPONENTS", "SHAFT_COMPONENTS",
     "GEOMETRY_COMPONENTS", "COMPONENT_GEOMETRY",
 ]

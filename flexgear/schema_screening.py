@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 from flexgear.schema_fields import _choice, _num, _text
 
-__all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance", "LengthTolerance",
+__all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance",
            "ReferenceIndicators", "ScreeningSettings"]
 
 
@@ -63,14 +63,6 @@ class LevelTolerance(_Tolerance):
 
 
 @dataclass(frozen=True)
-class LengthTolerance(_Tolerance):
-    """TEa in um of a displacement (the loaded transmission error)."""
-
-    tea_um: float = _num(0.0, 1e6, lo_open=True)
-    scale, tea_field = "um", "tea_um"
-
-
-@dataclass(frozen=True)
 class ReferenceIndicators:
     """TEa and weight of every indicator screened against a reference variant, each on the scale where it
     matters (``[screening.reference_indicators]``; flexgear.study.indicators defines each indicator)."""
@@ -88,7 +80,7 @@ class ReferenceIndicators:
     output_bearing_rms: LevelTolerance
     input_bearing_mesh1x: LevelTolerance
     output_bearing_mesh1x: LevelTolerance
-    transmission_error: LengthTolerance
+    transmission_error: IndicatorTolerance
 
 
 @dataclass(frozen=True)

@@ -123,11 +123,13 @@ def test_static_mesh_force_equals_theory(spec):
     np.testing.assert_allclose(outer, theory(spec).mesh_force, rtol=1e-9)
 
 
-def short_case(spec, arrangement: str = "star", friction: float = 0.0, variation: str = "constant"):
+def short_case(spec, arrangement: str = "star", friction: float = 0.0, variation: str = "constant",
+               law: str = "iso6336"):
+    """Ramps 0.02 s, 0.15 s; the linear mesh law of eq. 10-13 unless ``law`` says otherwise."""
     lc = dataclasses.replace(spec.load_case, ramp_time_s=0.02, end_time_s=0.15)
     return spec.with_changes(
         load_case=lc, gears=dataclasses.replace(spec.gears, arrangement=arrangement),
-        contact=dataclasses.replace(spec.contact, friction_coefficient=friction),
+        contact=dataclasses.replace(spec.contact, friction_coefficient=friction, law=law),
         contact_assumed=dataclasses.replace(spec.contact_assumed, stiffness_variation=variation),
     )
 
@@ -189,3 +191,28 @@ def test_reversed_load_crosses_backlash_to_back_flanks(spec):
     forces = w.filter(regex="mesh_force").to_numpy()
     assert (np.abs(forces[1:]) < 1e-9).any()  # free flight inside the backlash at some point
     np.testing.assert_allclose(forces[w["time_s"].to_numpy() >= 0.13].mean(0), -theory(spec).mesh_force, rtol=1e-5)
+
+
+def test_impact_law_mesh_carries_the_torque_at_the_laws_own_deflection(spec):
+    """The study's impact law in the lumped model (the multibody model's law): after the ramps the mean mesh force
+    is theory's (torque balance, any law); and the kernel's mesh force at a deflection delta, constant stiffness,
+    no rate, is the law's k delta^e with the whole-face k (at 798 N, delta = (F/k)^(1/e): a few tenths of a mm)."""
+    from flexgear.laws.contact import mesh_laws
+    from flexgear.lumped.run import build_lumped_model, lumped_rhs
+
+    s = short_case(spec, law="impact").with_fields("load_case", end_time_s=0.4)
+    th = theory(s)
+    w = run_lumped(s).signals
+    forces = w[w["time_s"] >= 0.3].filter(regex="mesh_force").to_numpy()
+    assert forces.mean() == pytest.approx(th.mesh_force, rel=2e-3)
+    law = mesh_laws(s)["outer"]
+    delta = (th.mesh_force / law.stiffness) ** (1.0 / law.exponent)
+    assert 1e-4 < delta < 1e-3
+    model = build_lumped_model(s)
+    g = model.system.mesh_G[0]   # the first sun-planet mesh: delta = G_0 . q, put on one free coordinate of it
+    j = next(k for k, i in enumerate(model.free) if abs(g[i]) > 0)
+    y = np.zeros(2 * model.free.size)
+    y[j] = delta / g[model.free[j]]
+    row = lumped_rhs(model).record(0.0, y)   # t = 0: the prescribed input spin at rest; signals row: speeds,
+    # torque, then the mesh forces
+    assert row[3] == pytest.approx(th.mesh_force, rel=1e-9)

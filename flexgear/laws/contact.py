@@ -77,7 +77,7 @@ def mesh_laws(spec: GearboxSpec) -> dict[str, ContactLaw]:
     geo = gear_set_geometry(spec)
     ga, ca = spec.gears_assumed, spec.contact_assumed
     b = ga.face_width_m
-    f_t = theory(spec).input_torque / (geo.planet_count * geo.sun.reference_radius)
+    f_t = abs(theory(spec).input_torque) / (geo.planet_count * geo.sun.reference_radius)  # either flank
     line_load = ca.application_factor * f_t / (b * 1e3)
     mass = {c: component_mass_properties(spec, c).mass for c in ("sun", "planet", "ring")}
     out = {}

@@ -13,6 +13,14 @@ delta = G_m . q and the normal force (eq. 1-13)
     k_m(t) = k_mean (1 + sum_n c_n cos(2 pi n (phi_m - (eps_alpha + eps_beta)/2)))   (eq. 11-12)
     f(delta) = delta (delta > 0), 0 (-j_n <= delta <= 0), delta + j_n (delta < -j_n)   (backlash j_n)
 
+with k_mean and c_m the multibody model's ISO 6336 law and eq. 13 damping under ``[contact] law = "iso6336"``
+(flexgear.laws.contact.mesh_laws). Under the study's impact law (``law = "impact"``, section 2.1: again the
+multibody model's law, so that both models are compared under the same law) the same mesh carries the
+whole-face impact law instead (flexgear.laws.contact.impact_force; the linear analyses of the lumped model,
+flexgear.lumped.modal and :func:`static_mesh_forces`, keep eq. 10's stiffness):
+F_n = k s(phi) delta^e + c_max STEP(delta, 0, 0, d, 1) delta' on the driving flank, mirrored on the back
+flank past the backlash.
+
 phi_m is the mesh phase (mesh cycles) from the sun or ring spin, each planet phased by its position
 (sun mesh: z_s (theta_s - psi_i) / 2 pi; ring mesh: -z_r (theta_r - psi_i) / 2 pi + outer-inner phase).
 The teeth start in contact with zero load (delta = 0 on the driving flank). Tooth friction
@@ -38,7 +46,8 @@ import numpy as np
 import pandas as pd
 
 from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
-from flexgear.laws.compiled import backlash_linear_force, padded_sparse_rows, ramp_state
+from flexgear.laws.compiled import backlash_linear_force, impact_normal_force, padded_sparse_rows, ramp_state
+from flexgear.laws.contact import mesh_laws
 from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
@@ -48,7 +57,7 @@ from flexgear.theory import theory
 __all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces"]
 
 # layout of the float parameter vector handed to the compiled kernel
-_MU, _W_IN, _T_RAMP, _R_C, _T_LOAD, _LOAD_SIGN, _NFP = range(7)
+_MU, _W_IN, _T_RAMP, _R_C, _T_LOAD, _LOAD_SIGN, _IMPACT, _EXPONENT, _DEPTH, _NFP = range(10)
 # layout of the integer parameter vector
 _IN_SPIN, _OUT_SPIN, _IN_BODY, _OUT_BODY, _NIP = range(5)
 
@@ -76,6 +85,8 @@ class LumpedModel:
     friction_scale: np.ndarray  # (meshes,) p_bt / (|g1| v_reg)
     ground_damping: np.ndarray  # (3,) bearing damping of the central members [N s/m]
     spin_support: np.ndarray  # (n,) torsional support stiffness on spins (absolute angle)
+    mesh_k: np.ndarray  # (meshes,) the law's stiffness: eq. 10 [N/m], or the impact law's [N/m^e]
+    mesh_c: np.ndarray  # (meshes,) the law's damping: eq. 13 [N s/m], or the impact law's c_max [N s/m]
 
 
 def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
@@ -97,6 +108,11 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
     fp[_T_LOAD] = lc.load_torque_nm
     fp[_LOAD_SIGN] = -math.copysign(1.0, th.ratio)
     ip = np.array([2, out_spin, 0, 1 if star else 2], dtype=np.int64)
+    mesh_k, mesh_c = sysm.mesh_stiffness, sysm.mesh_damping
+    if spec.contact.law == "impact":  # the multibody model's law, whole face width, on every mesh
+        law = mesh_laws(spec)["outer"]
+        fp[_IMPACT], fp[_EXPONENT], fp[_DEPTH] = 1.0, law.exponent, law.penetration_depth
+        mesh_k, mesh_c = np.full_like(mesh_k, law.stiffness), np.full_like(mesh_c, law.damping_max)
 
     presc = np.flatnonzero(sysm.held_spin)
     coef = np.array([(1.0 - r_c) if i == 2 else -r_c for i in presc])
@@ -129,7 +145,7 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
         np.concatenate(centre), phase_index, phase_coef, phase_offset,
         np.full(2 * nplan, geo.sun_planet.normal_backlash), np.ascontiguousarray(tables),
         np.r_[np.zeros(nplan), np.ones(nplan)].astype(np.int64), np.ascontiguousarray(jn), g1, fscale, ground,
-        spin_support,
+        spin_support, mesh_k, mesh_c,
     )
 
 
@@ -203,7 +219,15 @@ def _evaluate(t, y, model, work):
         for h in range(harm.shape[1]):
             kf += harm[m, h] * ch
             ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
-        F = backlash_linear_force(d, dd, km[m] * kf, cm[m], backlash[m])
+        if fp[_IMPACT] > 0.0:  # the impact law on the driving flank, mirrored on the back flank
+            if d >= 0.0:
+                F = impact_normal_force(d, dd, km[m] * kf, fp[_EXPONENT], cm[m], fp[_DEPTH])
+            elif d < -backlash[m]:
+                F = -impact_normal_force(-d - backlash[m], -dd, km[m] * kf, fp[_EXPONENT], cm[m], fp[_DEPTH])
+            else:
+                F = 0.0
+        else:
+            F = backlash_linear_force(d, dd, km[m] * kf, cm[m], backlash[m])
         forces[m] = F
         for k in range(gidx.shape[1]):
             f[gidx[m, k]] -= F * gval[m, k]
@@ -314,8 +338,8 @@ def _phase_groups(model: LumpedModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
 def _kernel_args(model: LumpedModel) -> tuple:
     s = model.system
     return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
-            *padded_sparse_rows(s.mesh_G), s.mesh_stiffness,
-            s.mesh_damping, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
+            *padded_sparse_rows(s.mesh_G), model.mesh_k,
+            model.mesh_c, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
             model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
             model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
             s.nominal_position, s.free & (s.mass > 0.0), *_phase_groups(model))

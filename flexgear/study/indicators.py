@@ -128,8 +128,7 @@ def on_scale(key: str, scale: str, samples: np.ndarray) -> np.ndarray:
     - "relative": unchanged (the bias is then relative to the reference's value);
     - "load": % of the mean tooth load: the ripples are that already (RMS alternating load / mean load), a load
       factor K (K_gamma, K_v) becomes 100 K, so that a difference is the extra load in % of the mean load;
-    - "db": 20 log10(x / 1 m/s^2), vibration level in dB (amplitudes below LEVEL_FLOOR_M_PER_S2 at the floor);
-    - "um": the displacement in um.
+    - "db": 20 log10(x / 1 m/s^2), vibration level in dB (amplitudes below LEVEL_FLOOR_M_PER_S2 at the floor).
     """
     x = np.asarray(samples, dtype=float)
     if scale == "relative":
@@ -138,6 +137,4 @@ def on_scale(key: str, scale: str, samples: np.ndarray) -> np.ndarray:
         return x if key.endswith("_ripple") else 100.0 * x
     if scale == "db":
         return 20.0 * np.log10(np.maximum(np.abs(x), LEVEL_FLOOR_M_PER_S2))
-    if scale == "um":
-        return 1e6 * x
-    raise ValueError(f"unknown indicator scale {scale!r}; allowed: relative, load, db, um")
+    raise ValueError(f"unknown indicator scale {scale!r}; allowed: relative, load, db")

@@ -173,7 +173,7 @@ def cv_pct(samples: np.ndarray) -> float:
 @dataclass(frozen=True)
 class IndicatorResult:
     """One indicator of one run on its judging scale: target (theory or the reference), mean of the samples,
-    Bias, CV and TEa in ``unit`` ("%" relative to the target, "% of load", "dB", "um"), and the samples."""
+    Bias, CV and TEa in ``unit`` ("%" relative to the target, "% of load", "dB"), and the samples."""
 
     name: str
     theory: float
@@ -213,7 +213,7 @@ def indicator_samples(result: RunResult, settings: ScreeningSettings, keys: tupl
     return window, indicator_segments(result.signals, slices, f_mesh, keys)
 
 
-_UNITS = {"relative": "%", "load": "% of load", "db": "dB", "um": "um"}
+_UNITS = {"relative": "%", "load": "% of load", "db": "dB"}
 
 
 def scaled_bias_cv(samples: np.ndarray, target: float, scale: str) -> tuple[float, float]:
