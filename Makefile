@@ -14,6 +14,7 @@ STAMP := $(VENV)/.flexgear-installed
 PYTHON_CANDIDATES := $(PYTHON) python3 python3.13 python3.12 python3.11 /usr/bin/python3
 VARIANTS := $(sort $(wildcard model_variants/model*.toml))
 QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
+QUICK_ISO_VARIANTS := $(sort $(wildcard model_variants/quick_iso6336/model*.toml))
 RESULTS ?= results
 # pytest-xdist worker processes of `make test` (the machine's 2 cores; `make test TEST_WORKERS=auto` for all)
 TEST_WORKERS ?= 2
@@ -23,9 +24,11 @@ TEST_WORKERS ?= 2
 quick: install
 	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
 	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7
+	$(PY) -m flexgear.cli matrix $(QUICK_ISO_VARIANTS) --out $(RESULTS)/quick_iso6336 --reference model7
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width
-	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf --westgard-png docs/img/westgard.png
+	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf --westgard-png docs/img/westgard.png \
+		--also $(RESULTS)/quick_iso6336 $(RESULTS)/full
 
 install: $(STAMP)
 
@@ -53,10 +56,11 @@ meshes: install
 
 matrix: install
 	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7 --t-end settled
-	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full
+	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full --t-end settled
 
 report: install
-	$(PY) -m flexgear.cli report $(RESULTS)/full --output reports/screening_report.pdf
+	$(PY) -m flexgear.cli report $(RESULTS)/full --output reports/full_screening_report.pdf --also $(RESULTS)/quick \
+		$(RESULTS)/quick_iso6336
 
 lpm: install
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full

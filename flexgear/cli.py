@@ -121,7 +121,7 @@ def cmd_sweep(a: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------- lpm
 def _args_lpm(p: argparse.ArgumentParser) -> None:
     p.add_argument("gearbox", help="gearbox file, or a variant file (its gearbox with its overrides)")
-    p.add_argument("--t-end", type=float, default=None, metavar="S", help=T_END_HELP)
+    p.add_argument("--t-end", type=_t_end, default=None, metavar="S", help=T_END_HELP)
     p.add_argument("--out", default="results", metavar="DIR",
                    help="results folder; the run goes to OUT/lumped/ (default: %(default)s)")
 
@@ -216,6 +216,9 @@ def _args_report(p: argparse.ArgumentParser) -> None:
                    help="PDF to write (default: %(default)s)")
     p.add_argument("--westgard-png", default=None, metavar="FILE",
                    help="also write the verdict's Westgard diagram as a PNG (default: none)")
+    p.add_argument("--also", nargs="*", default=[], metavar="DIR",
+                   help="results folders of other load cases or contact laws: their verdicts beside this one on "
+                        "page 1 (a missing folder is skipped)")
 
 
 def cmd_report(a: argparse.Namespace) -> int:
@@ -223,7 +226,7 @@ def cmd_report(a: argparse.Namespace) -> int:
 
     if not Path(a.results).is_dir():
         raise FileNotFoundError(f"{a.results}: expected the results folder of a matrix")
-    path = build_report(Path(a.results), Path(a.output), a.westgard_png)
+    path = build_report(Path(a.results), Path(a.output), a.westgard_png, tuple(a.also))
     print(f"report -> {path}")
     return 0
 

@@ -371,10 +371,16 @@ def _simulate(model: LumpedModel, t_end: float, h_out: float, substeps: int, pro
     return rec
 
 
-def run_lumped(spec: GearboxSpec, t_end_s: float | None = None, progress: bool = False) -> RunResult:
-    """Run the lumped model for the spec's load case; signals as the multibody runs (flexgear.results)."""
+def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: bool = False) -> RunResult:
+    """Run the lumped model for the spec's load case; signals as the multibody runs (flexgear.results).
+
+    ``t_end_s`` "settled" (or None with ``[load_case] end = "settled"``): to ``settle_max_time_s``, so that its run
+    covers the multibody runs' settled windows (the lumped model costs seconds, not minutes)."""
     lc = spec.load_case
-    t_end = lc.end_time_s if t_end_s is None else float(t_end_s)
+    if t_end_s == "settled" or (t_end_s is None and lc.end == "settled"):
+        t_end = lc.settle_max_time_s
+    else:
+        t_end = lc.end_time_s if t_end_s is None else float(t_end_s)
     if t_end <= 0.0:
         raise ValueError(f"t_end_s: expected > 0, got {t_end}")
     wall0, cpu0 = time.perf_counter(), time.process_time()

@@ -16,6 +16,7 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
+import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -96,7 +97,8 @@ def verdict_lines(d: ReportData) -> list[str]:
         ref_row = tab[tab["variant"] == s.reference]
         faster = (f", {float(ref_row['time_s'].iloc[0]) / row['time_s']:.3g}x faster than {s.reference}"
                   if len(ref_row) and sel.variant != s.reference else "")
-        lines.append(f"Zone '{row['zone']}', distance {row['distance_pct']:.3g} {s.lines.unit}{faster}.")
+        lines.append(f"Zone '{row['zone']}', distance {row['distance_pct']:.3g} {s.lines.unit}{faster}."
+                     + (f" Outside their own TEa: {row['outside_tea']}." if row.get("outside_tea") else ""))
     else:
         lines.append(sel.reasoning.split(". ")[0][:180] + ".")
     unscreened = tab[tab["status"] != "ok"]
@@ -105,8 +107,29 @@ def verdict_lines(d: ReportData) -> list[str]:
     return lines[:3]
 
 
-def _verdict_page(d: ReportData) -> Callable[[Figure], None]:
-    """Page 1: the verdict in at most three lines, the Westgard diagram and a small table."""
+def case_summary(d: ReportData) -> str:
+    """The load case and law of a results folder's runs, in words (to tell two verdicts' cases apart)."""
+    laws = {((r.meta.get("spec") or {}).get("contact") or {}).get("law", "?") for r in d.runs.values()}
+    ramps = {r.meta.get("ramp_time_s") for r in d.runs.values()}
+    ends = [float(r.meta.get("t_end_s", math.nan)) for r in d.runs.values()]
+    return (f"{'/'.join(sorted(map(str, laws)))} law, ramps {'/'.join(fmt(x) for x in sorted(ramps, key=str))} s, "
+            f"runs to {fmt(min(ends))}-{fmt(max(ends))} s")
+
+
+def other_verdicts(d: ReportData, others: list[ReportData]) -> list[str]:
+    """One line per other results folder (another load case or law): its verdict, and whether it agrees."""
+    lines = []
+    for o in others:
+        verdict = "none" if o.refused else (o.selection.variant or "none")
+        same = verdict == ("none" if d.refused else (d.selection.variant or "none"))
+        lines.append(f"{o.results_dir.name} ({case_summary(o)}): verdict {verdict}"
+                     + ("" if o.selection.resolved else " (NOT RESOLVED)")
+                     + (" - the same." if same else " - DIFFERENT: the verdict depends on the load case or law."))
+    return lines
+
+
+def _verdict_page(d: ReportData, others: list[ReportData]) -> Callable[[Figure], None]:
+    """Page 1: the verdict in at most three lines, the Westgard diagram, a small table, the other cases' verdicts."""
     s = d.primary
     cols = {"variant": "variant", "zone": "zone", "distance_pct": f"distance [{s.lines.unit}]",
             "error_pct": f"± error [{s.lines.unit}]", "time_s": "run time [s]", "status": "status"}
@@ -115,9 +138,11 @@ def _verdict_page(d: ReportData) -> Callable[[Figure], None]:
 
     def draw(fig: Figure) -> None:
         fig.text(0.04, 0.90, "\n".join(verdict_lines(d)), fontsize=10.5, va="top", wrap=True)
-        ax = fig.add_axes([0.06, 0.08, 0.46, 0.68])
+        fig.text(0.04, 0.80, "\n".join([f"This case: {case_summary(d)}.", *other_verdicts(d, others)]), fontsize=8,
+                 va="top", color="#333333")
+        ax = fig.add_axes([0.06, 0.08, 0.46, 0.66])
         s.plot(ax, title="")
-        right = fig.add_axes([0.56, 0.08, 0.41, 0.68])
+        right = fig.add_axes([0.56, 0.08, 0.41, 0.66])
         right.axis("off")
         draw_table(right, tab.assign(**{c: [fmt(v, 4) if isinstance(v, float) else v for v in tab[c]]
                                          for c in tab.columns}), top=1.0, fontsize=7.5, wrap=18)
@@ -226,10 +251,12 @@ def _provenance_pages(d: ReportData) -> list[Page]:
 
 
 def build_report(results_dir: str | Path, output: str | Path = Path("reports/screening_report.pdf"),
-                 westgard_png: str | Path | None = None) -> Path:
+                 westgard_png: str | Path | None = None, also: tuple[str | Path, ...] = ()) -> Path:
     """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF): page 1 the verdict,
-    then the details, the assumptions in an appendix. ``westgard_png``: also the verdict's diagram as a PNG."""
+    then the details, the assumptions in an appendix. ``westgard_png``: also the verdict's diagram as a PNG.
+    ``also``: results folders of other load cases or laws whose verdicts page 1 sets beside this one."""
     d = gather(results_dir)
+    others = [gather(o) for o in also if Path(o).is_dir()]
     output = Path(output)
     created = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
     assumptions = documented_assumptions(d.gearbox_file)
@@ -244,7 +271,8 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
                         f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
     body += _provenance_pages(d)
     contents = [(i + 3, title) for i, (title, _) in enumerate(body)]
-    pages: list[Page] = [("flexgear screening report: verdict", _verdict_page(d)),
+    body = [page for o in others for page in rp.diagram_pages(o)[-1:]] + body
+    pages: list[Page] = [("flexgear screening report: verdict", _verdict_page(d, others)),
                          ("Runs, screening rule and contents", _title_page(d, contents, created)), *body]
     if westgard_png is not None:
         write_westgard_png(d, westgard_png)

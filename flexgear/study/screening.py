@@ -422,6 +422,9 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
     table = pd.DataFrame(rows).reindex(columns=columns)
     indicators = pd.DataFrame(ind_rows, columns=["variant", "indicator", "target", "mean", "bias", "cv", "tea", "unit",
                                                  "weight", "sigma", "zone"])
+    over = indicators[indicators["bias"] > indicators["tea"]]
+    table["outside_tea"] = [", ".join(f"{r.indicator} {r.bias:.3g} {r.unit} (TEa {r.tea:g})"
+                                      for r in over[over["variant"] == v].itertuples()) for v in table["variant"]]
     selection = select_variant(table, settings.selection, lines, ref_name)
     if ref_name:
         selection = Selection(selection.variant, selection.rule,
