@@ -78,6 +78,16 @@ def test_report_pages_and_key_text(results, tmp_path):
     assert stamps == {p: p.stat().st_mtime_ns for p in results.glob("*/run.json")}
 
 
+def test_report_sets_other_verdicts_beside_its_own(results, tmp_path):
+    """--also: another results folder's verdict on page 1 (the same folder: 'the same'); a missing one is skipped;
+    the Westgard PNG is written."""
+    png = tmp_path / "westgard.png"
+    pdf = build_report(results, tmp_path / "r.pdf", png, also=(results, tmp_path / "missing"))
+    first = PdfReader(pdf).pages[0].extract_text()
+    assert f"{results.name} (" in first and "verdict model3 - the same." in first
+    assert png.stat().st_size > 1000
+
+
 def test_documented_assumptions_lists_only_what_the_study_does_not_give():
     table = documented_assumptions(Path(GEARBOX)).set_index("key")
     assert "face_width_mm" in table.index and "ring_bolt_hole_diameter_mm" in table.index
