@@ -56,3 +56,36 @@ def test_a_settled_run_stops_where_the_settling_test_passes(model1):
     block = rule.block_mesh_cycles / res.meta["theory"]["mesh_frequency_hz"]
     assert res.meta["t_end_s"] - test.start_s >= rule.min_blocks * block - 1e-9
     assert res.meta["t_end_s"] < 0.5
+
+
+@pytest.mark.slow
+def test_verdicts_against_the_reference_at_half_the_step_are_unchanged_or_not_resolved(model1):
+    """Model 1 (ramps 10 ms) as the reference, run to 0.12 s and its window 0.12-0.15 s solved from there at h and
+    at h/2; two candidates run to 0.15 s: a numerical variant (spectral radius 0.6 instead of 0.8) and a physical
+    one (no tooth friction). Screened over 0.12-0.15 s against the reference's h window and against its h/2
+    window, each candidate's zone is the same, or the screening marks it not resolved (its zone changes within
+    the numerical error)."""
+    import dataclasses as dc
+
+    from flexgear.results import RunResult
+    from flexgear.study.screening import screen
+
+    base = _short(model1, end_time_s=0.15)
+    gb = base.gearbox
+    ref = run_variant(dc.replace(base, name="ref"), t_end_s=0.12, error_window_s=0.03)
+    radius = gb.with_fields("solver_assumed", spectral_radius=0.6)
+    frictionless = gb.with_fields("contact", friction_coefficient=0.0)
+    cands = [run_variant(dc.replace(base, name="radius", gearbox=radius)),
+             run_variant(dc.replace(base, name="frictionless", gearbox=frictionless))]
+    assert all(r.ok for r in (ref, *cands))
+    settings = dc.replace(gb.screening, window="fixed", window_start_s=0.12, window_end_s=0.15)
+    assert len(ref.extra["error_half_step"]) > 1.9 * len(ref.extra["error_step"])   # h/2: twice the points
+    zones = []
+    for window in ("error_step", "error_half_step"):
+        at = RunResult(ref.meta, ref.extra[window], {})
+        zones.append(screen([at, *cands], settings, reference="ref").table.set_index("variant")["zone"])
+    with_error = screen([RunResult(ref.meta, ref.extra["error_step"], ref.extra), *cands], settings,
+                        reference="ref").table.set_index("variant")
+    assert (with_error["error_pct"].dropna() > 0).all()
+    for name in ("radius", "frictionless"):
+        assert zones[0][name] == zones[1][name] or not with_error.loc[name, "resolved"], name
