@@ -1,0 +1,514 @@
+"""Steady harmonic response of the star gearbox to the transmission-error excitation, over a speed grid.
+
+Excitation (first order in the stiffness variation). Each mesh contact carries the time-varying stiffness of
+eq. 11-12, k(t) = k_mean s(phi(t)), s(phi) = 1 + sum_h c_h cos(2 pi h (phi - phi_0)), with the mesh phase phi in
+mesh cycles advancing at the mesh frequency f_mesh = z_sun (n_in - n_carrier) / 60 [Hz] and each planet's meshes
+phased by the planet's position (the models' own phases: flexgear.mbs.gearbox.mesh_contacts,
+flexgear.lumped.run.build_lumped_model). About the static operating point under the load torque (deflection
+delta_0, force F_0 = F(delta_0) of the contact law, the mean stiffness) the contact force is
+
+    F(t) = F(delta_0 + x_delta) s(phi)  ~  F_0 + k_t x_delta + c x_delta' + F_0 (s(phi) - 1),
+
+k_t = dF/d delta at delta_0 the tangent stiffness (k_mean for the linear ISO 6336 law, 1.5 k delta_0^0.5 for the
+impact law), c the contact damping. The last term is the excitation: at harmonic h its complex amplitude is
+F_h = F_0 C_h = Delta k_h delta_0 (linear law) with C_h the complex Fourier coefficient of s at +h f_mesh, acting
+along the mesh's line of action (the generalised force -g F_h, g = d delta / dz). The products of the stiffness
+variation with the response (parametric terms, x_delta (s - 1)) are dropped: the result is exact to first order in
+the variation c_h and fails near the parametric instabilities (2 f_n / k = h f_mesh, combination resonances) and
+where the teeth lose contact (|F_dyn| comparable to F_0: the law's kink is not linearised).
+
+Response at each speed of the grid and each harmonic h = 1..H, omega = 2 pi h f_mesh(speed):
+
+    (-omega^2 M + i omega (D + G) + K) X_h = F_h                    (direct dense complex solve)
+
+with M, D, G, K the linearised model at that speed (multibody: flexgear.modal.linear.linearize, interpolated in the
+speed between a few linearisations; lumped: flexgear.lumped.model.assemble). Outputs (complex amplitudes of
+x(t) = Re(X e^{i omega t}); ``amplitude`` = |X|, ``phase`` = arg X [rad], time origin at mesh phase 0):
+
+- ``outer_mesh_force_<i>_n``, ``inner_mesh_force_<i>_n`` [N]: each mesh's dynamic normal force, the sum over its
+  contacts (helix halves) of F_dyn,h = (k_t + i omega c) x_delta,h + F_0 C_h (the direct stiffness-variation term
+  included: it is what a force sensor in the mesh reads);
+- ``outer_mesh_force_max_n``, ``inner_mesh_force_max_n`` [N]: the largest over the planets;
+- ``{input,output}_bearing_accel_{x,y}_m_per_s2`` [m/s^2]: -omega^2 X of the frame translation of the member
+  carrying the input/output bearing (flexgear.results.signal_columns: the gear-centre frame node);
+- ``transmission_error_m`` [m]: dynamic transmission error at the output, TE = -r_b,out theta_out sign(omega_out)
+  (flexgear.mbs.deflection.transmission_error: the input is prescribed, so its dynamic part is the output's);
+  the output member's frame spin (a flexible output shaft's elastic twist to its load seat is left out);
+- ``dynamic_factor`` [-] (``harmonic`` 0, the sum over harmonics): K_v = 1 + max over meshes of
+  sum_h |F_dyn,h| / F_static, the peak of the dynamic over the static mesh load if all harmonics peaked together
+  (an upper bound of the time signal's max(F)/mean(F), ISO 6336-1's K_v read as a peak factor).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+__all__ = ["Response", "harmonic_response", "lumped_harmonic_response", "mesh_frequency_hz", "INDICATOR_UNITS",
+           "DEFAULT_HARMONICS"]
+
+DEFAULT_HARMONICS = 10
+"""Mesh harmonics h = 1..H of the excitation and response."""
+
+RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
+
+INDICATOR_UNITS = {"mesh_force": "N", "bearing_accel": "m/s^2", "transmission_error": "m", "dynamic_factor": "-"}
+"""Unit of each family of indicators (by a part of the name)."""
+
+_TABLE_COLUMNS = ["speed_rpm", "harmonic", "frequency_hz", "indicator", "amplitude", "phase"]
+
+
+def _unit(indicator: str) -> str:
+    return next((u for key, u in INDICATOR_UNITS.items() if key in indicator), "")
+
+
+@dataclass
+class Response:
+    """Harmonic response over a speed grid (module docstring).
+
+    ``table``: one row per speed, harmonic and indicator: speed_rpm, harmonic (0 for sums over harmonics),
+    frequency_hz (h f_mesh), indicator, amplitude (SI units of the indicator), phase [rad]. ``static_forces_n``:
+    static normal force of each mesh [N]; ``mesh_frequency_hz_per_rpm``: f_mesh per input rpm [Hz/rpm];
+    ``wall_time_s``: time spent (linearisation and solves).
+    """
+
+    table: pd.DataFrame
+    model: str
+    static_forces_n: dict[str, float] = field(default_factory=dict)
+    mesh_frequency_hz_per_rpm: float = 0.0
+    wall_time_s: float = 0.0
+
+    @property
+    def indicators(self) -> list[str]:
+        return list(dict.fromkeys(self.table["indicator"]))
+
+    @property
+    def speeds_rpm(self) -> np.ndarray:
+        return np.unique(self.table["speed_rpm"].to_numpy())
+
+    def amplitudes(self, indicator: str) -> pd.DataFrame:
+        """Amplitude of ``indicator``: one row per speed [rpm], one column per harmonic."""
+        sel = self.table[self.table["indicator"] == indicator]
+        if sel.empty:
+            raise KeyError(f"no indicator {indicator!r}; known: {', '.join(self.indicators)}")
+        return sel.pivot(index="speed_rpm", columns="harmonic", values="amplitude")
+
+    def complex(self, indicator: str) -> pd.DataFrame:
+        """Complex amplitude (amplitude e^{i phase}) of ``indicator``: rows speeds, columns harmonics."""
+        sel = self.table[self.table["indicator"] == indicator]
+        values = sel["amplitude"].to_numpy() * np.exp(1j * sel["phase"].to_numpy())
+        return pd.DataFrame({"speed_rpm": sel["speed_rpm"].to_numpy(), "harmonic": sel["harmonic"].to_numpy(),
+                             "value": values}).pivot(index="speed_rpm", columns="harmonic", values="value")
+
+    def dynamic_factor(self) -> pd.Series:
+        """K_v per speed [rpm] (module docstring)."""
+        return self.amplitudes("dynamic_factor")[0]
+
+    def plot(self, ax: Any, indicator: str, harmonics: Sequence[int] | None = None) -> Any:
+        """Amplitude of ``indicator`` over the speed [rpm], one line per harmonic (``harmonics``: which, default
+        all; K_v one line); a mesh-frequency axis on top. Returns ``ax``."""
+        amp = self.amplitudes(indicator)
+        cols = [h for h in amp.columns if harmonics is None or h in harmonics]
+        for h in cols:
+            ax.plot(amp.index, amp[h], lw=1.0, label="sum" if h == 0 else f"{h}x mesh")
+        unit = _unit(indicator)
+        ax.set_xlabel("input speed [rpm]")
+        ax.set_ylabel(f"{indicator} [{unit}]" if unit else indicator)
+        ax.set_title(f"{self.model}: {indicator}")
+        if indicator != "dynamic_factor":
+            ax.set_yscale("log")
+        if len(cols) > 1:
+            ax.legend(fontsize="small", ncol=2)
+        if self.mesh_frequency_hz_per_rpm > 0.0:
+            k = self.mesh_frequency_hz_per_rpm
+            top = ax.secondary_xaxis("top", functions=(lambda n: n * k, lambda f: f / k))
+            top.set_xlabel("mesh frequency f_mesh [Hz]")
+        ax.grid(True, alpha=0.3)
+        return ax
+
+
+# --------------------------------------------------------------------------- the linear problem at one speed
+@dataclass
+class _Operating:
+    """The linearised model at one speed, with its excitation and outputs (all SI).
+
+    ``rows`` (n_c, n): contact deflection per coordinate; ``k_t``, ``c``, ``f0`` (n_c,): tangent stiffness,
+    damping, static force; ``coef`` (n_c, H): complex Fourier coefficient of s - 1 at +h f_mesh; ``mesh`` (n_c,):
+    index of each contact's mesh in ``mesh_names``; ``accel`` (4, n): input x, y and output x, y translation
+    per coordinate; ``te`` (n,): transmission error per coordinate; ``omega_mesh`` [rad/s].
+    """
+
+    mass: np.ndarray
+    damping: np.ndarray
+    stiffness: np.ndarray
+    rows: np.ndarray
+    k_t: np.ndarray
+    c: np.ndarray
+    f0: np.ndarray
+    coef: np.ndarray
+    mesh: np.ndarray
+    mesh_names: tuple[str, ...]
+    accel: np.ndarray
+    te: np.ndarray
+    omega_mesh: float
+
+
+_ACCEL = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
+
+
+def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
+    """Complex amplitudes (H,) of every indicator at one speed (module docstring)."""
+    h = np.arange(1, harmonics + 1)
+    w = h * op.omega_mesh
+    n = op.mass.shape[0]
+    a = (op.stiffness[None] - (w**2)[:, None, None] * op.mass[None]
+         + 1j * w[:, None, None] * op.damping[None])  # (H, n, n)
+    excite = op.f0[:, None] * op.coef  # (n_c, H): F_0 C_h
+    f = -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
+    x = np.linalg.solve(a, f[..., None])[..., 0] if n else np.zeros((harmonics, 0), complex)
+    delta = x @ op.rows.T  # (H, n_c)
+    contact = (op.k_t[None] + 1j * w[:, None] * op.c[None]) * delta + excite.T
+    out: dict[str, np.ndarray] = {}
+    for m, name in enumerate(op.mesh_names):
+        out[name] = contact[:, op.mesh == m].sum(axis=1)
+    acc = -(w**2)[:, None] * (x @ op.accel.T)
+    for k, name in enumerate(_ACCEL):
+        out[name] = acc[:, k]
+    out["transmission_error_m"] = x @ op.te
+    return out
+
+
+def _mesh_name(kind: str, i: int) -> str:
+    return f"{kind}_mesh_force_{i}_n"
+
+
+def _sweep(operating: Callable[[float], _Operating], speeds_rpm: Sequence[float], harmonics: int, model: str,
+           per_rpm: float, t0: float) -> Response:
+    """Solve every speed and gather the table."""
+    if harmonics < 1:
+        raise ValueError(f"harmonics: expected >= 1, got {harmonics}")
+    speeds = np.asarray(speeds_rpm, float)
+    if speeds.ndim != 1 or speeds.size == 0:
+        raise ValueError("speeds_rpm: expected a non-empty list of speeds")
+    h = np.arange(1, harmonics + 1)
+    parts: list[pd.DataFrame] = []
+    static: dict[str, float] = {}
+    for speed in speeds:
+        op = operating(float(speed))
+        out = _solve(op, harmonics)
+        static = {name: float(op.f0[op.mesh == m].sum()) for m, name in enumerate(op.mesh_names)}
+        for kind in ("outer", "inner"):  # the largest over the planets, per harmonic
+            names = [nm for nm in op.mesh_names if nm.startswith(f"{kind}_")]
+            if names:
+                stack = np.stack([out[nm] for nm in names])
+                out[f"{kind}_mesh_force_max_n"] = stack[np.abs(stack).argmax(axis=0), np.arange(harmonics)]
+        freq = h * op.omega_mesh / (2.0 * math.pi)
+        for name, values in out.items():
+            parts.append(pd.DataFrame({"speed_rpm": speed, "harmonic": h, "frequency_hz": freq, "indicator": name,
+                                       "amplitude": np.abs(values), "phase": np.angle(values)}))
+        kv = 1.0 + max(float(np.abs(out[nm]).sum()) / static[nm] for nm in op.mesh_names)
+        parts.append(pd.DataFrame({"speed_rpm": [speed], "harmonic": [0], "frequency_hz": [0.0],
+                                   "indicator": ["dynamic_factor"], "amplitude": [kv], "phase": [0.0]}))
+    table = pd.concat(parts, ignore_index=True)[_TABLE_COLUMNS]
+    return Response(table, model, static, per_rpm, time.perf_counter() - t0)
+
+
+def mesh_frequency_hz(spec: Any, speed_rpm: float) -> float:
+    """f_mesh = z_sun (n_in - n_carrier) / 60 [Hz] at the input speed ``speed_rpm`` (carrier speed from the
+    arrangement: fixed for the star, z_s / (z_s + z_r) of the input for the planetary)."""
+    g = spec.gears
+    r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
+
+
+def _excited(spec: Any, harmonics: int) -> Any:
+    """The spec with ``harmonics`` stiffness harmonics from the contact lines (eq. 11-12)."""
+    spec = spec.with_fields("contact_assumed", stiffness_harmonics=int(harmonics))
+    if spec.contact_assumed.stiffness_variation == "constant":
+        spec = spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
+    return spec
+
+
+def _series_coefficients(cos_c: np.ndarray, sin_c: np.ndarray, offset_cycles: np.ndarray,
+                         rate_sign: np.ndarray) -> np.ndarray:
+    """Complex coefficients (n_c, H) at +h f_mesh of s(phi) - 1 = sum_h a_h cos 2 pi h phi + b_h sin 2 pi h phi,
+    phi = |rate| t sign + offset: (a_h - i b_h) e^{i 2 pi h offset}, conjugated where the phase runs backwards."""
+    h = np.arange(1, cos_c.shape[1] + 1)
+    c = (cos_c - 1j * sin_c) * np.exp(2j * np.pi * h[None] * offset_cycles[:, None])
+    return np.where(rate_sign[:, None] >= 0, c, c.conj())
+
+
+# --------------------------------------------------------------------------- lumped model
+def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS) -> Response:
+    """Harmonic response of the lumped model of ``spec`` (a flexgear.spec.GearboxSpec) at ``speeds_rpm`` [rpm].
+
+    The time model's equations (flexgear.lumped.run) linearised about the static equilibrium under the load
+    torque: input spin held (the prescribed drive), mean mesh stiffness, friction left out. The contact law is the
+    spec's (``[contact] law``): ISO 6336 (F = k delta, k_t = k, damping of eq. 13) or the impact law (F = k
+    delta^e, k_t = e F_0 / delta_0, damping c_max STEP(delta_0, 0, 0, d, 1)). The stiffness harmonics c_h
+    (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model. A
+    rotating carrier (planetary arrangement) adds its Coriolis, centripetal and bearing-damping terms; then the
+    bearing accelerations are in the carrier frame.
+    """
+    from flexgear.lumped.run import (
+        _DEPTH,
+        _EXPONENT,
+        _IMPACT,
+        _IN_BODY,
+        _LOAD_SIGN,
+        _OUT_BODY,
+        _OUT_SPIN,
+        _T_LOAD,
+        build_lumped_model,
+    )
+    from flexgear.theory import theory
+
+    t0 = time.perf_counter()
+    spec = _excited(spec, harmonics)
+    model = build_lumped_model(spec)
+    s = model.system
+    p = s.params
+    g = spec.gears
+    star = g.arrangement == "star"
+    r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    free = model.free
+    nf = free.size
+    rows = s.mesh_G[:, free]
+    nmesh = rows.shape[0]
+    impact = model.fp[_IMPACT] > 0.0
+    exponent = float(model.fp[_EXPONENT]) if impact else 1.0
+    depth = float(model.fp[_DEPTH])
+    k_law, c_law = model.mesh_k, model.mesh_c
+
+    # static equilibrium under the load (mean stiffness, no friction): K_s q + G^T F(G q) = T (Newton)
+    load = np.zeros(s.n)
+    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    ks = s.support_stiffness[np.ix_(free, free)]
+    q = np.linalg.solve(s.stiffness()[np.ix_(free, free)], load[free])
+    for _ in range(100):
+        d = np.maximum(rows @ q, 0.0)
+        force = k_law * d**exponent
+        tangent = exponent * k_law * d ** (exponent - 1.0) if impact else k_law
+        resid = ks @ q + rows.T @ force - load[free]
+        step = np.linalg.solve(ks + (rows.T * tangent) @ rows, resid)
+        q = q - step
+        if np.abs(step).max() <= 1e-13 * max(np.abs(q).max(), 1e-30):
+            break
+    delta0 = rows @ q
+    if np.any(delta0 <= 0.0):
+        raise ValueError("lumped model: a mesh is unloaded at the operating point")
+    f0 = k_law * delta0**exponent
+    k_t = exponent * f0 / delta0
+    if impact:
+        ramp = np.minimum(delta0 / depth, 1.0)
+        c = c_law * ramp * ramp * (3.0 - 2.0 * ramp)
+    else:
+        c = np.asarray(c_law, float)
+
+    # mesh phases: phase_m = coef_m q[index_m] + offset_m, the spin's nominal rate relative to the carrier frame
+    zs, zr = g.sun_teeth, g.ring_teeth
+    rel = {2: 1.0 - r_c, 5: -(zs / zr) * (1.0 - r_c)}  # sun and ring spin per input angle, carrier frame
+    rate = np.array([model.phase_coef[m] * rel[int(model.phase_index[m])] for m in range(nmesh)])
+    offset = model.phase_offset - model.phase_centre
+    cos_c = np.asarray(model.harmonics, float)
+    coef = _series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
+
+    n_pl = p.planet_count
+    names = tuple([_mesh_name("outer", i + 1) for i in range(n_pl)] + [_mesh_name("inner", i + 1) for i in range(n_pl)])
+    pos = {int(j): k for k, j in enumerate(free)}
+    accel = np.zeros((4, nf))
+    for k, b in enumerate((int(model.ip[_IN_BODY]), int(model.ip[_OUT_BODY]))):
+        for a in range(2):
+            if 3 * b + a in pos:
+                accel[2 * k + a, pos[3 * b + a]] = 1.0
+    th = theory(spec)
+    r_out = p.ring.radius_m if star else p.carrier.radius_m
+    te = np.zeros(nf)
+    out_spin = int(model.ip[_OUT_SPIN])
+    if out_spin in pos:
+        te[pos[out_spin]] = -r_out * math.copysign(1.0, th.output_speed)
+    mass = np.diag(s.mass[free])
+    base_k = ks + (rows.T * k_t) @ rows
+    base_d = s.support_damping[np.ix_(free, free)] + (rows.T * c) @ rows
+
+    def operating(speed_rpm: float) -> _Operating:
+        w_in = speed_rpm * RPM
+        om = r_c * w_in
+        gyro = np.zeros((nf, nf))
+        kk = base_k.copy()
+        if om != 0.0:  # rotating frame: m (x'' - 2 Om y' - Om^2 x), ground bearings damp x' + Om J x
+            for j in free:
+                if j % 3 == 0 and j + 1 in pos and s.mass[j] > 0.0:
+                    ix, iy = pos[j], pos[j + 1]
+                    m = s.mass[j]
+                    gyro[ix, iy], gyro[iy, ix] = -2.0 * m * om, 2.0 * m * om
+                    kk[ix, ix] -= m * om**2
+                    kk[iy, iy] -= m * om**2
+                    cg = s.ground_damping[j, j]
+                    kk[ix, iy] -= cg * om
+                    kk[iy, ix] += cg * om
+        omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
+        return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
+                          omega_mesh)
+
+    per_rpm = mesh_frequency_hz(spec, 1.0)
+    return _sweep(operating, speeds_rpm, harmonics, f"lumped ({Path(str(spec.source)).stem})", per_rpm, t0)
+
+
+# --------------------------------------------------------------------------- multibody model
+def _lagrange(nodes: np.ndarray, x: float) -> np.ndarray:
+    """Lagrange interpolation weights of ``nodes`` at ``x``."""
+    w = np.ones(nodes.size)
+    for k in range(nodes.size):
+        for j in range(nodes.size):
+            if j != k:
+                w[k] *= (x - nodes[j]) / (nodes[k] - nodes[j])
+    return w
+
+
+def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> tuple[np.ndarray, list[Any]]:
+    """(speeds [rpm] of the linearisations, the flexgear.modal.linear.LinearModel at each)."""
+    from flexgear.modal.linear import linearize
+
+    if linearization == "each":
+        nodes = np.unique(speeds_rpm)
+    elif linearization == "quadratic":
+        lo, hi = float(speeds_rpm.min()), float(speeds_rpm.max())
+        nodes = np.unique([lo, 0.5 * (lo + hi), hi])
+    else:
+        raise ValueError(f"linearization: expected 'quadratic' or 'each', got {linearization!r}")
+    models = [linearize(variant, speed_rpm=float(n)) for n in nodes]
+    first = models[0].coordinates
+    for lm in models[1:]:
+        if lm.coordinates != first:
+            raise ValueError("the linearisations at the interpolation speeds have different independent coordinates; "
+                             "use linearization='each'")
+    return nodes, models
+
+
+def _frame_row(lm: Any, components: Sequence[str], name: str) -> int:
+    """Index in the system coordinates of the first of ``components`` with a frame coordinate ``name``."""
+    for comp in components:
+        for i, c in enumerate(lm.full_coordinates):
+            if c.component == comp and c.kind == "frame" and c.name == name:
+                return i
+    raise ValueError(f"no frame coordinate {name} of {components} in the linearised model")
+
+
+def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS, *,
+                      linearization: str = "quadratic") -> Response:
+    """Harmonic response (module docstring) of a variant at ``speeds_rpm`` [rpm], mesh harmonics 1..``harmonics``.
+
+    ``model_or_variant``: a flexgear.spec.Variant or the path of its file (the multibody model, rigid or flexible,
+    through flexgear.modal.linear.linearize at the load case's torque); a flexgear.modal.linear.LinearModel (its
+    matrices at its own speed for every speed of the grid: spin terms frozen); or a flexgear.spec.GearboxSpec (the
+    lumped model: :func:`lumped_harmonic_response`).
+
+    ``linearization``: ``"quadratic"`` linearises at the grid's lowest, middle and highest speed and interpolates
+    M, D, G, K, the reduction basis and the static deflections quadratically in the speed (exact where they are
+    quadratic in Omega: gyroscopic terms ~ Omega, spin softening ~ Omega^2, a speed-independent operating point);
+    ``"each"`` linearises at every speed (about a second each for model 1).
+    """
+    from flexgear.modal.linear import LinearModel
+    from flexgear.spec import GearboxSpec, load_variant
+
+    if isinstance(model_or_variant, GearboxSpec):
+        return lumped_harmonic_response(model_or_variant, speeds_rpm, harmonics)
+    t0 = time.perf_counter()
+    speeds = np.asarray(speeds_rpm, float)
+    if speeds.ndim != 1 or speeds.size == 0:
+        raise ValueError("speeds_rpm: expected a non-empty list of speeds")
+    if isinstance(model_or_variant, LinearModel):
+        variant = model_or_variant.variant
+        nodes, models = np.array([model_or_variant.speed_rpm]), [model_or_variant]
+    else:
+        variant = model_or_variant if not isinstance(model_or_variant, str | Path) else load_variant(model_or_variant)
+        variant = dataclasses.replace(variant, gearbox=_excited(variant.gearbox, harmonics))
+        nodes, models = _linear_models(variant, speeds, linearization)
+    return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0)
+
+
+def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.ndarray, harmonics: int,
+               t0: float) -> Response:
+    from flexgear.geometry.involute import gear_set_geometry
+    from flexgear.laws.contact import normal_force
+    from flexgear.mbs.gearbox import mesh_contacts
+    from flexgear.theory import theory
+
+    spec = _excited(variant.gearbox, harmonics)
+    lc = spec.load_case
+    contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
+    lm = models[0]
+    names = list(lm.static_deflections)
+    if names != [c.name for c in contacts]:
+        raise ValueError("the linearised model's contacts differ from flexgear.mbs.gearbox.mesh_contacts")
+    rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
+    if len(rows) != len(contacts):
+        raise ValueError(f"{len(rows)} deflection coordinates for {len(contacts)} contacts")
+    for i, c in zip(rows, contacts, strict=True):  # outer_mesh_<i>_half<k> -> sun_planet_<i>.delta_<k>
+        kind, _, planet, half = c.name.split("_")
+        comp = f"sun_planet_{planet}" if kind == "outer" else f"planet_{planet}_ring"
+        if lm.full_coordinates[i].component != comp or lm.full_coordinates[i].name != f"delta_{half[4:]}":
+            raise ValueError(f"contact {c.name}: deflection coordinate {lm.full_coordinates[i].label}")
+    contact_mesh = [_mesh_name(c.name.split("_")[0], int(c.name.split("_")[2])) for c in contacts]
+    mesh_names = tuple(sorted(set(contact_mesh), key=lambda nm: (not nm.startswith("outer"), int(nm.split("_")[3]))))
+    mesh = np.array([mesh_names.index(nm) for nm in contact_mesh])
+    rate = np.array([c.phase_per_drive_angle for c in contacts]) * math.copysign(1.0, lc.input_speed_rad_s)
+    cos_c = np.stack([np.asarray(c.stiffness.cos_coeffs, float)[:harmonics] for c in contacts])
+    sin_c = np.stack([np.asarray(c.stiffness.sin_coeffs, float)[:harmonics] for c in contacts])
+    offset = -np.array([c.phase_offset for c in contacts])
+    coef = _series_coefficients(cos_c, sin_c, offset, np.sign(rate))
+    means = np.array([c.stiffness.mean for c in contacts])
+
+    full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
+    in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
+    out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
+    accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
+    out_row = _frame_row(lm, out_comp, "phi_z")
+    geo = gear_set_geometry(spec)
+    th = theory(spec)
+    r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
+    te_scale = -r_out * math.copysign(1.0, th.output_speed)
+
+    def law_terms(delta0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """F_0, k_t, c of every contact at its static deflection."""
+        f0, kt, cc = (np.zeros(len(contacts)) for _ in range(3))
+        for j, (c, d) in enumerate(zip(contacts, delta0, strict=True)):
+            f = float(normal_force(d, 0.0, c.law, means[j]))
+            eps = 1e-6 * d
+            kt[j] = float(normal_force(d + eps, 0.0, c.law, means[j]) - normal_force(d - eps, 0.0, c.law,
+                                                                                     means[j])) / (2 * eps)
+            v = 1e-9
+            cc[j] = float(normal_force(d, v, c.law, means[j]) - f) / v
+            f0[j] = f
+        if np.any(f0 <= 0.0):
+            raise ValueError("a contact is unloaded at the operating point: no first-order excitation")
+        return f0, kt, cc
+
+    deflections = [np.array([m.static_deflections[nm] for nm in names]) for m in models]
+    cache: dict[tuple[float, ...], tuple] = {}
+
+    def operating(speed_rpm: float) -> _Operating:
+        w = _lagrange(nodes, speed_rpm) if nodes.size > 1 else np.ones(1)
+        key = tuple(np.round(w, 15))
+        if key not in cache:
+            mix = lambda get: sum(wk * get(m) for wk, m in zip(w, models, strict=True))  # noqa: E731
+            basis = mix(lambda m: m.basis)
+            delta0 = sum(wk * d for wk, d in zip(w, deflections, strict=True))
+            f0, kt, cc = law_terms(delta0)
+            cache.clear()
+            cache[key] = (mix(lambda m: m.mass), mix(lambda m: m.damping + m.gyroscopic), mix(lambda m: m.stiffness),
+                          basis[rows], kt, cc, f0, basis[accel_rows], te_scale * basis[out_row])
+        mass, damp, stiff, g, kt, cc, f0, acc, te = cache[key]
+        omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
+        return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh)
+
+    return _sweep(operating, speeds, harmonics, variant.name, mesh_frequency_hz(spec, 1.0), t0)
