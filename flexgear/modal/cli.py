@@ -1,10 +1,21 @@
-"""Command line ``flexgear modes VARIANT [--speed-rpm R] [--f-max-hz F] [--out DIR]``.
+"""Command lines ``flexgear modes``, ``flexgear campbell`` and ``flexgear modal-screening``.
 
-Linearises the variant at its operating point (flexgear.modal.linear), prints one line per mode (frequency, damping
-ratio, kind, multiplet spread, the components holding most kinetic and strain energy) and writes
+``flexgear modes VARIANT [--speed-rpm R] [--f-max-hz F] [--out DIR]`` linearises the variant at its operating
+point (flexgear.modal.linear), prints one line per mode (frequency, damping ratio, kind, multiplet spread, the
+components holding most kinetic and strain energy) and writes
 DIR/<variant>/modes.csv (flexgear.modal.modes.Modes.table: mode, frequency_hz, damping_ratio, kind, multiplicity,
-spread_pct, kinetic_<component>, strain_<component>). The parser pieces follow flexgear.cli's pattern:
-:data:`SUBCOMMAND` (name, help, arguments, command) or :func:`add_parsers`.
+spread_pct, kinetic_<component>, strain_<component>).
+
+``flexgear campbell VARIANT [--speeds-rpm 0:6000:13] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell) writes
+DIR/<variant>/campbell.csv (speed_rpm, mode, frequency_hz, damping_ratio, kind), crossings.csv (speed_rpm, order,
+mode, kind, frequency_hz) and campbell.png.
+
+``flexgear modal-screening VARIANT [--f-band-hz F] [--threshold S] [--out DIR]`` (flexgear.modal.screening; VARIANT
+the all-flexible model 7) prints and writes DIR/<variant>/modal_screening.csv (component,
+weighted_elastic_strain_share, must_be_flexible) and the recommended Table 3 variant.
+
+The parser pieces follow flexgear.cli's pattern: :data:`SUBCOMMAND`, :data:`CAMPBELL`, :data:`SCREENING` (name,
+help, arguments, command) or :func:`add_parsers`.
 """
 
 from __future__ import annotations
@@ -12,7 +23,8 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-__all__ = ["SUBCOMMAND", "add_parsers", "args_modes", "cmd_modes"]
+__all__ = ["CAMPBELL", "SCREENING", "SUBCOMMAND", "add_parsers", "args_campbell", "args_modes", "args_screening",
+           "cmd_campbell", "cmd_modes", "cmd_screening", "speeds_rpm"]
 
 
 def args_modes(p: argparse.ArgumentParser) -> None:
@@ -54,9 +66,111 @@ SUBCOMMAND = ("modes", "natural frequencies, damping and mode kinds of a variant
               args_modes, cmd_modes)
 
 
+def speeds_rpm(text: str) -> list[float]:
+    """``--speeds-rpm``: ``START:STOP:COUNT`` (COUNT equally spaced speeds from START to STOP, both included) or a
+    comma-separated list, in rpm."""
+    try:
+        if ":" in text:
+            start, stop, count = text.split(":")
+            a, b, n = float(start), float(stop), int(count)
+            if n < 1:
+                raise ValueError
+            return [a + (b - a) * i / (n - 1) for i in range(n)] if n > 1 else [a]
+        return [float(x) for x in text.split(",")]
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected START:STOP:COUNT or a list a,b,c in rpm, got {text!r}") from None
+
+
+def args_campbell(p: argparse.ArgumentParser) -> None:
+    """The arguments of ``flexgear campbell``."""
+    p.add_argument("variant", help="variant file (model_variants/model1.toml ...)")
+    p.add_argument("--speeds-rpm", type=speeds_rpm, default=speeds_rpm("0:6000:13"), metavar="A:B:N",
+                   help="input speeds in rpm: N equally spaced from A to B, or a list a,b,c (default: 0:6000:13)")
+    p.add_argument("--f-max-hz", type=float, default=None, metavar="F",
+                   help="highest frequency in Hz (default: 10x the mesh frequency at the highest speed)")
+    p.add_argument("--out", default="results", metavar="DIR",
+                   help="results folder; OUT/<variant name>/campbell.csv, crossings.csv, campbell.png "
+                        "(default: %(default)s)")
+
+
+def cmd_campbell(a: argparse.Namespace) -> int:
+    """Run ``flexgear campbell``; returns the exit code."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    from flexgear.modal.campbell import campbell
+    from flexgear.spec import load_variant
+
+    variant = load_variant(a.variant)
+
+    def progress(speed: float, model, m) -> None:
+        print(f"{variant.name}: {speed:8.1f} rpm, {len(m)} modes, {model.n} coordinates", flush=True)
+
+    result = campbell(variant, a.speeds_rpm, a.f_max_hz, progress=progress)
+    out = Path(a.out) / variant.name
+    out.mkdir(parents=True, exist_ok=True)
+    result.table.to_csv(out / "campbell.csv", index=False)
+    result.crossings.to_csv(out / "crossings.csv", index=False)
+    fig, ax = plt.subplots(figsize=(9, 6))
+    result.plot(ax)
+    fig.tight_layout()
+    fig.savefig(out / "campbell.png", dpi=150)
+    plt.close(fig)
+    lines = result.table["mode"].nunique()
+    print(f"{variant.name}: {lines} lines up to {result.f_max_hz:g} Hz, {len(result.crossings)} crossings with "
+          f"orders 1x-{max(result.orders)}x (lowest MAC of a continuation {result.mac_min:.2f})")
+    print(f"-> {out / 'campbell.csv'}, {out / 'crossings.csv'}, {out / 'campbell.png'}")
+    return 0
+
+
+def args_screening(p: argparse.ArgumentParser) -> None:
+    """The arguments of ``flexgear modal-screening``."""
+    from flexgear.modal.screening import THRESHOLD
+
+    p.add_argument("variant", help="the all-flexible variant file (model_variants/model7.toml)")
+    p.add_argument("--f-band-hz", type=float, default=None, metavar="F",
+                   help="excitation band in Hz (default: 10x the mesh frequency at the load case's speed)")
+    p.add_argument("--threshold", type=float, default=THRESHOLD, metavar="S",
+                   help="weighted elastic strain share above which a component must be flexible "
+                        "(default: %(default)s)")
+    p.add_argument("--out", default="results", metavar="DIR",
+                   help="results folder; the table goes to OUT/<variant name>/modal_screening.csv "
+                        "(default: %(default)s)")
+
+
+def cmd_screening(a: argparse.Namespace) -> int:
+    """Run ``flexgear modal-screening``; returns the exit code."""
+    from flexgear.modal.screening import modal_screening
+    from flexgear.spec import load_variant
+
+    variant = load_variant(a.variant)
+    result = modal_screening(variant, a.f_band_hz, threshold=a.threshold)
+    out = Path(a.out) / variant.name
+    out.mkdir(parents=True, exist_ok=True)
+    result.table.to_csv(out / "modal_screening.csv", index=False)
+    print(f"{variant.name}: {len(result.weights)} modes up to {result.f_band_hz:g} Hz (mesh frequency "
+          f"{result.f_mesh_hz:g} Hz), threshold {result.threshold:g}")
+    for _, row in result.table.iterrows():
+        verdict = "must be flexible" if row.must_be_flexible else "may be rigid"
+        print(f"  {row.component:<13} {row.weighted_elastic_strain_share:7.4f}  {verdict}")
+    print(f"recommended: {result.recommended} ({result.reason})")
+    print(f"-> {out / 'modal_screening.csv'}")
+    return 0
+
+
+CAMPBELL = ("campbell", "Campbell diagram of a variant: natural frequencies against input speed, mesh-order "
+            "crossings", args_campbell, cmd_campbell)
+
+SCREENING = ("modal-screening", "which components must be flexible, from the all-flexible variant's modes in the "
+             "excitation band", args_screening, cmd_screening)
+
+
 def add_parsers(subparsers) -> None:
-    """Add ``modes`` to an ``argparse`` sub-parser set (``parser.add_subparsers()``)."""
-    name, help_text, add_args, func = SUBCOMMAND
-    sp = subparsers.add_parser(name, help=help_text, description=help_text)
-    add_args(sp)
-    sp.set_defaults(func=func)
+    """Add ``modes``, ``campbell`` and ``modal-screening`` to an ``argparse`` sub-parser set
+    (``parser.add_subparsers()``)."""
+    for name, help_text, add_args, func in (SUBCOMMAND, CAMPBELL, SCREENING):
+        sp = subparsers.add_parser(name, help=help_text, description=help_text)
+        add_args(sp)
+        sp.set_defaults(func=func)
