@@ -199,8 +199,17 @@ def _sweep(operating: Callable[[float], _Operating], speeds_rpm: Sequence[float]
     if speeds.ndim != 1 or speeds.size == 0:
         raise ValueError("speeds_rpm: expected a non-empty list of speeds")
     h = np.arange(1, harmonics + 1)
-    parts: list[pd.DataFrame] = []
+    columns: dict[str, list] = {c: [] for c in _TABLE_COLUMNS}
     static: dict[str, float] = {}
+
+    def put(speed: float, harm: np.ndarray, freq: np.ndarray, name: str, values: np.ndarray) -> None:
+        columns["speed_rpm"].append(np.full(harm.size, speed))
+        columns["harmonic"].append(harm)
+        columns["frequency_hz"].append(freq)
+        columns["indicator"].append(np.full(harm.size, name, dtype=object))
+        columns["amplitude"].append(np.abs(values))
+        columns["phase"].append(np.angle(values))
+
     for speed in speeds:
         op = operating(float(speed))
         out = _solve(op, harmonics)
@@ -212,12 +221,10 @@ def _sweep(operating: Callable[[float], _Operating], speeds_rpm: Sequence[float]
                 out[f"{kind}_mesh_force_max_n"] = stack[np.abs(stack).argmax(axis=0), np.arange(harmonics)]
         freq = h * op.omega_mesh / (2.0 * math.pi)
         for name, values in out.items():
-            parts.append(pd.DataFrame({"speed_rpm": speed, "harmonic": h, "frequency_hz": freq, "indicator": name,
-                                       "amplitude": np.abs(values), "phase": np.angle(values)}))
+            put(float(speed), h, freq, name, values)
         kv = 1.0 + max(float(np.abs(out[nm]).sum()) / static[nm] for nm in op.mesh_names)
-        parts.append(pd.DataFrame({"speed_rpm": [speed], "harmonic": [0], "frequency_hz": [0.0],
-                                   "indicator": ["dynamic_factor"], "amplitude": [kv], "phase": [0.0]}))
-    table = pd.concat(parts, ignore_index=True)[_TABLE_COLUMNS]
+        put(float(speed), np.zeros(1, int), np.zeros(1), "dynamic_factor", np.array([kv]))
+    table = pd.DataFrame({c: np.concatenate(v) for c, v in columns.items()})
     return Response(table, model, static, per_rpm, time.perf_counter() - t0)
 
 

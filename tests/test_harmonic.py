@@ -1,0 +1,162 @@
+"""Harmonic response to the transmission-error excitation (flexgear.harmonic) against the models' own physics.
+
+(1) The lumped model's frequency-domain mesh-force and bearing-acceleration amplitudes at 1x and 2x mesh against its
+    own time integration (flexgear.lumped.run, ISO 6336 law, contact-line stiffness variation, no friction), settled,
+    at speeds whose 1x and 2x mesh frequencies lie away from the natural frequencies: the first-order excitation
+    F_0 (s - 1) leaves out terms of order c_h^2 (c_1, c_2 ~ 0.05-0.1), so within 10 %.
+(2) Resonance: the mesh-force response of a harmonic peaks where a natural frequency of the linearised model
+    (flexgear.lumped.modal) equals h f_mesh, within the speed grid's step (lightly damped).
+(3) Mesh phasing of equally spaced planets (Parker 2004, sequential phasing z_s psi_i / 2 pi): harmonic h excites the
+    rotational modes only if h z_s / N is an integer, the translational ones only if (h z_s +- 1) / N is; with
+    z_s = 44, N = 5 the transmission error (output spin) vanishes at h = 1..4 and the central members' bearing
+    accelerations at h = 2, 3, 5.
+(4) The multibody model 1 (rigid) against its own time integration (flexgear.mbs.run.run_variant), as (1); and
+    against the lumped model at 2x mesh, which excites planet modes only (3): for them the lumped model is the
+    multibody model's in-plane part (tests/test_modal.py).
+"""
+
+import dataclasses
+import math
+
+import numpy as np
+import pytest
+
+from flexgear.harmonic import harmonic_response, lumped_harmonic_response, mesh_frequency_hz
+from flexgear.harmonic.cli import parse_speeds
+
+RAMP_S, END_S = 0.05, 0.25  # short load case: the ramps, then 0.2 s (the slowest decay time is about 33 ms)
+WINDOW_S = 0.1  # analysed: the last 0.1 s, a whole number of mesh cycles
+COLUMNS = ("outer_mesh_force_1_n", "inner_mesh_force_1_n", "input_bearing_accel_x_m_per_s2")
+
+
+@pytest.fixture(scope="module")
+def iso_spec(gearbox):
+    """The ISO 6336 law with the contact-line stiffness variation and no friction (the linearisation's scope)."""
+    spec = gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.0)
+    return spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
+
+
+def _time_amplitudes(spec, speed_rpm: float) -> dict[str, np.ndarray]:
+    """1x, 2x amplitudes of the settled time signals of the lumped model at ``speed_rpm``."""
+    from flexgear.lumped.run import run_lumped
+    from flexgear.study.compare import harmonic_amplitudes
+
+    spec = spec.with_fields("load_case", input_speed_rpm=speed_rpm, ramp_time_s=RAMP_S, end_time_s=END_S)
+    signals = run_lumped(spec).signals
+    dt = spec.load_case.step_size_s
+    f_mesh = mesh_frequency_hz(spec, speed_rpm)
+    n = int(math.floor(WINDOW_S * f_mesh) / f_mesh / dt)  # whole mesh cycles
+    return {c: harmonic_amplitudes(signals[c].to_numpy()[-n:], dt, f_mesh, (1, 2)) for c in COLUMNS}
+
+
+@pytest.mark.parametrize("speed_rpm", [1500.0, 3500.0, 4000.0])
+def test_lumped_frequency_domain_matches_time_integration(iso_spec, speed_rpm):
+    from flexgear.lumped.modal import modal_analysis
+
+    f_mesh = mesh_frequency_hz(iso_spec, speed_rpm)
+    modes = modal_analysis(iso_spec, hold_input=True).frequencies_hz
+    for h in (1, 2):  # the speed is away from resonance: no natural frequency within 2 % of h f_mesh
+        assert np.min(np.abs(modes / (h * f_mesh) - 1.0)) > 0.02
+    response = lumped_harmonic_response(iso_spec, [speed_rpm], harmonics=iso_spec.contact_assumed.stiffness_harmonics)
+    timed = _time_amplitudes(iso_spec, speed_rpm)
+    for column, amp in timed.items():
+        freq = response.amplitudes(column).iloc[0].to_numpy()[:2]
+        if column.startswith("input_bearing"):  # 2x excites no central-member translation (test 3)
+            freq, amp = freq[:1], amp[:1]
+        np.testing.assert_allclose(freq, amp, rtol=0.10, err_msg=f"{column} at {speed_rpm} rpm")
+
+
+def _lightly_damped(spec, factor: float = 0.1):
+    """``spec`` with the mesh damping ratio and the bearings' damping per stiffness scaled by ``factor``."""
+    spec = spec.with_fields("contact_assumed", mesh_damping_ratio=factor * spec.contact_assumed.mesh_damping_ratio)
+    b = spec.bearings
+    return spec.with_fields("bearings", **{
+        f.name: dataclasses.replace(getattr(b, f.name), damping_per_stiffness_s=factor * getattr(
+            b, f.name).damping_per_stiffness_s) for f in dataclasses.fields(b)})
+
+
+def test_lumped_response_peaks_at_natural_frequencies(iso_spec):
+    """Lightly damped (damping ratios about 1 %), the largest resonance peak of each harmonic lies at a natural
+    frequency up to the peak's shift of order zeta^2: within one step of a 10 rpm grid (0.07 Hz per rpm at 1x)."""
+    from flexgear.lumped.modal import modal_analysis
+
+    spec = _lightly_damped(iso_spec)
+    modes = modal_analysis(spec, hold_input=True).frequencies_hz
+    step = 10.0
+    speeds = np.arange(500.0, 7000.0 + step, step)
+    response = lumped_harmonic_response(spec, speeds, harmonics=4)
+    per_rpm = response.mesh_frequency_hz_per_rpm
+    for h in (1, 2, 3, 4):
+        amp = response.amplitudes("outer_mesh_force_1_n")[h].to_numpy()
+        inner = np.flatnonzero((amp[1:-1] > amp[:-2]) & (amp[1:-1] > amp[2:])) + 1
+        assert inner.size, f"{h}x: no resonance peak in {speeds[0]:g}-{speeds[-1]:g} rpm"
+        peak = inner[np.argmax(amp[inner])]  # the largest local maximum
+        resonant_rpm = modes / (h * per_rpm)  # speed at which h f_mesh = f_n
+        assert np.min(np.abs(resonant_rpm - speeds[peak])) <= step, (h, speeds[peak])
+
+
+def test_planet_phasing_selects_the_excited_modes(iso_spec):
+    response = lumped_harmonic_response(iso_spec, [1500.0, 4000.0], harmonics=5)
+    force = response.amplitudes("outer_mesh_force_1_n").to_numpy()
+    te = response.amplitudes("transmission_error_m").to_numpy()
+    accel = np.maximum(response.amplitudes("input_bearing_accel_x_m_per_s2").to_numpy(),
+                       response.amplitudes("output_bearing_accel_y_m_per_s2").to_numpy())
+    assert np.all(force > 0.0)
+    te_scale = te.max()
+    accel_scale = accel.max()
+    assert np.all(te[:, :4] < 1e-9 * te_scale) and np.all(te[:, 4] > 1e-3 * te_scale)  # h = 1..4 off, 5 on
+    assert np.all(accel[:, [1, 2, 4]] < 1e-9 * accel_scale)  # h = 2, 3, 5 off
+    assert np.all(accel[:, [0, 3]] > 1e-3 * accel_scale)  # h = 1, 4 on
+
+
+def test_dynamic_factor_and_table(iso_spec):
+    response = lumped_harmonic_response(iso_spec, [2000.0, 4000.0], harmonics=3)
+    assert list(response.table.columns) == ["speed_rpm", "harmonic", "frequency_hz", "indicator", "amplitude", "phase"]
+    kv = response.dynamic_factor()
+    for speed, value in kv.items():  # K_v = 1 + max over meshes of sum_h |F_h| / F_static
+        sums = [response.amplitudes(m).loc[speed].sum() / f0 for m, f0 in response.static_forces_n.items()]
+        assert value == pytest.approx(1.0 + max(sums), rel=1e-12)
+    from flexgear.theory import theory
+
+    th = theory(iso_spec)  # the static mesh force balances the input torque: F_0 = T_in / (N r_bs cos beta_b)
+    assert np.mean(list(response.static_forces_n.values())) == pytest.approx(th.mesh_force, rel=1e-6)
+
+
+def test_model1_matches_lumped_model_at_2x(model1, iso_spec):
+    variant = dataclasses.replace(model1, gearbox=iso_spec)
+    speeds = [1500.0, 4000.0]
+    mbs = harmonic_response(variant, speeds, harmonics=2)
+    lumped = lumped_harmonic_response(iso_spec, speeds, harmonics=2)
+    for column in ("outer_mesh_force_1_n", "inner_mesh_force_3_n"):
+        np.testing.assert_allclose(mbs.amplitudes(column)[2], lumped.amplitudes(column)[2], rtol=0.02)
+    assert mbs.static_forces_n["outer_mesh_force_1_n"] == pytest.approx(
+        lumped.static_forces_n["outer_mesh_force_1_n"], rel=1e-4)
+
+
+def test_parse_speeds():
+    assert parse_speeds("500:7000:200")[:2] == [500.0, 700.0]
+    assert parse_speeds("500:7000:200")[-1] == 6900.0
+    assert parse_speeds("1000:2000:500") == [1000.0, 1500.0, 2000.0]
+    assert parse_speeds("1000,3000") == [1000.0, 3000.0]
+
+
+@pytest.mark.parametrize("speed_rpm", [1500.0, 4000.0])
+def test_model1_frequency_domain_matches_time_integration(model1, iso_spec, speed_rpm):
+    from flexgear.mbs.run import run_variant
+    from flexgear.study.compare import harmonic_amplitudes
+
+    spec = iso_spec.with_fields("load_case", input_speed_rpm=speed_rpm, ramp_time_s=0.03, end_time_s=0.15)
+    variant = dataclasses.replace(model1, gearbox=spec)
+    response = harmonic_response(variant, [speed_rpm], harmonics=spec.contact_assumed.stiffness_harmonics)
+    result = run_variant(variant)
+    assert result.ok, result.meta.get("reason")
+    t = result.signals["time_s"].to_numpy()
+    dt = float(t[1] - t[0])
+    f_mesh = mesh_frequency_hz(spec, speed_rpm)
+    n = int(math.floor(0.05 * f_mesh) / f_mesh / dt)  # the last 0.05 s, whole mesh cycles
+    for column in COLUMNS:
+        timed = harmonic_amplitudes(result.signals[column].to_numpy()[-n:], dt, f_mesh, (1, 2))
+        freq = response.amplitudes(column).iloc[0].to_numpy()[:2]
+        if column.startswith("input_bearing"):
+            freq, timed = freq[:1], timed[:1]
+        np.testing.assert_allclose(freq, timed, rtol=0.10, err_msg=f"{column} at {speed_rpm} rpm")
