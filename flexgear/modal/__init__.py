@@ -11,16 +11,19 @@ imported on first use (PEP 562), so that the command line's parser (flexgear.mod
 from importlib import import_module
 
 _LAZY = {"Coordinate": "linear", "LinearModel": "linear", "linearize": "linear", "Modes": "modes", "modes": "modes",
-         "Campbell": "campbell", "campbell": "campbell", "ModalScreening": "screening",
-         "modal_screening": "screening"}
+         "Campbell": "campbell", "campbell": "campbell", "mesh_frequency_hz": "campbell", "resonant": "campbell",
+         "ModalScreening": "screening", "modal_screening": "screening"}
 
 __all__ = ["Campbell", "Coordinate", "LinearModel", "ModalScreening", "Modes", "campbell", "linearize",
-           "modal_screening", "modes"]
+           "mesh_frequency_hz", "modal_screening", "modes", "resonant"]
 
 
 def __getattr__(name: str):
     if name in _LAZY:
-        value = getattr(import_module(f"flexgear.modal.{_LAZY[name]}"), name)
-        globals()[name] = value
-        return value
+        module = import_module(f"flexgear.modal.{_LAZY[name]}")
+        # every name of that submodule at once: importing flexgear.modal.modes (.campbell) binds the package's
+        # ``modes`` (``campbell``) to the submodule, which the function of the same name must replace; within the
+        # package these names are imported from here, so that the functions keep them
+        globals().update({n: getattr(module, n) for n, m in _LAZY.items() if m == _LAZY[name]})
+        return globals()[name]
     raise AttributeError(f"module 'flexgear.modal' has no attribute {name!r}")

@@ -37,8 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
-from flexgear.modal.linear import LinearModel
-from flexgear.modal.modes import Modes
+from flexgear.modal import LinearModel, Modes
 from flexgear.schema import GearboxSpec, Variant
 
 __all__ = ["Campbell", "campbell", "mesh_frequency_hz", "track", "MESH_ORDERS", "MAX_DAMPING_RATIO", "MAC_MIN"]
@@ -183,8 +182,7 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
     ``f_max_hz`` [Hz]: the band (default: the highest order's mesh frequency at the highest speed, max(orders)
     f_m(n_max): no order crosses above it); ``progress(speed_rpm, model, modes)`` is called after each speed.
     """
-    from flexgear.modal.linear import linearize
-    from flexgear.modal.modes import modes
+    from flexgear.modal import linearize, modes
 
     speeds = np.sort(np.asarray(speeds_rpm, float))
     if speeds.size == 0 or np.any(speeds < 0.0) or np.any(np.diff(speeds) == 0.0):

@@ -100,7 +100,7 @@ def cmd_campbell(a: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from flexgear.modal.campbell import campbell
+    from flexgear.modal import campbell
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)
@@ -142,7 +142,7 @@ def args_screening(p: argparse.ArgumentParser) -> None:
 
 def cmd_screening(a: argparse.Namespace) -> int:
     """Run ``flexgear modal-screening``; returns the exit code."""
-    from flexgear.modal.screening import modal_screening
+    from flexgear.modal import modal_screening
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)

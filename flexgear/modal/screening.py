@@ -43,8 +43,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from flexgear.modal.linear import LinearModel
-from flexgear.modal.modes import Modes
+from flexgear.modal import LinearModel, Modes
 from flexgear.schema import Variant
 
 __all__ = ["ModalScreening", "modal_screening", "amplification", "THRESHOLD", "TABLE3_COMPONENTS"]
@@ -129,9 +128,7 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     the share above which a component must be flexible; ``variants_dir``: the folder of Table 3's variant files
     (default: the variant file's own folder).
     """
-    from flexgear.modal.campbell import mesh_frequency_hz, resonant
-    from flexgear.modal.linear import linearize
-    from flexgear.modal.modes import modes
+    from flexgear.modal import linearize, mesh_frequency_hz, modes, resonant
 
     model = variant_flexible_all if isinstance(variant_flexible_all, LinearModel) else linearize(variant_flexible_all)
     variant = model.variant
