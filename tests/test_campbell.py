@@ -85,10 +85,10 @@ def test_translational_pair_splits_with_speed(diagram):
 def test_campbell_command_writes_files(tmp_path, capsys):
     from flexgear.modal.cli import CAMPBELL, add_parsers
 
-    variant = tmp_path / "model1_exact.toml"
-    variant.write_text(f'name = "model1_exact"\ngearbox = "{(VARIANTS / "gearbox.toml").as_posix()}"\n'
-                       'rigid_mass_properties = "exact"\n[components]\ninput_shaft = "rigid"\nsun = "rigid"\n'
-                       'planets = "rigid"\nring = "rigid"\noutput_shaft = "rigid"\n')
+    variant = tmp_path / "model1_exact.toml"  # model 1 on the exact geometry's mass properties: no meshes
+    text = (VARIANTS / "model1.toml").read_text().replace('name = "model1"', 'name = "model1_exact"')
+    text = text.replace('gearbox = "gearbox.toml"', f'gearbox = "{(VARIANTS / "gearbox.toml").as_posix()}"')
+    variant.write_text(text.replace('mesh_level = "coarse"', 'rigid_mass_properties = "exact"'))
     parser = argparse.ArgumentParser(prog="flexgear")
     add_parsers(parser.add_subparsers(dest="command", required=True))
     args = parser.parse_args([CAMPBELL[0], str(variant), "--speeds-rpm", "0:6000:3", "--f-max-hz", "2000",
