@@ -247,7 +247,7 @@ def _excited(spec: Any, harmonics: int) -> Any:
 def _series_coefficients(cos_c: np.ndarray, sin_c: np.ndarray, offset_cycles: np.ndarray,
                          rate_sign: np.ndarray) -> np.ndarray:
     """Complex coefficients (n_c, H) at +h f_mesh of s(phi) - 1 = sum_h a_h cos 2 pi h phi + b_h sin 2 pi h phi,
-    phi = |rate| t sign + offset: (a_h - i b_h) e^{i 2 pi h offset}, conjugated where the phase runs backwards."""
+    phi = rate t + offset: (a_h - i b_h) e^{i 2 pi h offset}, conjugated where the phase runs backwards."""
     h = np.arange(1, cos_c.shape[1] + 1)
     c = (cos_c - 1j * sin_c) * np.exp(2j * np.pi * h[None] * offset_cycles[:, None])
     return np.where(rate_sign[:, None] >= 0, c, c.conj())
@@ -393,12 +393,27 @@ def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> 
     else:
         raise ValueError(f"linearization: expected 'quadratic' or 'each', got {linearization!r}")
     models = [linearize(variant, speed_rpm=float(n)) for n in nodes]
-    first = models[0].coordinates
-    for lm in models[1:]:
-        if lm.coordinates != first:
-            raise ValueError("the linearisations at the interpolation speeds have different independent coordinates; "
-                             "use linearization='each'")
-    return nodes, models
+    return nodes, [models[0]] + [_in_coordinates(lm, models[0]) for lm in models[1:]]
+
+
+def _in_coordinates(lm: Any, ref: Any, rtol: float = 1e-6) -> Any:
+    """``lm`` in the independent coordinates of ``ref``: the constraints' column-pivoted QR may choose other
+    independent coordinates at another speed, spanning the same motions q = B z. With B_ref = B T (least squares,
+    checked to ``rtol``), z = T z_ref and each matrix A becomes T^T A T."""
+    if lm.coordinates == ref.coordinates:
+        return lm
+    if lm.basis.shape[0] != ref.basis.shape[0]:
+        raise ValueError(f"the model has {ref.basis.shape[0]} coordinates at {ref.speed_rpm:g} rpm and "
+                         f"{lm.basis.shape[0]} at {lm.speed_rpm:g} rpm (a speed-dependent reduction): no interpolation "
+                         "between them; use linearization='each'")
+    t = np.linalg.lstsq(lm.basis, ref.basis, rcond=None)[0]
+    basis = lm.basis @ t
+    if np.abs(basis - ref.basis).max() > rtol * np.abs(ref.basis).max():
+        raise ValueError(f"the linearisations at {ref.speed_rpm:g} and {lm.speed_rpm:g} rpm span different motions; "
+                         "use linearization='each'")
+    return dataclasses.replace(lm, mass=t.T @ lm.mass @ t, damping=t.T @ lm.damping @ t,
+                               gyroscopic=t.T @ lm.gyroscopic @ t, stiffness=t.T @ lm.stiffness @ t, basis=basis,
+                               coordinates=ref.coordinates)
 
 
 def _frame_row(lm: Any, components: Sequence[str], name: str) -> int:
@@ -422,7 +437,8 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
     ``linearization``: ``"quadratic"`` linearises at the grid's lowest, middle and highest speed and interpolates
     M, D, G, K, the reduction basis and the static deflections quadratically in the speed (exact where they are
     quadratic in Omega: gyroscopic terms ~ Omega, spin softening ~ Omega^2, a speed-independent operating point);
-    ``"each"`` linearises at every speed (about a second each for model 1).
+    ``"each"`` linearises at every speed (about a second each for model 1, 6 s for model 7); needed where the
+    linearised models' sizes change with the speed (flexible variants whose reduction depends on it).
     """
     from flexgear.modal.linear import LinearModel
     from flexgear.spec import GearboxSpec, load_variant
