@@ -8,8 +8,8 @@ cannot resonate at a crossing; at speed these are the overdamped roots that the 
 complex by a small imaginary part.
 
 Tracking. Each line of the diagram is one mode followed across the grid by its shape: between neighbouring speeds
-a and b the modes are paired by the modal assurance criterion over the system's coordinates q (mass-weighted,
-complex shapes)
+a and b the modes are paired by the modal assurance criterion over the bodies' frame and elastic coordinates q
+(the system's coordinates that every speed shares; mass-weighted, complex shapes)
 
     MAC_ij = |q_a,i^H M q_b,j|^2 / ((q_a,i^H M q_a,i) (q_b,j^H M q_b,j)),    M = (M_a + M_b) / 2,
 
@@ -73,13 +73,22 @@ def _mac(qa: np.ndarray, qb: np.ndarray, mass: np.ndarray) -> np.ndarray:
     return cross / np.outer(na, nb)
 
 
-def track(shapes: Sequence[np.ndarray], masses: Sequence[np.ndarray], mac_min: float = MAC_MIN
-          ) -> tuple[list[dict[int, int]], np.ndarray]:
+def _common(a: Sequence[str], b: Sequence[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Positions in ``a`` and in ``b`` of the labels that both hold, in ``a``'s order."""
+    where = {label: j for j, label in enumerate(b)}
+    both = [(i, where[label]) for i, label in enumerate(a) if label in where]
+    return np.array([i for i, _ in both], int), np.array([j for _, j in both], int)
+
+
+def track(shapes: Sequence[np.ndarray], masses: Sequence[np.ndarray], labels: Sequence[Sequence[str]],
+          mac_min: float = MAC_MIN) -> tuple[list[dict[int, int]], np.ndarray]:
     """Lines through a grid of mode sets (module docstring).
 
-    ``shapes[i]``: (n_q, n_i) mode shapes over the system's coordinates at grid point i; ``masses[i]``: the mass
-    matrix there. Returns (lines: one {grid point: mode index} per line, numbered by start and then by the order of
-    the modes at the start; the MAC of each continuation, one per matched pair, for diagnostics).
+    ``shapes[i]``: (n_i, m_i) mode shapes over coordinates labelled ``labels[i]`` at grid point i; ``masses[i]``:
+    the mass matrix over them. The MAC between neighbouring points is taken over the labels that both hold (the
+    bodies' frames and elastic coordinates: a flexible gear's contact coordinates change with its angle). Returns
+    (lines: one {grid point: mode index} per line, numbered by start and then by the order of the modes at the
+    start; the MAC of each continuation, for diagnostics).
     """
     from scipy.optimize import linear_sum_assignment
 
@@ -89,8 +98,10 @@ def track(shapes: Sequence[np.ndarray], masses: Sequence[np.ndarray], mac_min: f
         active = [line for line in lines if i - 1 in line]
         started = set()
         if active and shapes[i].shape[1]:
-            qa = shapes[i - 1][:, [line[i - 1] for line in active]]
-            mac = _mac(qa, shapes[i], 0.5 * (masses[i - 1] + masses[i]))
+            a, b = _common(labels[i - 1], labels[i])
+            qa = shapes[i - 1][np.ix_(a, [line[i - 1] for line in active])]
+            mass = 0.5 * (masses[i - 1][np.ix_(a, a)] + masses[i][np.ix_(b, b)])
+            mac = _mac(qa, shapes[i][b], mass)
             rows, cols = linear_sum_assignment(-mac)
             for r, c in zip(rows, cols, strict=True):
                 if mac[r, c] >= mac_min:
@@ -199,8 +210,12 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
         picks.append(resonant(m, max_damping_ratio))
         if progress is not None:
             progress(float(n), model, m)
-    shapes = [m.full_shapes()[:, p] for m, p in zip(found, picks, strict=True)]
-    lines, macs = track(shapes, [m.model.full_mass for m in found], mac_min)
+    stable = [np.array([c.kind in ("frame", "elastic") for c in m.model.full_coordinates]) for m in found]
+    shapes = [m.full_shapes()[np.ix_(s, p)] for m, s, p in zip(found, stable, picks, strict=True)]
+    masses = [m.model.full_mass[np.ix_(s, s)] for m, s in zip(found, stable, strict=True)]
+    labels = [[c.label for c, k in zip(m.model.full_coordinates, s, strict=True) if k]
+              for m, s in zip(found, stable, strict=True)]
+    lines, macs = track(shapes, masses, labels, mac_min)
     rows = []
     for number, line in enumerate(lines, start=1):
         for i, j in sorted(line.items()):

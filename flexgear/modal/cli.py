@@ -100,13 +100,14 @@ def cmd_campbell(a: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from flexgear.modal import campbell
+    from flexgear.modal import campbell, resonant
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)
 
     def progress(speed: float, model, m) -> None:
-        print(f"{variant.name}: {speed:8.1f} rpm, {len(m)} modes, {model.n} coordinates", flush=True)
+        print(f"{variant.name}: {speed:8.1f} rpm, {len(resonant(m))} modes with a resonance peak "
+              f"({len(m)} roots), {model.n} coordinates", flush=True)
 
     result = campbell(variant, a.speeds_rpm, a.f_max_hz, progress=progress)
     out = Path(a.out) / variant.name
