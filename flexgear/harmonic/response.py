@@ -393,6 +393,8 @@ def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> 
     else:
         raise ValueError(f"linearization: expected 'quadratic' or 'each', got {linearization!r}")
     models = [linearize(variant, speed_rpm=float(n)) for n in nodes]
+    if linearization == "each":
+        return nodes, models
     return nodes, [models[0]] + [_in_coordinates(lm, models[0]) for lm in models[1:]]
 
 
@@ -459,6 +461,20 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
     return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0)
 
 
+def _check_contacts(lm: Any, names: list[str]) -> None:
+    """The linearised model's contacts (static deflections, deflection coordinates) are ``names``, in order."""
+    if list(lm.static_deflections) != names:
+        raise ValueError("the linearised model's contacts differ from flexgear.mbs.gearbox.mesh_contacts")
+    rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
+    if len(rows) != len(names):
+        raise ValueError(f"{len(rows)} deflection coordinates for {len(names)} contacts")
+    for i, name in zip(rows, names, strict=True):  # outer_mesh_<i>_half<k> -> sun_planet_<i>.delta_<k>
+        kind, _, planet, half = name.split("_")
+        comp = f"sun_planet_{planet}" if kind == "outer" else f"planet_{planet}_ring"
+        if lm.full_coordinates[i].component != comp or lm.full_coordinates[i].name != f"delta_{half[4:]}":
+            raise ValueError(f"contact {name}: deflection coordinate {lm.full_coordinates[i].label}")
+
+
 def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.ndarray, harmonics: int,
                t0: float) -> Response:
     from flexgear.geometry.involute import gear_set_geometry
@@ -469,18 +485,9 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
     spec = _excited(variant.gearbox, harmonics)
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
-    lm = models[0]
-    names = list(lm.static_deflections)
-    if names != [c.name for c in contacts]:
-        raise ValueError("the linearised model's contacts differ from flexgear.mbs.gearbox.mesh_contacts")
-    rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
-    if len(rows) != len(contacts):
-        raise ValueError(f"{len(rows)} deflection coordinates for {len(contacts)} contacts")
-    for i, c in zip(rows, contacts, strict=True):  # outer_mesh_<i>_half<k> -> sun_planet_<i>.delta_<k>
-        kind, _, planet, half = c.name.split("_")
-        comp = f"sun_planet_{planet}" if kind == "outer" else f"planet_{planet}_ring"
-        if lm.full_coordinates[i].component != comp or lm.full_coordinates[i].name != f"delta_{half[4:]}":
-            raise ValueError(f"contact {c.name}: deflection coordinate {lm.full_coordinates[i].label}")
+    names = [c.name for c in contacts]
+    for lm in models:
+        _check_contacts(lm, names)
     contact_mesh = [_mesh_name(c.name.split("_")[0], int(c.name.split("_")[2])) for c in contacts]
     mesh_names = tuple(sorted(set(contact_mesh), key=lambda nm: (not nm.startswith("outer"), int(nm.split("_")[3]))))
     mesh = np.array([mesh_names.index(nm) for nm in contact_mesh])
@@ -491,11 +498,17 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
     coef = _series_coefficients(cos_c, sin_c, offset, np.sign(rate))
     means = np.array([c.stiffness.mean for c in contacts])
 
-    full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
-    in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
-    out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
-    accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
-    out_row = _frame_row(lm, out_comp, "phi_z")
+    def selectors(lm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Contact deflections, bearing-node translations and output spin per z; static deflections."""
+        rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
+        full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
+        in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
+        out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
+        accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
+        out_row = _frame_row(lm, out_comp, "phi_z")
+        delta0 = np.array([lm.static_deflections[nm] for nm in names])
+        return lm.basis[rows], lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
+
     geo = gear_set_geometry(spec)
     th = theory(spec)
     r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
@@ -516,21 +529,19 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
             raise ValueError("a contact is unloaded at the operating point: no first-order excitation")
         return f0, kt, cc
 
-    deflections = [np.array([m.static_deflections[nm] for nm in names]) for m in models]
+    parts = [(m.mass, m.damping + m.gyroscopic, m.stiffness, *selectors(m)) for m in models]
     cache: dict[tuple[float, ...], tuple] = {}
 
     def operating(speed_rpm: float) -> _Operating:
-        w = _lagrange(nodes, speed_rpm) if nodes.size > 1 else np.ones(1)
+        at = np.flatnonzero(np.isclose(nodes, speed_rpm, rtol=0.0, atol=1e-9))
+        w = np.eye(nodes.size)[at[0]] if at.size else _lagrange(nodes, speed_rpm)
         key = tuple(np.round(w, 15))
         if key not in cache:
-            mix = lambda get: sum(wk * get(m) for wk, m in zip(w, models, strict=True))  # noqa: E731
-            basis = mix(lambda m: m.basis)
-            delta0 = sum(wk * d for wk, d in zip(w, deflections, strict=True))
-            f0, kt, cc = law_terms(delta0)
+            used = [(wk, part) for wk, part in zip(w, parts, strict=True) if wk != 0.0]
+            mixed = [sum(wk * part[i] for wk, part in used) for i in range(7)]
             cache.clear()
-            cache[key] = (mix(lambda m: m.mass), mix(lambda m: m.damping + m.gyroscopic), mix(lambda m: m.stiffness),
-                          basis[rows], kt, cc, f0, basis[accel_rows], te_scale * basis[out_row])
-        mass, damp, stiff, g, kt, cc, f0, acc, te = cache[key]
+            cache[key] = (*mixed[:6], *law_terms(mixed[6]))
+        mass, damp, stiff, g, acc, te, f0, kt, cc = cache[key]
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
         return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh)
 
