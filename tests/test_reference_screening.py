@@ -180,12 +180,12 @@ def test_a_verdict_within_the_numerical_error_is_not_resolved(settings):
 
     def runs(error: float):
         ref = _decaying(0.01, 0.0)
-        ref.meta.update(variant="ref", wall_time_s=100.0)
+        ref.meta.update(variant="ref", wall_time_s=100.0, cpu_time_s=100.0)
         window = ref.signals[ref.signals["time_s"] >= 0.55].reset_index(drop=True)
         ref.extra.update(error_step=window.copy(), error_half_step=_scaled_forces(
             type(ref)(ref.meta, window.copy()), 1.0 + error).signals)
         near = _scaled_forces(_decaying(0.01, 0.0), 1.0 + y)
-        near.meta.update(variant="near", wall_time_s=10.0)
+        near.meta.update(variant="near", wall_time_s=10.0, cpu_time_s=10.0)
         return [ref, near]
 
     s = screen(runs(x), settings, reference="ref")

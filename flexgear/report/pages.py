@@ -132,7 +132,7 @@ def _verdict_page(d: ReportData, others: list[ReportData]) -> Callable[[Figure],
     """Page 1: the verdict in at most three lines, the Westgard diagram, a small table, the other cases' verdicts."""
     s = d.primary
     cols = {"variant": "variant", "zone": "zone", "distance_pct": f"distance [{s.lines.unit}]",
-            "error_pct": f"± error [{s.lines.unit}]", "time_s": "run time [s]", "status": "status"}
+            "error_pct": f"± error [{s.lines.unit}]", "time_s": "CPU time [s]", "status": "status"}
     tab = s.table.reindex(columns=list(cols)).rename(columns=cols)
     tab["settled"] = s.table["status"].isin(["ok"]) & s.table.get("steady_window", True).fillna(False).astype(bool)
 

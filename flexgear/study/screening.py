@@ -266,8 +266,10 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
 
 # --------------------------------------------------------------------------- many variants
 def _run_time(meta: dict) -> float:
-    """Time a variant is judged by: the runner's wall time of the simulation (s)."""
-    value = meta.get("wall_time_s")
+    """Time a variant is judged by [s]: the runner's CPU time of the run (model build and simulation), its wall
+    time when no CPU time is recorded. CPU time, because the matrix runs variants side by side on shared cores:
+    their wall times include waiting for a core, which depends on what else ran, not on the model."""
+    value = meta.get("cpu_time_s", meta.get("wall_time_s"))
     return float(value) if value is not None else math.nan
 
 
