@@ -13,6 +13,7 @@ import sys
 from collections.abc import Callable
 from pathlib import Path
 
+from flexgear.harmonic.cli import SWEEP_SPEED
 from flexgear.modal.cli import SUBCOMMAND as MODES
 from flexgear.progress import Progress, say
 
@@ -290,6 +291,7 @@ SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Cal
     ("animate", "VTK time series (.pvd + .vtu) of the deformed bodies of a run", _args_animate, cmd_animate),
     ("meshes", "build (or load from the cache) the component meshes and reduced bodies", _args_meshes, cmd_meshes),
     MODES,
+    SWEEP_SPEED,
 ]
 
 
