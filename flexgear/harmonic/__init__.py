@@ -12,6 +12,6 @@ __all__ = ["Response", "harmonic_response", "lumped_harmonic_response", "mesh_fr
 def __getattr__(name: str):
     if name not in __all__:
         raise AttributeError(f"module 'flexgear.harmonic' has no attribute {name!r}")
-    from flexgear.harmonic import response
+    from flexgear.harmonic import lumped, response
 
-    return getattr(response, name)
+    return getattr(lumped if name == "lumped_harmonic_response" else response, name)

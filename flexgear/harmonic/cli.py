@@ -51,7 +51,8 @@ def cmd_sweep_speed(a: argparse.Namespace) -> int:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    from flexgear.harmonic.response import harmonic_response, lumped_harmonic_response
+    from flexgear.harmonic.lumped import lumped_harmonic_response
+    from flexgear.harmonic.response import harmonic_response
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)

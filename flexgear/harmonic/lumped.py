@@ -1,0 +1,146 @@
+"""Harmonic response of the lumped model (flexgear.lumped): the time model's equations linearised about the
+static equilibrium under the load, excited at each mesh harmonic (the approximation and the outputs are those of
+:mod:`flexgear.harmonic.response`)."""
+
+from __future__ import annotations
+
+import math
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from flexgear.harmonic.response import (
+    DEFAULT_HARMONICS,
+    RPM,
+    Response,
+    _excited,
+    _mesh_name,
+    _Operating,
+    _series_coefficients,
+    _sweep,
+    mesh_frequency_hz,
+)
+
+__all__ = ["lumped_harmonic_response"]
+
+
+def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS) -> Response:
+    """Harmonic response of the lumped model of ``spec`` (a flexgear.spec.GearboxSpec) at ``speeds_rpm`` [rpm].
+
+    The time model's equations (flexgear.lumped.run) linearised about the static equilibrium under the load
+    torque: input spin held (the prescribed drive), mean mesh stiffness, friction left out. The contact law is the
+    spec's (``[contact] law``): ISO 6336 (F = k delta, k_t = k, damping of eq. 13) or the impact law (F = k
+    delta^e, k_t = e F_0 / delta_0, damping c_max STEP(delta_0, 0, 0, d, 1)). The stiffness harmonics c_h
+    (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model. A
+    rotating carrier (planetary arrangement) adds its Coriolis, centripetal and bearing-damping terms; then the
+    bearing accelerations are in the carrier frame.
+    """
+    from flexgear.lumped.run import (
+        _DEPTH,
+        _EXPONENT,
+        _IMPACT,
+        _IN_BODY,
+        _LOAD_SIGN,
+        _OUT_BODY,
+        _OUT_SPIN,
+        _T_LOAD,
+        build_lumped_model,
+    )
+    from flexgear.theory import theory
+
+    t0 = time.perf_counter()
+    spec = _excited(spec, harmonics)
+    model = build_lumped_model(spec)
+    s = model.system
+    p = s.params
+    g = spec.gears
+    star = g.arrangement == "star"
+    r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    free = model.free
+    nf = free.size
+    rows = s.mesh_G[:, free]
+    nmesh = rows.shape[0]
+    impact = model.fp[_IMPACT] > 0.0
+    exponent = float(model.fp[_EXPONENT]) if impact else 1.0
+    depth = float(model.fp[_DEPTH])
+    k_law, c_law = model.mesh_k, model.mesh_c
+
+    # static equilibrium under the load (mean stiffness, no friction): K_s q + G^T F(G q) = T (Newton)
+    load = np.zeros(s.n)
+    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    ks = s.support_stiffness[np.ix_(free, free)]
+    q = np.linalg.solve(s.stiffness()[np.ix_(free, free)], load[free])
+    for _ in range(100):
+        d = np.maximum(rows @ q, 0.0)
+        force = k_law * d**exponent
+        tangent = exponent * k_law * d ** (exponent - 1.0) if impact else k_law
+        resid = ks @ q + rows.T @ force - load[free]
+        step = np.linalg.solve(ks + (rows.T * tangent) @ rows, resid)
+        q = q - step
+        if np.abs(step).max() <= 1e-13 * max(np.abs(q).max(), 1e-30):
+            break
+    delta0 = rows @ q
+    if np.any(delta0 <= 0.0):
+        raise ValueError("lumped model: a mesh is unloaded at the operating point")
+    f0 = k_law * delta0**exponent
+    k_t = exponent * f0 / delta0
+    if impact:
+        ramp = np.minimum(delta0 / depth, 1.0)
+        c = c_law * ramp * ramp * (3.0 - 2.0 * ramp)
+    else:
+        c = np.asarray(c_law, float)
+
+    # mesh phases: phase_m = coef_m q[index_m] + offset_m, the spin's nominal rate relative to the carrier frame
+    zs, zr = g.sun_teeth, g.ring_teeth
+    rel = {2: 1.0 - r_c, 5: -(zs / zr) * (1.0 - r_c)}  # sun and ring spin per input angle, carrier frame
+    rate = np.array([model.phase_coef[m] * rel[int(model.phase_index[m])] for m in range(nmesh)])
+    offset = model.phase_offset - model.phase_centre
+    cos_c = np.asarray(model.harmonics, float)
+    coef = _series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
+
+    n_pl = p.planet_count
+    names = tuple([_mesh_name("outer", i + 1) for i in range(n_pl)] + [_mesh_name("inner", i + 1) for i in range(n_pl)])
+    pos = {int(j): k for k, j in enumerate(free)}
+    accel = np.zeros((4, nf))
+    for k, b in enumerate((int(model.ip[_IN_BODY]), int(model.ip[_OUT_BODY]))):
+        for a in range(2):
+            if 3 * b + a in pos:
+                accel[2 * k + a, pos[3 * b + a]] = 1.0
+    th = theory(spec)
+    r_out = p.ring.radius_m if star else p.carrier.radius_m
+    te = np.zeros(nf)
+    out_spin = int(model.ip[_OUT_SPIN])
+    if out_spin in pos:
+        te[pos[out_spin]] = -r_out * math.copysign(1.0, th.output_speed)
+    mass = np.diag(s.mass[free])
+    base_k = ks + (rows.T * k_t) @ rows
+    base_d = s.support_damping[np.ix_(free, free)] + (rows.T * c) @ rows
+
+    def operating(speed_rpm: float) -> _Operating:
+        w_in = speed_rpm * RPM
+        om = r_c * w_in
+        gyro = np.zeros((nf, nf))
+        kk = base_k.copy()
+        if om != 0.0:  # rotating frame: m (x'' - 2 Om y' - Om^2 x), ground bearings damp x' + Om J x
+            for j in free:
+                if j % 3 == 0 and j + 1 in pos and s.mass[j] > 0.0:
+                    ix, iy = pos[j], pos[j + 1]
+                    m = s.mass[j]
+                    gyro[ix, iy], gyro[iy, ix] = -2.0 * m * om, 2.0 * m * om
+                    kk[ix, ix] -= m * om**2
+                    kk[iy, iy] -= m * om**2
+                    cg = s.ground_damping[j, j]
+                    kk[ix, iy] -= cg * om
+                    kk[iy, ix] += cg * om
+        omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
+        return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
+                          omega_mesh)
+
+    per_rpm = mesh_frequency_hz(spec, 1.0)
+    return _sweep(operating, speeds_rpm, harmonics, f"lumped ({Path(str(spec.source)).stem})", per_rpm, t0)
+
+
+# --------------------------------------------------------------------------- multibody model
