@@ -21,6 +21,14 @@ standing pair at rest becomes the forward and backward whirl at speed; ``mac_min
 perturbation of the subspace between grid speeds. Lines are numbered by the speed at which they start and then by
 frequency.
 
+Operating points at one angle. A flexible gear's elastic coordinates are fixed in the body, its meshes fixed in
+space: the same mode has other elastic coordinates where the gear stands at another angle. The gears' angles at the
+operating point are theta = omega (t* - T/2) (the input's STEP ramp over T, flexgear.laws.ramps.drive_angle, the
+other members' in proportion), so every speed n > 0 is linearised at t* = T/2 + theta_ref / omega(n), with
+theta_ref = omega(n_max) T / 2 (the highest speed's angle at the end of its ramp: t* >= T at every speed); the
+gears then stand at the same angles at every speed. At zero speed the gears stand at the load case's start (theta
+= 0), and a flexible variant's lines may start anew at the first speed above it.
+
 Mesh orders. The mesh frequency is flexgear.theory's, f_m = z_s |omega_sun - omega_carrier| / (2 pi) (carrier
 fixed in the star arrangement: f_m = z_s n / 60), linear in n. Order k's line is k f_m(n); a crossing of a mode with
 it is a sign change of g(n) = f(n) - k f_m(n) between two grid speeds, placed by linear interpolation:
@@ -201,10 +209,14 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
     spec = variant.gearbox
     per_rpm = mesh_frequency_hz(spec, 1.0)
     band = max(orders) * per_rpm * speeds[-1] if f_max_hz is None else float(f_max_hz)
+    ramp = spec.load_case.ramp_time_s
+    omega = speeds * (2.0 * math.pi / 60.0)  # rad/s
+    theta_ref = omega[-1] * ramp / 2.0  # rad
     found: list[Modes] = []
     picks: list[np.ndarray] = []
-    for n in speeds:
-        model = linearize(variant, speed_rpm=float(n))
+    for n, w in zip(speeds, omega, strict=True):
+        t_star = ramp / 2.0 + theta_ref / w if w > 0.0 else None
+        model = linearize(variant, speed_rpm=float(n), t_star=t_star)
         m = modes(model, band)
         found.append(m)
         picks.append(resonant(m, max_damping_ratio))
