@@ -1,7 +1,7 @@
 """Shared fixtures: the study's gearbox and variant files; how ``make test`` shares the tests out.
 
 ``make test`` runs the suite in two pytest-xdist worker processes (``-n 2 --dist loadgroup``). With
-``--dist loadgroup`` the tests of a module that defines a module-scoped fixture (a simulation run, an FE model)
+``--dist loadgroup`` the tests that use a module-scoped fixture of their module (a simulation run, an FE model)
 go to one worker, so that the fixture is built once, and every other test is shared out on its own
 (:func:`pytest_xdist_make_scheduler`). The mesh cache (``meshes/`` or ``$FLEXGEAR_CACHE_DIR``) is shared by the
 workers: a missing mesh or reduced body is built by the first worker that needs it while the other waits for it
@@ -20,33 +20,62 @@ ROOT = Path(__file__).resolve().parents[1]
 VARIANTS = ROOT / "model_variants"
 
 
-def _module_fixture_files(folder: Path) -> set[str]:
-    """Paths (relative to the project, as in node ids) of the test modules that define a module-scoped fixture."""
-    out = set()
-    for path in folder.rglob("test_*.py"):
+def _fixture_of(node: ast.FunctionDef) -> tuple[str, bool] | None:
+    """(scope, autouse) of a function decorated with ``pytest.fixture``, else None."""
+    for dec in node.decorator_list:
+        call = dec if isinstance(dec, ast.Call) else None
+        if ast.unparse(call.func if call else dec).split(".")[-1] != "fixture":
+            continue
+        kw = {k.arg: k.value.value for k in (call.keywords if call else []) if isinstance(k.value, ast.Constant)}
+        return str(kw.get("scope", "function")), bool(kw.get("autouse", False))
+    return None
+
+
+def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
+    """Per test module (its path as in node ids): the names of its test functions that use one of its
+    module-scoped fixtures, directly or through another fixture of the module ({"*"}: all of them, the fixture
+    being autouse)."""
+    out: dict[str, set[str]] = {}
+    for path in sorted(folder.rglob("test_*.py")):
+        fixtures: dict[str, tuple[tuple[str, bool], set[str]]] = {}
+        tests: dict[str, set[str]] = {}
         for node in ast.walk(ast.parse(path.read_text())):
-            if isinstance(node, ast.Call) and any(
-                    k.arg == "scope" and isinstance(k.value, ast.Constant) and k.value.value == "module"
-                    for k in node.keywords) and ast.unparse(node.func).endswith("fixture"):
-                out.add(path.relative_to(ROOT).as_posix())
-                break
+            if isinstance(node, ast.FunctionDef):
+                args = {a.arg for a in node.args.args + node.args.kwonlyargs}
+                kind = _fixture_of(node)
+                if kind is not None:
+                    fixtures[node.name] = (kind, args)
+                elif node.name.startswith("test"):
+                    tests[node.name] = args
+        shared = {name for name, ((scope, _), _) in fixtures.items() if scope == "module"}
+        grown = True
+        while grown:  # fixtures of the module that request a shared one
+            extra = {name for name, (_, args) in fixtures.items() if args & shared} - shared
+            shared |= extra
+            grown = bool(extra)
+        users = {"*"} if any(fixtures[n][0][1] for n in shared) else {t for t, args in tests.items() if args & shared}
+        if users:
+            out[path.relative_to(ROOT).as_posix()] = users
     return out
 
 
 def pytest_xdist_make_scheduler(config, log):
-    """``--dist loadgroup``: a module that defines a module-scoped fixture is one unit of work, every other test
-    is a unit of its own; units with more tests are handed out first. (Replaces xdist's own loadgroup, which
-    groups by ``xdist_group`` marks written into the node ids: pytest 9.2's node ids do not take them.)"""
+    """``--dist loadgroup``: the tests of a module that use one of its module-scoped fixtures are one unit of work,
+    every other test is a unit of its own; units with more tests are handed out first. (Replaces xdist's own
+    loadgroup, which groups by ``xdist_group`` marks written into the node ids: pytest 9.2's node ids do not take
+    them.)"""
     if config.getvalue("dist") != "loadgroup":
         return None
     from xdist.scheduler import LoadScopeScheduling
 
-    grouped = _module_fixture_files(Path(__file__).resolve().parent)
+    users = _module_fixture_users(Path(__file__).resolve().parent)
 
     class ModuleFixtureScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
-            module = nodeid.split("::", 1)[0]
-            return module if module in grouped else nodeid
+            module, _, rest = nodeid.partition("::")
+            test = rest.split("::")[-1].split("[")[0]
+            grouped = users.get(module, set())
+            return module if "*" in grouped or test in grouped else nodeid
 
     return ModuleFixtureScheduling(config, log)
 
