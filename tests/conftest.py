@@ -59,6 +59,7 @@ def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
     return out
 
 
+@pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: without xdist installed, never called
 def pytest_xdist_make_scheduler(config, log):
     """``--dist loadgroup``: the tests of a module that use one of its module-scoped fixtures are one unit of work,
     every other test is a unit of its own; units with more tests are handed out first. (Replaces xdist's own
