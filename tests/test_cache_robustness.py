@@ -131,20 +131,32 @@ def test_solid_without_its_digest_is_rebuilt(cached, gearbox, monkeypatch):
 
 # --- build once among processes ------------------------------------------------------------------------------
 
+_WAIT_FOR = """
+def wait_for(path, timeout=120.0):  # the other process has started and is about to ask for the entry
+    t0 = time.monotonic()
+    while not path.exists() and time.monotonic() - t0 < timeout:
+        time.sleep(0.02)
+    time.sleep(0.5)  # time to reach the lock
+"""
+
 _SLOW_BUILDER = """
 import sys, time
 from pathlib import Path
 from flexgear.cache import load_or_build, atomic_write_bytes
-
-path, log = Path(sys.argv[1]), Path(sys.argv[2])
+""" + _WAIT_FOR + """
+path, log, role, ready = Path(sys.argv[1]), Path(sys.argv[2]), sys.argv[3], Path(sys.argv[4])
 def load():
     return path.read_bytes() if path.exists() else None
 def build():
     with open(log, "a") as fh:
         fh.write("build\\n")
-    time.sleep(float(sys.argv[3]))
-    atomic_write_bytes(path, b"built by " + sys.argv[4].encode())
+    if role == "first":
+        wait_for(ready)
+    atomic_write_bytes(path, b"built by " + role.encode())
     return path.read_bytes()
+if role == "second":
+    print("missing" if not path.exists() else "present")
+    ready.touch()
 print(load_or_build(path, load, build).decode())
 """
 
@@ -154,7 +166,7 @@ def _python(*args: str) -> subprocess.Popen:
                             cwd=ROOT, env={**os.environ, "PYTHONPATH": str(ROOT)})
 
 
-def _wait_for(path: Path, timeout: float = 60.0) -> None:
+def _wait_for(path: Path, timeout: float = 120.0) -> None:
     t0 = time.monotonic()
     while not path.exists():
         assert time.monotonic() - t0 < timeout, f"{path} never appeared"
@@ -162,15 +174,17 @@ def _wait_for(path: Path, timeout: float = 60.0) -> None:
 
 
 def test_two_processes_build_a_missing_entry_once(tmp_path):
-    """The second process asks while the first is building: it waits for the lock and reads the first's file."""
-    entry, log = tmp_path / "entry.bin", tmp_path / "builds.log"
-    first = _python("-c", _SLOW_BUILDER, str(entry), str(log), "2.0", "first")
+    """The second process asks while the first is building (the first writes its file only after the second has
+    found it missing): the second waits for the lock and reads the first's file."""
+    entry, log, ready = tmp_path / "entry.bin", tmp_path / "builds.log", tmp_path / "second-ready"
+    first = _python("-c", _SLOW_BUILDER, str(entry), str(log), "first", str(ready))
     _wait_for(log)  # the first holds the lock and is building
-    second = _python("-c", _SLOW_BUILDER, str(entry), str(log), "0.0", "second")
-    outs = [p.communicate(timeout=120) for p in (first, second)]
+    second = _python("-c", _SLOW_BUILDER, str(entry), str(log), "second", str(ready))
+    outs = [p.communicate(timeout=300) for p in (first, second)]
     assert [p.returncode for p in (first, second)] == [0, 0], outs
     assert log.read_text().splitlines() == ["build"]
-    assert [o.strip() for o, _ in outs] == ["built by first", "built by first"]
+    assert outs[0][0].split() == ["built", "by", "first"]
+    assert outs[1][0].split() == ["missing", "built", "by", "first"]
 
 
 def test_lock_waits_in_threads_and_is_reentrant(tmp_path):
@@ -210,26 +224,29 @@ import sys, time
 from pathlib import Path
 import flexgear.fe.mesh as fm
 from flexgear.spec import load_gearbox
-
-started = Path(sys.argv[1])
+""" + _WAIT_FOR + """
+started, ready = Path(sys.argv[1]), Path(sys.argv[2])
 build = fm._build_mesh
-def slow_build(*args, **kwargs):  # announce the build and hold the lock a while: the other process asks meanwhile
+def slow_build(*args, **kwargs):  # announce the build and hold the lock until the other process asks
     started.touch()
-    time.sleep(float(sys.argv[2]))
+    wait_for(ready)
     return build(*args, **kwargs)
 fm._build_mesh = slow_build
-mesh = fm.component_mesh(load_gearbox("model_variants/gearbox.toml"), "input_shaft", "coarse", order=1, progress=True)
+spec = load_gearbox("model_variants/gearbox.toml")
+if sys.argv[3] == "second":
+    ready.touch()
+mesh = fm.component_mesh(spec, "input_shaft", "coarse", order=1, progress=True)
 print(mesh.n_nodes, mesh.nodes.sum())
 """
 
 
 def test_two_processes_mesh_a_missing_component_once(tmp_path, monkeypatch):
     """Two processes need the same missing mesh: Netgen runs once, both get its nodes (progress lines counted)."""
-    started = tmp_path / "started"
+    started, ready = tmp_path / "started", tmp_path / "second-ready"
     monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path / "cache"))
-    first = _python("-c", _MESHER, str(started), "2.0")
+    first = _python("-c", _MESHER, str(started), str(ready), "first")
     _wait_for(started)
-    second = _python("-c", _MESHER, str(tmp_path / "second-started"), "0.0")
+    second = _python("-c", _MESHER, str(tmp_path / "second-started"), str(ready), "second")
     outs = [p.communicate(timeout=300) for p in (first, second)]
     assert [p.returncode for p in (first, second)] == [0, 0], outs
     log = "".join(err for _, err in outs)
