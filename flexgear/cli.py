@@ -1,4 +1,5 @@
-"""Command line: flexgear run | matrix | sweep | lpm | compare | report | animate | meshes.
+"""Command line: flexgear run | matrix | sweep | lpm | compare | report | animate | meshes | modes | campbell |
+modal-screening | sweep-speed.
 
 Each subcommand is a pair of functions, ``_args_<name>(parser)`` (its arguments, each with help text) and
 ``cmd_<name>(args) -> exit code`` (a thin wrapper over one library function), listed in ``SUBCOMMANDS``;
@@ -14,6 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from flexgear.harmonic.cli import SWEEP_SPEED
+from flexgear.modal.cli import CAMPBELL, SCREENING
 from flexgear.modal.cli import SUBCOMMAND as MODES
 from flexgear.progress import Progress, say
 
@@ -291,6 +293,8 @@ SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Cal
     ("animate", "VTK time series (.pvd + .vtu) of the deformed bodies of a run", _args_animate, cmd_animate),
     ("meshes", "build (or load from the cache) the component meshes and reduced bodies", _args_meshes, cmd_meshes),
     MODES,
+    CAMPBELL,
+    SCREENING,
     SWEEP_SPEED,
 ]
 
