@@ -36,7 +36,8 @@ def test_grid_product_zip_and_all_combinations(tmp_path):
                                             "model4__face_width_mm_20", "model4__face_width_mm_40"]
     v = load_variant(paths[3])
     assert v.gearbox.gears_assumed.face_width_mm == pytest.approx(40.0)
-    assert v.gearbox.load_case.end_time_s == pytest.approx(0.2)          # the base's own overrides are kept
+    assert v.gearbox.load_case.ramp_time_s == pytest.approx(0.02)        # the base's own overrides are kept
+    assert v.gearbox.load_case.end == "settled"
     assert v.components["sun"] == "flexible" and v.components["input_shaft"] == "rigid"
     combos = load_sweep(_sweep_file(tmp_path), all_combinations=True)
     paths, rows = write_variants(combos, tmp_path / "all")

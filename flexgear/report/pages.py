@@ -16,7 +16,6 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
-import math
 from collections.abc import Callable
 from pathlib import Path
 
@@ -111,9 +110,9 @@ def case_summary(d: ReportData) -> str:
     """The load case and law of a results folder's runs, in words (to tell two verdicts' cases apart)."""
     laws = {((r.meta.get("spec") or {}).get("contact") or {}).get("law", "?") for r in d.runs.values()}
     ramps = {r.meta.get("ramp_time_s") for r in d.runs.values()}
-    ends = [float(r.meta.get("t_end_s", math.nan)) for r in d.runs.values()]
-    return (f"{'/'.join(sorted(map(str, laws)))} law, ramps {'/'.join(fmt(x) for x in sorted(ramps, key=str))} s, "
-            f"runs to {fmt(min(ends))}-{fmt(max(ends))} s")
+    ends = [float(r.meta["t_end_s"]) for r in d.runs.values() if r.meta.get("t_end_s") is not None]
+    span = f"runs to {fmt(min(ends))}-{fmt(max(ends))} s" if ends else "no finished runs"
+    return f"{'/'.join(sorted(map(str, laws)))} law, ramps {'/'.join(fmt(x) for x in sorted(ramps, key=str))} s, {span}"
 
 
 def other_verdicts(d: ReportData, others: list[ReportData]) -> list[str]:
