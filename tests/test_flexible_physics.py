@@ -2,7 +2,7 @@
 
 - model 4 (flexible sun and ring) changes the inner mesh-force ripple against model 1 by more than 10 % and by
   more than ten times what halving the step changes (measured on model 1 here: model 4 at h/2 costs minutes;
-  benchmarks/bench_flexible_physics.py ripple measures both);
+  the halved step is measured outside the tests);
 - the load-induced deflection of each flexible gear at its meshes (flexgear.mbs.deflection, relative to its
   seat), averaged over its meshes, equals static_compliance (flexgear.fe.compliance, the same seat held, the
   contact kernel's loads) times the mesh forces within 10 %; mesh by mesh too for the sun. The ring's

@@ -1,7 +1,7 @@
 """The speed levers of issue 16 change no result: compiled per-step updates against the numpy reference
 formulation, the lumped right-hand side for other integrators against the project's own RK4.
 
-No timings here (benchmarks/bench_speed.py, benchmarks/bench_lumped_scipy.py measure them).
+No timings here (benchmarks/bench_speed.py and benchmarks/bench_lumped.py measure them).
 """
 
 import dataclasses

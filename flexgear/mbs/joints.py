@@ -27,8 +27,8 @@ modal columns turn (R_n Psi) and, off the axis, the frame rotations' lever. "bod
 premultiplied by Q_n^T = blockdiag(R_n^T, R_n^T) (:func:`body_axes_form`), an exact row transformation, so
 the solution is the same; the modal columns are then constant and the frame columns (R_n^T u, R_n^T phi) turn.
 The modified Newton method keeps a Jacobian over many steps while the coefficients turn; with a flexible
-shaft, turning frame columns cost it fewer iterations than turning modal ones (benchmarks/bench_joint_axes.py
-over the Table 5 case: model 3 3.06 -> 2.11 Newton iterations per step, model 7 3.19 -> 3.05), with a rigid
+shaft, turning frame columns cost it fewer Newton iterations than turning modal ones (benchmarks/bench_newton.py
+counts them per step), with a rigid
 shaft more Jacobians (model 4: 88 -> 148 per 1000 steps); "auto" takes body axes where the shaft is flexible.
 The multipliers are then the force and moment in the gear's body axes.
 
