@@ -73,3 +73,20 @@ def test_amplification_limits():
     f_mesh = 1000.0
     np.testing.assert_allclose(amplification(np.array([3000.0, 5000.0]), zeta, f_mesh), 1 / (2 * zeta))
     assert amplification(np.array([1e9]), np.array([0.02]), f_mesh)[0] == pytest.approx(1.0, rel=1e-9)
+
+
+@pytest.mark.slow
+def test_matrix_sets_the_modal_screening_beside_the_westgard_verdict(model4_linear, screened, tmp_path):
+    """flexgear.study.matrix.modal_verdict: the modal recommendation written beside the Westgard verdict of a
+    results folder, 'the same' exactly when they agree; a reference that cannot be linearised is recorded."""
+    from flexgear.study.matrix import modal_verdict
+
+    for westgard in (screened.recommended, "model1" if screened.recommended != "model1" else "model2"):
+        (tmp_path / "selection.txt").write_text(f"selected: {westgard}\n")
+        text = modal_verdict(tmp_path, model4_linear)
+        assert f"recommends {screened.recommended}" in text and f"Westgard verdict: {westgard}" in text
+        assert ("(the same)" in text) == (westgard == screened.recommended)
+        assert (tmp_path / "modal_screening.csv").exists()
+        assert (tmp_path / "modal_screening.txt").read_text().strip() == text
+    not_a_variant = type("NotAVariant", (), {"name": "x"})()   # cannot be linearised: recorded, not raised
+    assert "Modal screening of x not done" in modal_verdict(tmp_path, not_a_variant)

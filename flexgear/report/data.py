@@ -41,6 +41,7 @@ class ReportData:
     reference: Screening | None         # against a reference variant, if one was used or configured
     sweep: SweepResult | None = None
     refused: str = ""                   # why the reference screening was refused (its reference has not settled)
+    modal_note: str = ""                # the modal screening beside the Westgard verdict (modal_screening.txt)
 
     @property
     def primary(self) -> Screening:
@@ -108,8 +109,9 @@ def gather(results_dir: str | Path) -> ReportData:
             refused = str(exc)
     sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
     sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)
+    modal = results_dir / "modal_screening.txt"
     return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep,
-                      refused)
+                      refused, modal.read_text().strip() if modal.exists() else "")
 
 
 def _split_comment(line: str) -> tuple[str, str]:

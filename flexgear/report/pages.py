@@ -16,6 +16,7 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -137,11 +138,13 @@ def _verdict_page(d: ReportData, others: list[ReportData]) -> Callable[[Figure],
 
     def draw(fig: Figure) -> None:
         fig.text(0.04, 0.90, "\n".join(verdict_lines(d)), fontsize=10.5, va="top", wrap=True)
-        fig.text(0.04, 0.80, "\n".join([f"This case: {case_summary(d)}.", *other_verdicts(d, others)]), fontsize=8,
-                 va="top", color="#333333")
-        ax = fig.add_axes([0.06, 0.08, 0.46, 0.66])
+        notes = [f"This case: {case_summary(d)}.", *other_verdicts(d, others)]
+        if d.modal_note:
+            notes += textwrap.wrap(d.modal_note, 170)
+        fig.text(0.04, 0.80, "\n".join(notes), fontsize=8, va="top", color="#333333")
+        ax = fig.add_axes([0.06, 0.07, 0.46, 0.56])
         s.plot(ax, title="")
-        right = fig.add_axes([0.56, 0.08, 0.41, 0.66])
+        right = fig.add_axes([0.56, 0.07, 0.41, 0.56])
         right.axis("off")
         draw_table(right, tab.assign(**{c: [fmt(v, 4) if isinstance(v, float) else v for v in tab[c]]
                                          for c in tab.columns}), top=1.0, fontsize=7.5, wrap=18)

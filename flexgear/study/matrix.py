@@ -257,6 +257,34 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     return table
 
 
+def modal_verdict(out_dir: Path, reference: Any, progress: bool = False) -> str:
+    """The modal screening of the all-flexible reference (flexgear.modal.screening: which components deform in the
+    modes that the mesh harmonics can excite) beside the Westgard verdict of ``out_dir/selection.txt``; writes
+    ``modal_screening.csv`` and ``modal_screening.txt`` (one paragraph) and returns the paragraph. ``reference``: a
+    Variant or its flexgear.modal.LinearModel. A failure is recorded in the text, not raised: the Westgard verdict
+    stands on its own."""
+    from flexgear.modal.screening import modal_screening
+
+    name = reference.variant.name if hasattr(reference, "variant") else reference.name
+
+    try:
+        m = modal_screening(reference)
+    except Exception as exc:  # recorded: the time-domain screening does not depend on it
+        text = f"Modal screening of {name} not done: {type(exc).__name__}: {exc}"
+    else:
+        write_table(m.table, out_dir / "modal_screening")
+        selection = (out_dir / "selection.txt").read_text().splitlines()[0].removeprefix("selected: ")
+        must = ", ".join(m.table.component[m.table.must_be_flexible]) or "none"
+        text = (f"Modal screening of {name}'s modes up to {m.f_band_hz:.4g} Hz (10x the mesh frequency): "
+                f"must be flexible: {must}; recommends {m.recommended}. Westgard verdict: {selection}"
+                + (" (the same)." if selection == m.recommended else
+                   "; they differ: the modal screening asks which components deform in the modes the mesh harmonics "
+                   "can excite, the Westgard verdict whether the indicators change beyond their TEa."))
+    atomic_write_bytes(out_dir / "modal_screening.txt", (text + "\n").encode())
+    _say(progress, text)
+    return text
+
+
 def _check_reference(reference: str, names: Sequence[str]) -> None:
     """A reference variant must be one of the matrix's variants (checked before any run)."""
     if reference and reference not in names:
@@ -286,7 +314,7 @@ def _run_order(variants: dict[str, Variant]) -> list[str]:
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | str | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
                runner: Runner | None = None, time_budget_s: float | None = None,
-               reference: str | None = None) -> pd.DataFrame:
+               reference: str | None = None, modal: bool = True) -> pd.DataFrame:
     """Run the variant files, save each run, screen them; return the results + screening table.
 
     ``runner(variant, t_end_s=..., progress=...) -> RunResult`` defaults to
@@ -294,13 +322,15 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     ``scheduler`` is a Dask scheduler address (``tcp://host:8786``); None uses ``workers`` local
     processes. ``time_budget_s`` overrides each variant's ``[solver_assumed] wall_time_budget_s``.
     ``reference``: screen against this variant (:func:`flexgear.study.screening.screen`; default the
-    gearbox's ``[screening] reference``). See the module docstring for the files written and the resume rule.
+    gearbox's ``[screening] reference``). ``modal``: with an all-flexible reference and the default runner, also
+    :func:`modal_verdict`. See the module docstring for the files written and the resume rule.
     """
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     for stale in remove_stale_temporaries(out_dir):
         _say(progress, f"removed {stale.relative_to(out_dir)} (an interrupted write)")
     names: list[str] = []
+    variant_files: dict[str, Path] = {}
     metas: dict[str, dict] = {}
     resumed: set[str] = set()
     tasks: list[RunTask] = []
@@ -322,6 +352,7 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
         if name in names:
             raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
         names.append(name)
+        variant_files[name] = path
         settings = settings or variant.gearbox.screening
         ref = reference if reference is not None else settings.reference
         task = make_task(variant, t_end_s, time_budget_s,
@@ -345,6 +376,12 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     if settings is None:
         settings = load_gearbox(Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml").screening
     screening = screen_directory(out_dir, names, settings, progress, reference)
+    ref_name = reference if reference is not None else settings.reference
+    ref_file = variant_files.get(ref_name)
+    if ref_file is not None and modal and runner is None:
+        ref_variant = load_variant(ref_file)
+        if all(form == "flexible" for form in ref_variant.components.values()):
+            modal_verdict(out_dir, ref_variant, progress)
     screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
                                            "selected"])
     return table.merge(screening, on="variant", how="left")
