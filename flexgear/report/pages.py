@@ -113,7 +113,15 @@ def case_summary(d: ReportData) -> str:
     ramps = {r.meta.get("ramp_time_s") for r in d.runs.values()}
     ends = [float(r.meta["t_end_s"]) for r in d.runs.values() if r.meta.get("t_end_s") is not None]
     span = f"runs to {fmt(min(ends))}-{fmt(max(ends))} s" if ends else "no finished runs"
-    return f"{'/'.join(sorted(map(str, laws)))} law, ramps {'/'.join(fmt(x) for x in sorted(ramps, key=str))} s, {span}"
+    ref = d.runs.get(d.primary.reference) if d.primary.reference else None
+    te = ""
+    if ref is not None and ref.ok and "transmission_error_m" in ref.signals:  # the law's static penetration shows here
+        w = d.window(ref)
+        t = ref.signals["time_s"]
+        mean_te = float(ref.signals["transmission_error_m"][(t >= w.start_s) & (t <= w.end_s)].mean())
+        te = f", {ref.name}'s loaded transmission error {1e6 * mean_te:.4g} um"
+    return (f"{'/'.join(sorted(map(str, laws)))} law, ramps {'/'.join(fmt(x) for x in sorted(ramps, key=str))} s, "
+            f"{span}{te}")
 
 
 def other_verdicts(d: ReportData, others: list[ReportData]) -> list[str]:
