@@ -196,3 +196,22 @@ def test_a_verdict_within_the_numerical_error_is_not_resolved(settings):
     assert s.selection.reasoning.startswith("NOT RESOLVED")
     clean = screen(runs(0.0), settings, reference="ref")
     assert clean.selection.variant == "near" and clean.selection.resolved
+
+
+def test_a_failed_reference_is_refused_and_the_matrix_writes_why(settings, tmp_path):
+    """A reference that did not finish: screen() refuses in one line naming it and its reason; the matrix's
+    screening writes that line to selection.txt and selects nothing, instead of stopping."""
+    from flexgear.results import RunResult, save_result
+    from flexgear.study.matrix import screen_directory
+    from flexgear.study.screening import ReferenceNotUsable
+
+    failed = RunResult({"variant": "model7", "backend": "exudyn", "status": "failed", "reason": "solver failed"})
+    other = synthetic_result("model1")
+    with pytest.raises(ReferenceNotUsable, match="reference model7 did not finish \\(solver failed\\)"):
+        screen([other, failed], settings, reference="model7")
+    for r in (other, failed):
+        save_result(r, tmp_path / r.name)
+    table = screen_directory(tmp_path, ["model1", "model7"], settings, reference="model7")
+    text = (tmp_path / "selection.txt").read_text()
+    assert text.startswith("selected: None") and "did not finish" in text
+    assert set(table["status"]) == {"not screened"}

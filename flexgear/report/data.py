@@ -14,9 +14,9 @@ from flexgear.results import RunResult, load_result
 from flexgear.spec import GearboxSpec, ScreeningSettings, SpecError, load_gearbox
 from flexgear.study.screening import (
     DecisionLines,
+    ReferenceNotUsable,
     Screening,
     Selection,
-    UnsettledReference,
     Window,
     analysis_window,
     screen,
@@ -105,7 +105,7 @@ def gather(results_dir: str | Path) -> ReportData:
     if ref_name and ref_name in runs:
         try:
             reference = screen(runs.values(), settings, reference=ref_name)
-        except UnsettledReference as exc:
+        except ReferenceNotUsable as exc:
             refused = str(exc)
     sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
     sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)

@@ -47,7 +47,7 @@ from flexgear.cache import atomic_write_bytes, remove_stale_temporaries
 from flexgear.progress import Progress, say
 from flexgear.results import RunResult, load_result, save_result
 from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant, spec_hash
-from flexgear.study.screening import Selection, UnsettledReference, screening_tables
+from flexgear.study.screening import ReferenceNotUsable, Selection, screening_tables
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
@@ -242,7 +242,7 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     ref = settings.reference if reference is None else reference
     try:
         table, indicators, selection = screening_tables(results, settings, reference)
-    except UnsettledReference as exc:
+    except ReferenceNotUsable as exc:
         table = pd.DataFrame({"variant": [r.name for r in results], "status": "not screened", "reason": str(exc),
                               "selected": False})
         indicators = pd.DataFrame(columns=["variant", "indicator"])

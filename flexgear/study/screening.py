@@ -76,6 +76,7 @@ __all__ = [
     "scaled_bias_cv",
     "reference_means",
     "UnsettledReference",
+    "ReferenceNotUsable",
     "numerical_error",
 ]
 
@@ -335,8 +336,12 @@ def _resolution(table: pd.DataFrame, lines: DecisionLines, error: float, selecti
     return Selection(selection.variant, selection.rule, why + selection.reasoning, False)
 
 
-class UnsettledReference(ValueError):
-    """The screening's reference has not settled: nothing can be screened against it."""
+class ReferenceNotUsable(ValueError):
+    """The screening's reference did not finish or has not settled: nothing can be screened against it."""
+
+
+class UnsettledReference(ReferenceNotUsable):
+    """The screening's reference has not settled."""
 
 
 def _unsettled_reason(result: RunResult, settings: ScreeningSettings) -> str:
@@ -359,7 +364,7 @@ def reference_means(results: list[RunResult], name: str, settings: ScreeningSett
         raise ValueError(f"screening reference {name!r} is not among the runs "
                          f"({', '.join(r.name for r in results) or 'none'})")
     if not ref.ok:
-        raise ValueError(f"screening reference {name!r} did not finish ({ref.meta.get('reason')})")
+        raise ReferenceNotUsable(f"not screened: reference {name} did not finish ({ref.meta.get('reason')})")
     why = _unsettled_reason(ref, settings)
     if why:
         raise UnsettledReference(f"not screened: reference {name} has not settled by "
