@@ -1,4 +1,4 @@
-"""The heap of worker processes: large arrays go back to the system when freed (issue 16, peak memory).
+"""The heap of worker processes: large arrays go back to the system when freed (peak memory of a matrix).
 
 glibc's malloc serves a request of at least its mmap threshold with a mapping of its own, which ``free``
 unmaps, and smaller ones from the heap, which keeps freed memory for reuse. The threshold starts at

@@ -74,7 +74,7 @@ def test_gear_shaft_joints_carry_the_shaft_torques(flex_run):
 
 
 def test_rigid_and_flexible_twins_carry_identical_mass_properties():
-    """Issue 4: a component has the same mass, centre of mass and inertia in either form. With
+    """The rigid/flexible twin rule: a component has the same mass, centre of mass and inertia in either form. With
     rigid_mass_properties = "mesh" the rigid planet takes the reduced body's (FE) mass properties."""
     import exudyn as exu
     from exudyn.rigidBodyUtilities import Inertia6D2InertiaTensor

@@ -115,7 +115,7 @@ def _model1_runs(ramp_time_s: float, end_time_s: float, solver_field: str, value
 def test_model1_signals_with_linear_frames():
     """Model 1 (every body rigid, bearings at their seats) with linear frames against Exudyn's rigid bodies and
     three springs per bearing, 20 ms ramps, steady window 40-60 ms: every signal's mean within 0.1 % and 1x mesh
-    amplitude within 2 % (issue 16's rule; measured 3e-4 and 1.1e-3)."""
+    amplitude within 2 % (the agreement rule, flexgear.study.agreement; measured 3e-4 and 1.1e-3)."""
     from flexgear.study.agreement import signal_agreement
 
     runs = _model1_runs(0.02, 0.06, "frame_equations", ("exact", "linear"))

@@ -92,7 +92,7 @@ def _with_updates(variant, updates: str):
 
 
 def test_the_economy_keeps_every_signal_and_saves_iterations(short_model1):
-    """Issue 16's rule (means 0.1 %, 1x mesh amplitudes 2 %) against Exudyn's own Jacobian policy, fewer iterations."""
+    """The agreement rule (means 0.1 %, 1x amplitudes 2 %) against Exudyn's own Jacobian policy; fewer iterations."""
     ref = run_variant(_with_updates(short_model1, "exudyn"))
     new = run_variant(_with_updates(short_model1, "economy"))
     assert ref.ok and new.ok, (ref.meta.get("reason"), new.meta.get("reason"))

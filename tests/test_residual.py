@@ -131,7 +131,7 @@ def test_dropped_modes_carry_most_of_a_small_gears_compliance(gearbox):
 @pytest.mark.parametrize("variant", ["model4.toml", "quick/model4.toml"])
 def test_model4_with_the_cutoff_keeps_the_whole_basis_means(variant):
     """Model 4 (flexible sun and ring), impact law, a short run: the variant's cut-off against every mode
-    dynamic. Mean mesh forces within 0.1 % and their 1x mesh amplitudes within 2 % (issue 16's rule), and so the
+    dynamic. Mean mesh forces within 0.1 % and their 1x mesh amplitudes within 2 % (the agreement rule), and so the
     load deflections' 1x. The study's variant (cut-off 8x, the bolted ring kept whole): measured within 0.04 %
     with the sun's dropped modes answering its joint's force (+0.7 % sun-planet with the quasi-static seat
     reaction, +2.3 % without the residual's damping: benchmarks/bench_residual.py), sun-planet load deflections
@@ -170,7 +170,7 @@ def test_model5_planets_dropped_modes_answer_their_bearing_force():
     planet on its Table 2 bearing (about 1.6 kHz) is above resonance at the 4.4 kHz mesh frequency, so its inertia
     takes most of the 1x mesh load. With the dropped modes answering the bearing's force (residual_seat_loads =
     "dynamic", the default) every mesh force keeps its mean within 0.1 % and every mesh force and load deflection
-    its 1x amplitude within 2 % (issue 16's rule; measured within 0.51 %); with the contacts' quasi-static reaction
+    its 1x amplitude within 2 % (the agreement rule; measured within 0.51 %); with the contacts' quasi-static reaction
     at the seat the planet-ring load deflections' 1x is 26 % off (benchmarks/bench_residual.py)."""
     from flexgear.mbs.run import run_variant
     from flexgear.study.agreement import signal_agreement

@@ -1,4 +1,4 @@
-"""The ring-output shaft joint (issue 13, "supports where they are"): reduced bodies joined as the multibody model
+"""The ring-output shaft joint (supports where they are): reduced bodies joined as the multibody model
 joins them, against full FE of ring + output shaft tied over the bolts' clamped discs (coarse meshes)."""
 
 import dataclasses

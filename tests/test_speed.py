@@ -1,4 +1,4 @@
-"""The speed levers of issue 16 change no result: compiled per-step updates against the numpy reference
+"""The speed levers change no result: compiled per-step updates against the numpy reference
 formulation, the lumped right-hand side for other integrators against the project's own RK4.
 
 No timings here (benchmarks/bench_speed.py and benchmarks/bench_lumped.py measure them).
@@ -66,7 +66,7 @@ def short_model7():
 
 
 def test_compiled_updates_keep_every_signal_of_the_reference_formulation(short_model7, monkeypatch):
-    """Issue 16's rule: means within 0.1 %, 1x mesh amplitudes within 2 % (flexgear.study.agreement)."""
+    """The agreement rule: means within 0.1 %, 1x mesh amplitudes within 2 % (flexgear.study.agreement)."""
     fast = run_variant(short_model7, reduced_source=annulus_source)
     assert fast.ok, fast.meta.get("reason")
     monkeypatch.setattr(ContactKinematics, "matrix_at", ContactKinematics.reference_matrix_at)

@@ -5,7 +5,7 @@ spinning state with elastic coordinates and velocities, both give the same modal
 gyroscopic, spin-softening and centrifugal terms of the linear form are exact for a body spinning about its
 axis); the ramp schedule adds exactly the difference to the scheduled spin; a short run of model 4 and of
 model 7 with the linear forms keeps the reference's mean mesh forces (0.1 %) and 1x mesh amplitudes (2 %),
-issue 16's rule for a faster formulation.
+the agreement rule (flexgear.study.agreement) for a faster formulation.
 """
 
 from __future__ import annotations

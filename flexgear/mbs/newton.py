@@ -22,7 +22,7 @@ measures it, for the report only (:attr:`JacobianEconomy.measured_ratio`, the ru
 without a Jacobian (least squares in running sums; ``b`` the cost of one iteration) and a Jacobian's cost the
 mean excess ``t - (a + b n)`` of the steps with one. The converged solution is the same to the Newton
 tolerance (the tolerance and the iteration are unchanged, only the matrix they use is fresher);
-``tests/test_newton.py`` checks issue 16's rule against Exudyn's own Jacobian policy.
+``tests/test_newton.py`` checks the agreement rule (flexgear.study.agreement) against Exudyn's own Jacobian policy.
 """
 
 from __future__ import annotations

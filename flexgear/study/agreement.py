@@ -1,6 +1,6 @@
 """Agreement of two runs of the same variant: a faster formulation or solver setting against the reference.
 
-Issue 16's acceptance rule: every signal's mean within 0.1 % and its amplitude at the mesh frequency
+The acceptance rule: every signal's mean within 0.1 % and its amplitude at the mesh frequency
 (1x, windowed DTFT as Table 7, flexgear.study.compare.harmonic_amplitudes) within 2 % of the
 reference run, over a common analysis window.
 
@@ -23,8 +23,8 @@ from flexgear.study.compare import harmonic_amplitudes
 
 __all__ = ["SignalAgreement", "signal_agreement"]
 
-MEAN_TOLERANCE = 1e-3  # issue 16: means within 0.1 %
-AMPLITUDE_TOLERANCE = 2e-2  # issue 16: 1x mesh amplitudes within 2 %
+MEAN_TOLERANCE = 1e-3  # means within 0.1 %
+AMPLITUDE_TOLERANCE = 2e-2  # 1x mesh amplitudes within 2 %
 NOISE_FLOOR = 1e-6  # amplitudes below this fraction of the mean's scale: the reference Newton tolerance, noise
 
 
