@@ -91,7 +91,7 @@ def test_campbell_command_writes_files(tmp_path, capsys):
     variant.write_text(text.replace('mesh_level = "coarse"', 'rigid_mass_properties = "exact"'))
     parser = argparse.ArgumentParser(prog="flexgear")
     add_parsers(parser.add_subparsers(dest="command", required=True))
-    args = parser.parse_args([CAMPBELL[0], str(variant), "--speeds-rpm", "0:6000:3", "--f-max-hz", "2000",
+    args = parser.parse_args([CAMPBELL[0], str(variant), "--speeds-rpm", "0:6000:3000", "--f-max-hz", "2000",
                               "--out", str(tmp_path / "out")])
     assert args.speeds_rpm == [0.0, 3000.0, 6000.0]
     assert args.func(args) == 0

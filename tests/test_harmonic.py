@@ -22,7 +22,7 @@ import numpy as np
 import pytest
 
 from flexgear.harmonic import harmonic_response, lumped_harmonic_response, mesh_frequency_hz
-from flexgear.harmonic.cli import parse_speeds
+from flexgear.modal.cli import speeds_rpm as parse_speeds
 
 RAMP_S, END_S = 0.05, 0.25  # short load case: the ramps, then 0.2 s (the slowest decay time is about 33 ms)
 WINDOW_S = 0.1  # analysed: the last 0.1 s, a whole number of mesh cycles

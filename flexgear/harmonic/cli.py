@@ -12,28 +12,15 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-__all__ = ["SWEEP_SPEED", "args_sweep_speed", "cmd_sweep_speed", "parse_speeds"]
+from flexgear.modal.cli import speeds_rpm
 
-
-def parse_speeds(text: str) -> list[float]:
-    """``START:STOP:STEP`` (STOP included when the steps reach it) or a comma-separated list, in rpm."""
-    try:
-        if ":" in text:
-            start, stop, step = (float(x) for x in text.split(":"))
-            if step <= 0.0 or stop < start:
-                raise ValueError
-            count = int(round((stop - start) / step + 1e-9)) + 1
-            speeds = [start + k * step for k in range(count)]
-            return [s for s in speeds if s <= stop + 1e-9 * max(abs(stop), 1.0)]
-        return [float(x) for x in text.split(",") if x.strip()]
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected START:STOP:STEP or a list of speeds in rpm, got {text!r}") from None
+__all__ = ["SWEEP_SPEED", "args_sweep_speed", "cmd_sweep_speed"]
 
 
 def args_sweep_speed(p: argparse.ArgumentParser) -> None:
     """The arguments of ``flexgear sweep-speed``."""
     p.add_argument("variant", help="variant file (model_variants/model1.toml ...)")
-    p.add_argument("--speeds-rpm", type=parse_speeds, default=parse_speeds("500:7000:200"), metavar="A:B:S",
+    p.add_argument("--speeds-rpm", type=speeds_rpm, default=speeds_rpm("500:7000:200"), metavar="A:B:S",
                    help="input speeds in rpm, START:STOP:STEP or a list a,b,c (default: 500:7000:200)")
     p.add_argument("--harmonics", type=int, default=10, metavar="H", help="mesh harmonics 1..H (default: 10)")
     p.add_argument("--lumped", action="store_true", help="the lumped model of the variant's gearbox")

@@ -6,7 +6,7 @@ components holding most kinetic and strain energy) and writes
 DIR/<variant>/modes.csv (flexgear.modal.modes.Modes.table: mode, frequency_hz, damping_ratio, kind, multiplicity,
 spread_pct, kinetic_<component>, strain_<component>).
 
-``flexgear campbell VARIANT [--speeds-rpm 0:6000:13] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell) writes
+``flexgear campbell VARIANT [--speeds-rpm 0:6000:500] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell) writes
 DIR/<variant>/campbell.csv (speed_rpm, mode, frequency_hz, damping_ratio, kind), crossings.csv (speed_rpm, order,
 mode, kind, frequency_hz) and campbell.png.
 
@@ -67,25 +67,26 @@ SUBCOMMAND = ("modes", "natural frequencies, damping and mode kinds of a variant
 
 
 def speeds_rpm(text: str) -> list[float]:
-    """``--speeds-rpm``: ``START:STOP:COUNT`` (COUNT equally spaced speeds from START to STOP, both included) or a
-    comma-separated list, in rpm."""
+    """``--speeds-rpm`` of every speed-grid command: ``START:STOP:STEP`` in rpm (STOP included when the steps reach
+    it) or a comma-separated list."""
     try:
         if ":" in text:
-            start, stop, count = text.split(":")
-            a, b, n = float(start), float(stop), int(count)
-            if n < 1:
+            start, stop, step = (float(x) for x in text.split(":"))
+            if step <= 0.0 or stop < start:
                 raise ValueError
-            return [a + (b - a) * i / (n - 1) for i in range(n)] if n > 1 else [a]
-        return [float(x) for x in text.split(",")]
+            count = int(round((stop - start) / step + 1e-9)) + 1
+            speeds = [start + k * step for k in range(count)]
+            return [s for s in speeds if s <= stop + 1e-9 * max(abs(stop), 1.0)]
+        return [float(x) for x in text.split(",") if x.strip()]
     except ValueError:
-        raise argparse.ArgumentTypeError(f"expected START:STOP:COUNT or a list a,b,c in rpm, got {text!r}") from None
+        raise argparse.ArgumentTypeError(f"expected START:STOP:STEP or a list a,b,c in rpm, got {text!r}") from None
 
 
 def args_campbell(p: argparse.ArgumentParser) -> None:
     """The arguments of ``flexgear campbell``."""
     p.add_argument("variant", help="variant file (model_variants/model1.toml ...)")
-    p.add_argument("--speeds-rpm", type=speeds_rpm, default=speeds_rpm("0:6000:13"), metavar="A:B:N",
-                   help="input speeds in rpm: N equally spaced from A to B, or a list a,b,c (default: 0:6000:13)")
+    p.add_argument("--speeds-rpm", type=speeds_rpm, default=speeds_rpm("0:6000:500"), metavar="A:B:S",
+                   help="input speeds in rpm, START:STOP:STEP or a list a,b,c (default: 0:6000:500, 13 speeds)")
     p.add_argument("--f-max-hz", type=float, default=None, metavar="F",
                    help="highest frequency in Hz (default: 10x the mesh frequency at the highest speed)")
     p.add_argument("--out", default="results", metavar="DIR",
