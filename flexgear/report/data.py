@@ -18,7 +18,7 @@ from flexgear.study.screening import (
     Screening,
     Selection,
     Window,
-    analysis_window,
+    run_window,
     screen,
 )
 from flexgear.study.sweep import SweepResult
@@ -65,8 +65,7 @@ class ReportData:
         return self.primary.lines
 
     def window(self, result: RunResult) -> Window:
-        t = result.signals["time_s"].to_numpy()
-        return analysis_window(result.meta, float(t[0]), float(t[-1]), self.settings, result.signals)
+        return run_window(result, self.settings)
 
 
 def _natural(name: str) -> tuple:

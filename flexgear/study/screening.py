@@ -55,30 +55,10 @@ from flexgear.spec import ScreeningSettings
 from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, on_scale, segment_slices
 from flexgear.study.selection import DecisionLines, Selection, select_variant, variant_names
 
-__all__ = [
-    "INDICATORS",
-    "DecisionLines",
-    "Window",
-    "IndicatorResult",
-    "VariantScreening",
-    "Selection",
-    "analysis_window",
-    "sample_means",
-    "bias_pct",
-    "cv_pct",
-    "sigma_metric",
-    "indicator_samples",
-    "Screening",
-    "screen",
-    "screen_result",
-    "screening_tables",
-    "select_variant",
-    "scaled_bias_cv",
-    "reference_means",
-    "UnsettledReference",
-    "ReferenceNotUsable",
-    "numerical_error",
-]
+__all__ = ["INDICATORS", "DecisionLines", "Window", "IndicatorResult", "VariantScreening", "Selection",
+           "analysis_window", "sample_means", "bias_pct", "cv_pct", "sigma_metric", "indicator_samples", "Screening",
+           "screen", "screen_result", "screening_tables", "select_variant", "scaled_bias_cv", "scaled_bias",
+           "run_window", "reference_means", "UnsettledReference", "ReferenceNotUsable", "numerical_error"]
 
 INDICATORS: dict[str, str] = STUDY_INDICATORS
 """The study's five indicators (section 2.2): key -> readable name."""
@@ -202,13 +182,20 @@ class VariantScreening:
     zone_rank: int
 
 
-def indicator_samples(result: RunResult, settings: ScreeningSettings, keys: tuple[str, ...] | None = None
-                      ) -> tuple[Window, dict[str, np.ndarray]]:
-    """The run's window and each indicator's samples in it (``sample_count`` segments)."""
+def run_window(result: RunResult, settings: ScreeningSettings) -> Window:
+    """The analysis window of a finished run (:func:`analysis_window` over its own signals)."""
     if not result.ok or result.signals is None:
         raise ValueError(f"{result.name}: run did not finish ({result.meta.get('reason')})")
     t = result.signals["time_s"].to_numpy()
-    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings, result.signals)
+    return analysis_window(result.meta, float(t[0]), float(t[-1]), settings, result.signals)
+
+
+def indicator_samples(result: RunResult, settings: ScreeningSettings, keys: tuple[str, ...] | None = None,
+                      window: Window | None = None) -> tuple[Window, dict[str, np.ndarray]]:
+    """The run's window (``window`` when already known) and each indicator's samples in it (``sample_count``
+    segments)."""
+    window = run_window(result, settings) if window is None else window
+    t = result.signals["time_s"].to_numpy()
     slices = segment_slices(t, window.start_s, window.end_s, settings.sample_count)
     f_mesh = float(result.meta["theory"]["mesh_frequency_hz"])
     return window, indicator_segments(result.signals, slices, f_mesh, keys)
@@ -221,14 +208,18 @@ def scaled_bias_cv(samples: np.ndarray, target: float, scale: str) -> tuple[floa
     """Bias and CV of samples already on their judging scale (indicators.on_scale): relative to the target in %
     for the "relative" scale (Bias = |mean - target| / |target| 100, CV = s / |mean| 100), otherwise absolute in
     the scale's unit (Bias = |mean - target|, CV = s), s the sample standard deviation (ddof = 1)."""
-    mean = float(np.mean(samples))
-    if scale == "relative":
-        return bias_pct(mean, target), cv_pct(samples)
-    return abs(mean - target), float(np.std(samples, ddof=1))
+    cv = cv_pct(samples) if scale == "relative" else float(np.std(samples, ddof=1))
+    return scaled_bias(float(np.mean(samples)), target, scale), cv
+
+
+def scaled_bias(mean: float, target: float, scale: str) -> float:
+    """Bias of a mean on its judging scale: |mean - target| / |target| 100 (%) on the "relative" scale, otherwise
+    |mean - target| in the scale's unit."""
+    return bias_pct(mean, target) if scale == "relative" else abs(mean - target)
 
 
 def screen_result(result: RunResult, settings: ScreeningSettings,
-                  reference: dict[str, float] | None = None) -> VariantScreening:
+                  reference: dict[str, float] | None = None, window: Window | None = None) -> VariantScreening:
     """Screen one finished run.
 
     ``reference`` None: the study's mode, the five indicators against ``result.meta["theory"]``,
@@ -239,13 +230,13 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
     """
     lines = DecisionLines.from_settings(settings, "ref" if reference is not None else "")
     if reference is None:
-        window, samples = indicator_samples(result, settings, tuple(INDICATORS))
+        window, samples = indicator_samples(result, settings, tuple(INDICATORS), window)
         theory = result.meta["theory"]
         targets = {k: float(theory[_THEORY_KEYS[k]]) for k in samples}
         weights = dataclasses.asdict(settings.weights)
         tols = dict.fromkeys(samples, (settings.allowable_total_error_pct, "relative"))
     else:
-        window, samples = indicator_samples(result, settings)
+        window, samples = indicator_samples(result, settings, window=window)
         tol = {k: getattr(settings.reference_indicators, k) for k in samples if k in reference}
         samples = {k: on_scale(k, tol[k].scale, v) for k, v in samples.items() if k in tol}
         targets = {k: float(reference[k]) for k in samples}
@@ -309,8 +300,7 @@ def numerical_error(reference: RunResult, settings: ScreeningSettings) -> tuple[
         samples = indicator_segments(table, segment_slices(t, float(t[0]), float(t[-1]), settings.sample_count),
                                      f_mesh)
         means.append({k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()})
-    errors = {k: scaled_bias_cv(np.array([means[1][k], means[1][k]]), means[0][k], getattr(tol, k).scale)[0]
-              for k in means[0] if k in means[1]}
+    errors = {k: scaled_bias(means[1][k], means[0][k], getattr(tol, k).scale) for k in means[0] if k in means[1]}
     total = sum(getattr(tol, k).weight for k in errors)
     return sum(getattr(tol, k).weight / total * e / getattr(tol, k).tea * 100.0 for k, e in errors.items()), errors
 
@@ -344,16 +334,14 @@ class UnsettledReference(ReferenceNotUsable):
     """The screening's reference has not settled."""
 
 
-def _unsettled_reason(result: RunResult, settings: ScreeningSettings) -> str:
+def _unsettled_reason(result: RunResult, settings: ScreeningSettings, window: Window) -> str:
     """Why a finished run cannot be screened as settled ('' when it can): the runner's own settling test
-    (``[load_case] end = "settled"``) or, with ``window = "settled"``, the window's."""
+    (``[load_case] end = "settled"``) or, with ``window = "settled"``, its ``window``'s."""
     if result.meta.get("settled") is False:
         return str(result.meta.get("settle_reason") or "not settled")
-    if settings.window != "settled" or result.signals is None:
+    if settings.window != "settled" or window.steady:
         return ""
-    t = result.signals["time_s"].to_numpy()
-    window = analysis_window(result.meta, float(t[0]), float(t[-1]), settings, result.signals)
-    return "" if window.steady else (window.settling.reason if window.settling else window.rule)
+    return window.settling.reason if window.settling else window.rule
 
 
 def reference_means(results: list[RunResult], name: str, settings: ScreeningSettings) -> dict[str, float]:
@@ -365,12 +353,13 @@ def reference_means(results: list[RunResult], name: str, settings: ScreeningSett
                          f"({', '.join(r.name for r in results) or 'none'})")
     if not ref.ok:
         raise ReferenceNotUsable(f"not screened: reference {name} did not finish ({ref.meta.get('reason')})")
-    why = _unsettled_reason(ref, settings)
+    window = run_window(ref, settings)
+    why = _unsettled_reason(ref, settings, window)
     if why:
         raise UnsettledReference(f"not screened: reference {name} has not settled by "
                                  f"{float(ref.meta.get('t_end_s', math.nan)):.4g} s ({why}); run it longer "
                                  "(--t-end settled)")
-    _, samples = indicator_samples(ref, settings)
+    _, samples = indicator_samples(ref, settings, window=window)
     tol = settings.reference_indicators
     return {k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()}
 
@@ -406,12 +395,17 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
         row = {"variant": res.name, "status": res.meta.get("status", "failed"),
                "reason": res.meta.get("reason") or "", "time_s": _run_time(res.meta),
                "t_end_s": res.meta.get("t_end_s", math.nan)}
-        why = _unsettled_reason(res, settings) if res.ok else ""
+        try:
+            window = run_window(res, settings) if res.ok else None
+        except (ValueError, KeyError) as exc:
+            row.update(status="failed", reason=f"screening: {exc}")
+            window = None
+        why = _unsettled_reason(res, settings, window) if window is not None else ""
         if why:
             row.update(status="unsettled", reason=why)
-        elif res.ok:
+        elif window is not None:
             try:
-                s = screen_result(res, settings, ref)
+                s = screen_result(res, settings, ref, window)
             except (ValueError, KeyError) as exc:
                 row.update(status="failed", reason=f"screening: {exc}")
             else:
