@@ -1,6 +1,6 @@
 """Harmonic response of the lumped model (flexgear.lumped): the time model's equations linearised about the
 static equilibrium under the load, excited at each mesh harmonic (the approximation and the outputs are those of
-:mod:`flexgear.harmonic.response`)."""
+flexgear.harmonic.response)."""
 
 from __future__ import annotations
 
@@ -12,7 +12,7 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.harmonic.response import (
+from flexgear.harmonic.base import (
     DEFAULT_HARMONICS,
     RPM,
     Response,

@@ -44,212 +44,25 @@ from __future__ import annotations
 import dataclasses
 import math
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 import numpy as np
-import pandas as pd
+
+from flexgear.harmonic.base import (
+    DEFAULT_HARMONICS,
+    INDICATOR_UNITS,
+    Response,
+    _excited,
+    _mesh_name,
+    _Operating,
+    _series_coefficients,
+    _sweep,
+    mesh_frequency_hz,
+)
 
 __all__ = ["Response", "harmonic_response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS"]
-
-DEFAULT_HARMONICS = 10
-"""Mesh harmonics h = 1..H of the excitation and response."""
-
-RPM = 2.0 * math.pi / 60.0  # rad/s per rpm
-
-INDICATOR_UNITS = {"mesh_force": "N", "bearing_accel": "m/s^2", "transmission_error": "m", "dynamic_factor": "-"}
-"""Unit of each family of indicators (by a part of the name)."""
-
-_TABLE_COLUMNS = ["speed_rpm", "harmonic", "frequency_hz", "indicator", "amplitude", "phase"]
-
-
-def _unit(indicator: str) -> str:
-    return next((u for key, u in INDICATOR_UNITS.items() if key in indicator), "")
-
-
-@dataclass
-class Response:
-    """Harmonic response over a speed grid (module docstring).
-
-    ``table``: one row per speed, harmonic and indicator: speed_rpm, harmonic (0 for sums over harmonics),
-    frequency_hz (h f_mesh), indicator, amplitude (SI units of the indicator), phase [rad]. ``static_forces_n``:
-    static normal force of each mesh [N]; ``mesh_frequency_hz_per_rpm``: f_mesh per input rpm [Hz/rpm];
-    ``wall_time_s``: time spent (linearisation and solves).
-    """
-
-    table: pd.DataFrame
-    model: str
-    static_forces_n: dict[str, float] = field(default_factory=dict)
-    mesh_frequency_hz_per_rpm: float = 0.0
-    wall_time_s: float = 0.0
-
-    @property
-    def indicators(self) -> list[str]:
-        return list(dict.fromkeys(self.table["indicator"]))
-
-    @property
-    def speeds_rpm(self) -> np.ndarray:
-        return np.unique(self.table["speed_rpm"].to_numpy())
-
-    def amplitudes(self, indicator: str) -> pd.DataFrame:
-        """Amplitude of ``indicator``: one row per speed [rpm], one column per harmonic."""
-        sel = self.table[self.table["indicator"] == indicator]
-        if sel.empty:
-            raise KeyError(f"no indicator {indicator!r}; known: {', '.join(self.indicators)}")
-        return sel.pivot(index="speed_rpm", columns="harmonic", values="amplitude")
-
-    def complex(self, indicator: str) -> pd.DataFrame:
-        """Complex amplitude (amplitude e^{i phase}) of ``indicator``: rows speeds, columns harmonics."""
-        sel = self.table[self.table["indicator"] == indicator]
-        values = sel["amplitude"].to_numpy() * np.exp(1j * sel["phase"].to_numpy())
-        return pd.DataFrame({"speed_rpm": sel["speed_rpm"].to_numpy(), "harmonic": sel["harmonic"].to_numpy(),
-                             "value": values}).pivot(index="speed_rpm", columns="harmonic", values="value")
-
-    def dynamic_factor(self) -> pd.Series:
-        """K_v per speed [rpm] (module docstring)."""
-        return self.amplitudes("dynamic_factor")[0]
-
-    def plot(self, ax: Any, indicator: str, harmonics: Sequence[int] | None = None) -> Any:
-        """Amplitude of ``indicator`` over the speed [rpm], one line per harmonic (``harmonics``: which, default
-        all; K_v one line); a mesh-frequency axis on top. Returns ``ax``."""
-        amp = self.amplitudes(indicator)
-        cols = [h for h in amp.columns if harmonics is None or h in harmonics]
-        for h in cols:
-            ax.plot(amp.index, amp[h], lw=1.0, label="sum" if h == 0 else f"{h}x mesh")
-        unit = _unit(indicator)
-        ax.set_xlabel("input speed [rpm]")
-        ax.set_ylabel(f"{indicator} [{unit}]" if unit else indicator)
-        ax.set_title(f"{self.model}: {indicator}")
-        if indicator != "dynamic_factor":
-            ax.set_yscale("log")
-        if len(cols) > 1:
-            ax.legend(fontsize="small", ncol=2)
-        if self.mesh_frequency_hz_per_rpm > 0.0:
-            k = self.mesh_frequency_hz_per_rpm
-            top = ax.secondary_xaxis("top", functions=(lambda n: n * k, lambda f: f / k))
-            top.set_xlabel("mesh frequency f_mesh [Hz]")
-        ax.grid(True, alpha=0.3)
-        return ax
-
-
-# --------------------------------------------------------------------------- the linear problem at one speed
-@dataclass
-class _Operating:
-    """The linearised model at one speed, with its excitation and outputs (all SI).
-
-    ``rows`` (n_c, n): contact deflection per coordinate; ``k_t``, ``c``, ``f0`` (n_c,): tangent stiffness,
-    damping, static force; ``coef`` (n_c, H): complex Fourier coefficient of s - 1 at +h f_mesh; ``mesh`` (n_c,):
-    index of each contact's mesh in ``mesh_names``; ``accel`` (4, n): input x, y and output x, y translation
-    per coordinate; ``te`` (n,): transmission error per coordinate; ``omega_mesh`` [rad/s].
-    """
-
-    mass: np.ndarray
-    damping: np.ndarray
-    stiffness: np.ndarray
-    rows: np.ndarray
-    k_t: np.ndarray
-    c: np.ndarray
-    f0: np.ndarray
-    coef: np.ndarray
-    mesh: np.ndarray
-    mesh_names: tuple[str, ...]
-    accel: np.ndarray
-    te: np.ndarray
-    omega_mesh: float
-
-
-_ACCEL = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
-
-
-def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
-    """Complex amplitudes (H,) of every indicator at one speed (module docstring)."""
-    h = np.arange(1, harmonics + 1)
-    w = h * op.omega_mesh
-    n = op.mass.shape[0]
-    a = (op.stiffness[None] - (w**2)[:, None, None] * op.mass[None]
-         + 1j * w[:, None, None] * op.damping[None])  # (H, n, n)
-    excite = op.f0[:, None] * op.coef  # (n_c, H): F_0 C_h
-    f = -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
-    x = np.linalg.solve(a, f[..., None])[..., 0] if n else np.zeros((harmonics, 0), complex)
-    delta = x @ op.rows.T  # (H, n_c)
-    contact = (op.k_t[None] + 1j * w[:, None] * op.c[None]) * delta + excite.T
-    out: dict[str, np.ndarray] = {}
-    for m, name in enumerate(op.mesh_names):
-        out[name] = contact[:, op.mesh == m].sum(axis=1)
-    acc = -(w**2)[:, None] * (x @ op.accel.T)
-    for k, name in enumerate(_ACCEL):
-        out[name] = acc[:, k]
-    out["transmission_error_m"] = x @ op.te
-    return out
-
-
-def _mesh_name(kind: str, i: int) -> str:
-    return f"{kind}_mesh_force_{i}_n"
-
-
-def _sweep(operating: Callable[[float], _Operating], speeds_rpm: Sequence[float], harmonics: int, model: str,
-           per_rpm: float, t0: float) -> Response:
-    """Solve every speed and gather the table."""
-    if harmonics < 1:
-        raise ValueError(f"harmonics: expected >= 1, got {harmonics}")
-    speeds = np.asarray(speeds_rpm, float)
-    if speeds.ndim != 1 or speeds.size == 0:
-        raise ValueError("speeds_rpm: expected a non-empty list of speeds")
-    h = np.arange(1, harmonics + 1)
-    columns: dict[str, list] = {c: [] for c in _TABLE_COLUMNS}
-    static: dict[str, float] = {}
-
-    def put(speed: float, harm: np.ndarray, freq: np.ndarray, name: str, values: np.ndarray) -> None:
-        columns["speed_rpm"].append(np.full(harm.size, speed))
-        columns["harmonic"].append(harm)
-        columns["frequency_hz"].append(freq)
-        columns["indicator"].append(np.full(harm.size, name, dtype=object))
-        columns["amplitude"].append(np.abs(values))
-        columns["phase"].append(np.angle(values))
-
-    for speed in speeds:
-        op = operating(float(speed))
-        out = _solve(op, harmonics)
-        static = {name: float(op.f0[op.mesh == m].sum()) for m, name in enumerate(op.mesh_names)}
-        for kind in ("outer", "inner"):  # the largest over the planets, per harmonic
-            names = [nm for nm in op.mesh_names if nm.startswith(f"{kind}_")]
-            if names:
-                stack = np.stack([out[nm] for nm in names])
-                out[f"{kind}_mesh_force_max_n"] = stack[np.abs(stack).argmax(axis=0), np.arange(harmonics)]
-        freq = h * op.omega_mesh / (2.0 * math.pi)
-        for name, values in out.items():
-            put(float(speed), h, freq, name, values)
-        kv = 1.0 + max(float(np.abs(out[nm]).sum()) / static[nm] for nm in op.mesh_names)
-        put(float(speed), np.zeros(1, int), np.zeros(1), "dynamic_factor", np.array([kv]))
-    table = pd.DataFrame({c: np.concatenate(v) for c, v in columns.items()})
-    return Response(table, model, static, per_rpm, time.perf_counter() - t0)
-
-
-def mesh_frequency_hz(spec: Any, speed_rpm: float) -> float:
-    """f_mesh = z_sun (n_in - n_carrier) / 60 [Hz] at the input speed ``speed_rpm`` (carrier speed from the
-    arrangement: fixed for the star, z_s / (z_s + z_r) of the input for the planetary)."""
-    g = spec.gears
-    r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
-    return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
-
-
-def _excited(spec: Any, harmonics: int) -> Any:
-    """The spec with ``harmonics`` stiffness harmonics from the contact lines (eq. 11-12)."""
-    spec = spec.with_fields("contact_assumed", stiffness_harmonics=int(harmonics))
-    if spec.contact_assumed.stiffness_variation == "constant":
-        spec = spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
-    return spec
-
-
-def _series_coefficients(cos_c: np.ndarray, sin_c: np.ndarray, offset_cycles: np.ndarray,
-                         rate_sign: np.ndarray) -> np.ndarray:
-    """Complex coefficients (n_c, H) at +h f_mesh of s(phi) - 1 = sum_h a_h cos 2 pi h phi + b_h sin 2 pi h phi,
-    phi = rate t + offset: (a_h - i b_h) e^{i 2 pi h offset}, conjugated where the phase runs backwards."""
-    h = np.arange(1, cos_c.shape[1] + 1)
-    c = (cos_c - 1j * sin_c) * np.exp(2j * np.pi * h[None] * offset_cycles[:, None])
-    return np.where(rate_sign[:, None] >= 0, c, c.conj())
 
 
 def _lagrange(nodes: np.ndarray, x: float) -> np.ndarray:
