@@ -280,8 +280,9 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
                         {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
                         f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
     body += _provenance_pages(d)
+    # the other results folders' verdict diagrams first, each titled with its folder
+    body = [(f"{o.results_dir.name}: {title}", draw) for o in others for title, draw in rp.diagram_pages(o)[-1:]] + body
     contents = [(i + 3, title) for i, (title, _) in enumerate(body)]
-    body = [page for o in others for page in rp.diagram_pages(o)[-1:]] + body
     pages: list[Page] = [("flexgear screening report: verdict", _verdict_page(d, others)),
                          ("Runs, screening rule and contents", _title_page(d, contents, created)), *body]
     if westgard_png is not None:
