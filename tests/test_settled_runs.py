@@ -89,3 +89,12 @@ def test_verdicts_against_the_reference_at_half_the_step_are_unchanged_or_not_re
     assert (with_error["error_pct"].dropna() > 0).all()
     for name in ("radius", "frictionless"):
         assert zones[0][name] == zones[1][name] or not with_error.loc[name, "resolved"], name
+
+
+def test_the_error_windows_are_timed_apart_from_the_run(model1):
+    """A run with its numerical error windows records their cost apart: its own CPU time stays the run's."""
+    v = _short(model1, end_time_s=0.02)
+    res = run_variant(v, error_window_s=0.01)
+    assert res.ok and res.meta["error_windows_cpu_time_s"] > 0.0
+    assert 0.0 < res.meta["cpu_time_s"] and set(res.extra) == {"error_step", "error_half_step"}
+    assert float(res.signals["time_s"].iloc[-1]) == pytest.approx(0.02)   # the run's own signals end at its end
