@@ -50,16 +50,18 @@ def build(mbs, spec):
     rho = spec.material_assumed.density_kg_m3
     pinion = fg.add_rigid_body(mbs, "pinion", fg.annulus_mass_properties(BORE_M / 2, mesh.gear1.reference_radius,
                                                                          WIDTH_M, rho), np.zeros(3))
+    w_in = INPUT_SPEED_RPM * 2 * math.pi / 60
+    # linear floating frame at the wheel's nominal spin; the SpinSchedule moves its spin terms with the ramp
     wheel = fg.add_flexible_body(mbs, "wheel", wheel_body(spec, mesh), centre2,
                                  stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
-                                 interface_markers=[], show=False)
+                                 interface_markers=[], show=False, nominal_spin_rad_s=-w_in * Z_PINION / Z_WHEEL)
+    spin = fg.SpinSchedule(mbs, [wheel], RAMP_S, spec.solver_assumed.spin_update_interval_s)
     contact = dataclasses.replace(spec.contact, damping_fraction_of_stiffness=DAMPING_FRACTION)
     contacts = fg.pair_contacts("mesh", "pinion", "wheel", mesh, np.zeros(3), centre2, contact,
                                 spec.contact_assumed, hand=1, drive_sign=1.0)
     bushings = [fg.Bushing(name, RADIAL_N_PER_M, AXIAL_N_PER_M, TILT_NM_PER_RAD, DAMPING_PER_STIFFNESS_S)
                 for name in ("pinion", "wheel")]
-    w_in = INPUT_SPEED_RPM * 2 * math.pi / 60
-    train = fg.add_gear_train(mbs, [pinion, wheel], bushings, contacts, RAMP_S, w_in,
+    train = fg.add_gear_train(mbs, [pinion, wheel], bushings, contacts, RAMP_S, w_in, extra_pre_steps=[spin],
                               contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                               radial_band=MODULE_M)
     drive = fg.add_speed_drive(mbs, pinion, RAMP_S, w_in)

@@ -32,7 +32,7 @@ _LAZY = {
     "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",
     # multibody: bodies, elements, contacts
     "Body": "mbs.bodies", "add_rigid_body": "mbs.bodies", "LinearFrame": "mbs.bodies", "add_linear_frame": "mbs.bodies",
-    "FlexibleBody": "mbs.flexible", "add_flexible_body": "mbs.flexible",
+    "FlexibleBody": "mbs.flexible", "add_flexible_body": "mbs.flexible", "SpinSchedule": "mbs.spin",
     "Bushing": "mbs.elements", "add_fixed_joint": "mbs.elements", "add_interface_joint": "mbs.elements",
     "add_speed_drive": "mbs.elements", "add_load_torque": "mbs.elements",
     "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts",

@@ -26,7 +26,7 @@ from flexgear.schema_screening import (
 
 __all__ = [
     "SpecError", "GearSet", "GearSetAssumed", "Material", "ComponentsAssumed", "Bearing", "Bearings", "Contact",
-    "ContactAssumed", "SupportsAssumed", "JointsAssumed", "LoadCase", "SolverSettings", "MeshingSettings",
+    "ContactAssumed", "JointsAssumed", "REMOVED_FIELDS", "LoadCase", "SolverSettings", "MeshingSettings",
     "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "LoadTolerance",
     "LevelTolerance", "ReferenceIndicators", "ScreeningSettings",
     "LumpedAssumed", "GearboxSpec", "Variant", "COMPONENTS", "GEAR_COMPONENTS", "SHAFT_COMPONENTS",
@@ -212,21 +212,25 @@ class SolverSettings:
     spectral_radius: float = _num(0.0, 1.0)
     newton_max_modified_iterations: int = _num(1, 50, integer=True)
     newton_relative_tolerance: float = _num(0.0, 1e-2, lo_open=True)
-    linear_solver: str = _choice("sparse", "dense")
     record_every_steps: int = _num(1, integer=True)
-    # divergence guard (flexgear.mbs.run.RunGuard); defaults keep older gearbox files valid
+    # "production": the package's formulation (linear body frames and floating frames about the prescribed spin,
+    # linear joint and seat equations, Jacobian economy); "reference": Exudyn's nonlinear objects (ObjectRigidBody,
+    # ObjectFFRFreducedOrder, ObjectJointGeneric, marker seats), for the tests that check the production one
+    formulation: str = _choice("production", "reference", default="production")
+    # divergence guard (flexgear.mbs.run.RunGuard)
     wall_time_budget_s: float = _num(0.0, lo_open=True, default=7200.0)
     runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
-    # linear floating frame: interval [s] of the spin-term updates in the ramp (flexgear.mbs.spin.SpinSchedule)
+    # interval [s] of the spin-term updates in the ramps (flexgear.mbs.spin.SpinSchedule)
     spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
-    # body frames' inertia: Exudyn's ObjectRigidBody, or constant matrices about the spin (mbs.bodies.add_linear_frame)
-    frame_equations: str = _choice("exact", "linear", default="exact")
+    # bodies axisymmetric within this relative tolerance take the linear frame (flexgear.mbs.bodies.add_linear_frame)
     frame_axisymmetry_tolerance: float = _num(0.0, 1.0, default=1e-4)
-    # sparse LU: a new ordering at each factorization, or the last one reused while its pattern holds
-    sparse_ordering: str = _choice("per_jacobian", "reused", default="per_jacobian")
-    # when the modified Newton gets a fresh Jacobian (flexgear.mbs.newton)
-    jacobian_updates: str = _choice("exudyn", "economy", default="exudyn")
+    # a Jacobian's cost in Newton iterations (flexgear.mbs.newton.JacobianEconomy)
     jacobian_cost_iterations: float = _num(1.0, default=12.0)
+
+    @property
+    def reference(self) -> bool:
+        """Whether the run uses the reference formulation (Exudyn's nonlinear objects) instead of production's."""
+        return self.formulation == "reference"
 
 
 @dataclass(frozen=True)
@@ -247,21 +251,12 @@ class ReductionSettings:
     """Component-mode synthesis settings for flexible bodies (assumed)."""
 
     fixed_interface_modes: int = _num(0, 200, integer=True)
-    interface: str = _choice("rbe3", "rbe2")
     modal_stiffness_damping_s: float = _num(0.0)
     contact_fourier_order: int = _num(1, 60, integer=True)
     # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
     attachment_order: int = _num(0, 60, integer=True)
-    # 0: keep every mode of the (attachment-corrected) basis; n > 0: the n lowest (loses the static correction)
-    simulation_modes: int = _num(0, 400, integer=True, default=0)
     # gears: modes above this multiple of the mesh frequency become static residual compliance (0: all dynamic)
     dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
-    # "ffrf": Exudyn's nonlinear floating frame; "linear": flexgear.mbs.spin (rigid frame + linear modal equations)
-    floating_frame: str = _choice("ffrf", "linear", default="ffrf")
-    # "linear" bodies: "interface": linear joints' and seats' interface motions as coordinates (flexgear.mbs.flexible)
-    modal_coordinates: str = _choice("modal", "interface", default="modal")
-    # seat load that a gear's dropped modes answer (flexgear.mbs.residual)
-    residual_seat_loads: str = _choice("dynamic", "quasi_static", default="dynamic")
 
 
 @dataclass(frozen=True)
@@ -285,32 +280,30 @@ class LumpedAssumed:
 
 
 @dataclass(frozen=True)
-class SupportsAssumed:
-    """Where the bearings, the speed drive and the load torque act (flexgear.geometry.supports).
-
-    ``placement`` "bearing_seats" or "gear_centres"; ``seat_equations`` "markers" or "linear" (flexgear.mbs.joints).
-    """
-
-    placement: str = field(default="bearing_seats", metadata={"choices": ("bearing_seats", "gear_centres"),
-                                                              "doc": "where supports act"})
-    seat_equations: str = field(default="markers", metadata={"choices": ("markers", "linear"),
-                                                             "doc": "seat bearings of flexible bodies"})
-
-
-@dataclass(frozen=True)
 class JointsAssumed:
-    """How the ring and the output shaft are joined when either is flexible (flexgear.fe.bolted, flexgear.fe.reduced).
+    """The bolted joint of the ring and the output shaft (section 2.1: 12 bolts), flexgear.fe.bolted."""
 
-    ``ring_output_shaft``: a patch per bolt ("bolt_patches") or one RBE3 joint; ``bolt_patch`` rbe2/rbe3;
-    ``joint_equations`` and ``joint_axes``: the gear-shaft joints' equations (flexgear.mbs.joints).
-    """
-
-    ring_output_shaft: str = field(default="bolt_patches", metadata={"choices": ("bolt_patches", "rbe3"),
-                                                                      "doc": "ring-output shaft joint model"})
-    bolt_patch: str = field(default="rbe2", metadata={"choices": ("rbe2", "rbe3"), "doc": "bolt patch kind"})
     bolt_clamp_diameter_mm: float = field(default=21.0, metadata={"lo": 0.0, "lo_open": True, "doc": "mm"})
-    joint_equations: str = _choice("generic", "linear", doc="gear-shaft joint equations", default="generic")
-    joint_axes: str = _choice("auto", "body", "ground", doc="axes of the linear joints' equations", default="auto")
+
+
+_REFERENCE = 'the production formulation is the only one; formulation = "reference" selects Exudyn\'s'
+REMOVED_FIELDS: dict[str, str] = {
+    "solver_assumed.linear_solver": "Eigen's sparse LU is the only linear solver",
+    "solver_assumed.frame_equations": f"{_REFERENCE} ObjectRigidBody",
+    "solver_assumed.sparse_ordering": "the sparse LU keeps its ordering while the pattern holds (production)",
+    "solver_assumed.jacobian_updates": "the Jacobian economy is production's rule; the reference uses Exudyn's",
+    "reduction_assumed.interface": "seat and joint interfaces are RBE3 averages, bolt patches rigid",
+    "reduction_assumed.simulation_modes": "the whole basis is kept; gears drop modes by dynamic_cutoff_mesh_orders",
+    "reduction_assumed.floating_frame": f"{_REFERENCE} ObjectFFRFreducedOrder",
+    "reduction_assumed.modal_coordinates": "linear joints and seats always have interface coordinates (production)",
+    "reduction_assumed.residual_seat_loads": "a gear's dropped modes answer its seat's own load (production)",
+    "supports_assumed": "bearings, drive and load act at the bearing seats, the only placement",
+    "joints_assumed.ring_output_shaft": "the ring and the output shaft are joined per bolt (section 2.1)",
+    "joints_assumed.bolt_patch": "each bolt patch is a rigid clamped disc",
+    "joints_assumed.joint_equations": f"{_REFERENCE} ObjectJointGeneric",
+    "joints_assumed.joint_axes": "a joint is written in body axes where its shaft is flexible, else in ground axes",
+}
+"""Fields and tables that no longer exist, each with what replaced it (flexgear.spec names them in its error)."""
 
 
 @dataclass(frozen=True)
@@ -332,7 +325,6 @@ class GearboxSpec:
     reduction_assumed: ReductionSettings
     screening: ScreeningSettings
     lumped_assumed: LumpedAssumed
-    supports_assumed: SupportsAssumed = field(default_factory=SupportsAssumed)
     joints_assumed: JointsAssumed = field(default_factory=JointsAssumed)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
@@ -341,7 +333,7 @@ class GearboxSpec:
 
     def with_fields(self, table: str, **fields: Any) -> GearboxSpec:
         """A new spec with single fields of one table replaced (``spec.with_fields("solver_assumed",
-        jacobian_updates="exudyn")``)."""
+        formulation="reference")``)."""
         return dataclasses.replace(self, **{table: dataclasses.replace(getattr(self, table), **fields)})
 
 

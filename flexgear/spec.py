@@ -26,6 +26,7 @@ from flexgear.schema import (
     COMPONENTS,
     GEAR_COMPONENTS,
     GEOMETRY_COMPONENTS,
+    REMOVED_FIELDS,
     SHAFT_COMPONENTS,
     Bearing,
     Bearings,
@@ -47,7 +48,6 @@ from flexgear.schema import (
     ScreeningSettings,
     SolverSettings,
     SpecError,
-    SupportsAssumed,
     Variant,
 )
 
@@ -61,8 +61,8 @@ __all__ = [
     "Bearings",
     "Contact",
     "ContactAssumed",
-    "SupportsAssumed",
     "JointsAssumed",
+    "REMOVED_FIELDS",
     "LoadCase",
     "SolverSettings",
     "MeshingSettings",
@@ -137,12 +137,21 @@ def _check_value(path: Path, name: str, value: Any, hint: Any, meta: dict) -> An
     return int(value) if integer else float(value)
 
 
+def _reject_removed(path: Path, name: str) -> None:
+    """A one-line SpecError if the field or table ``name`` ("table.field") was removed from the schema."""
+    key = name.split(".", 1)[1] if name.startswith("overrides.") else name
+    if key in REMOVED_FIELDS:
+        raise SpecError(path, name, f"removed ({REMOVED_FIELDS[key]}); delete it")
+
+
 def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
     """Build dataclass ``cls`` from a TOML table, validating every field."""
     if not isinstance(data, dict):
         raise SpecError(path, prefix, "expected a table", data)
     hints = get_type_hints(cls)
     fields = {f.name: f for f in dataclasses.fields(cls)}
+    for name in data:
+        _reject_removed(path, f"{prefix}.{name}")
     unknown = sorted(set(data) - set(fields))
     if unknown:
         raise SpecError(path, f"{prefix}.{unknown[0]}", f"unknown field; allowed: {', '.join(fields)}")
@@ -170,6 +179,8 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     path = Path(path)
     raw = _read_toml(path, text)
     tables = {f.name for f in dataclasses.fields(GearboxSpec)} - {"source"}
+    for name in raw:
+        _reject_removed(path, name)
     unknown = sorted(set(raw) - set(tables))
     if unknown:
         raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
@@ -218,9 +229,6 @@ def _check_consistency(spec: GearboxSpec) -> None:
     if spec.screening.window == "fixed" and spec.screening.window_end_s <= spec.screening.window_start_s:
         raise SpecError(p, "screening.window_end_s", "expected a value > window_start_s",
                         spec.screening.window_end_s)
-    if spec.solver_assumed.frame_equations == "linear" and spec.joints_assumed.joint_equations != "linear":
-        raise SpecError(p, "solver_assumed.frame_equations", "'linear' needs [joints_assumed] joint_equations = "
-                        "'linear' (generic joints need Exudyn's rigid bodies)", "linear")
     lc = spec.load_case
     if lc.end == "settled" and lc.settle_max_time_s < lc.end_time_s:
         raise SpecError(p, "load_case.settle_max_time_s", "expected >= end_time_s (the settled run's maximum time)",
@@ -240,6 +248,7 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
     hints = get_type_hints(GearboxSpec)
     changes = {}
     for table, values in overrides.items():
+        _reject_removed(path, f"overrides.{table}")
         current = getattr(gearbox, table, None)
         if table == "source" or not dataclasses.is_dataclass(current) or not isinstance(values, dict):
             allowed = sorted(n for n, h in hints.items() if dataclasses.is_dataclass(h))

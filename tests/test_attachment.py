@@ -4,8 +4,6 @@ and the full FE models of the study's components (coarse level)."""
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
 from test_flexible import RING_B, RING_R, RING_T, STEEL, ring_mesh
@@ -57,16 +55,11 @@ def test_slender_ring_under_equal_radial_loads_matches_curved_beam_theory():
 
 @pytest.fixture(scope="module")
 def component(gearbox, request):
-    """(spec, name, full FE model, pipeline reduced body) of a gear at the coarse level.
-
-    The ring and the output shaft with one RBE3 joint interface at the bolt circle ([joints_assumed]
-    ring_output_shaft = "rbe3"): these checks hold a body at one RBE3 interface (static_compliance's ``held``);
-    the rigid bolt patches of the default joint are checked against full FE in tests/test_ring_joint.py."""
+    """(spec, name, full FE model, pipeline reduced body) of a gear at the coarse level."""
     from flexgear.fe.mesh import component_mesh
     from flexgear.fe.reduced import component_reduced_body
 
     name = request.param
-    gearbox = gearbox.with_changes(joints_assumed=dataclasses.replace(gearbox.joints_assumed, ring_output_shaft="rbe3"))
     body = component_reduced_body(gearbox, name, "coarse")
     fe = fe_model(component_mesh(gearbox, name, "coarse", order=1).ngsolve_mesh(), gearbox.material_assumed,
                   gearbox.meshing_assumed["coarse"].element_order)
@@ -76,14 +69,14 @@ def component(gearbox, request):
 
 @pytest.mark.parametrize("component", ["sun", "planet", "ring"], indirect=True)
 def test_gear_compliance_under_kernel_loads_equals_full_fe(component):
-    from flexgear.fe.reduced import component_contacts, component_load_circles
+    from flexgear.fe.reduced import component_contacts, component_load_circles, gear_seat
 
     spec, name, fe, body = component
     points, normals = component_contacts(spec, name)
     kernel = component_load_circles(spec, name, spec.reduction_assumed.contact_fourier_order)
-    held = body.interfaces[0]  # the gear's joint (bore, bolt circle)
+    held = gear_seat(spec, body, name)  # the gear's seat (bore; the ring's bolt patches as one RBE3 average)
     full = fg.static_compliance(fe, points, normals, held, kernel=kernel)
-    reduced = fg.static_compliance(body, points, normals, held.name, kernel=kernel)
+    reduced = fg.static_compliance(body, points, normals, held, kernel=kernel)
     assert np.max(np.abs(reduced - full)) < 0.02 * np.max(np.abs(full))
     assert reduced.sum(axis=1) == pytest.approx(full.sum(axis=1), rel=0.02)  # all contacts loaded together
     # the lowest free-free frequencies still converge to the full model's

@@ -200,7 +200,7 @@ def test_tube_static_bending_matches_beam_theory_and_full_fe():
 
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    flex = add_flexible_body(mbs, "tube", body, [0.0, 0.0, 0.0], show=False)
+    flex = add_flexible_body(mbs, "tube", body, [0.0, 0.0, 0.0], show=False, reference=True)
     ground = mbs.AddObject(ObjectGround())
     m_ground = mbs.AddMarker(MarkerBodyRigid(bodyNumber=ground, localPosition=list(body.interface("root").point)))
     mbs.AddObject(GenericJoint(markerNumbers=[m_ground, flex.interface_markers["root"]], constrainedAxes=[1] * 6))
@@ -225,7 +225,7 @@ def test_spinning_ring_expands_and_keeps_angular_momentum(coarse_ring_fe):
     omega = 600.0
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    flex = add_flexible_body(mbs, "ring", body, [0.0, 0.0, 0.0], angular_velocity=[0.0, 0.0, omega],
+    flex = add_flexible_body(mbs, "ring", body, [0.0, 0.0, 0.0], angular_velocity=[0.0, 0.0, omega], reference=True,
                              stiffness_damping_s=2e-5, show=False)
     sensor = mbs.AddSensor(SensorNode(nodeNumber=flex.node, storeInternal=True,
                                       outputVariableType=exu.OutputVariableType.AngularVelocity))
@@ -275,7 +275,8 @@ def test_virtual_interface_marker_moves_as_rbe3_marker_over_the_real_nodes(coars
     itf = body.interface("top")
     sc = exu.SystemContainer()
     mbs = sc.AddSystem()
-    flex = add_flexible_body(mbs, "ring", body, [0.01, -0.02, 0.03], rotation_matrix=_rot_z(0.7), show=False)
+    flex = add_flexible_body(mbs, "ring", body, [0.01, -0.02, 0.03], rotation_matrix=_rot_z(0.7), show=False,
+                             reference=True)
     real = mbs.AddMarker(MarkerSuperElementRigid(bodyNumber=flex.obj, offset=[0.0, 0.0, 0.0],
                                                  meshNodeNumbers=itf.nodes, weightingFactors=itf.weights,
                                                  useAlternativeApproach=True))

@@ -1,4 +1,5 @@
-"""Linear body frames (flexgear.mbs.bodies.add_linear_frame, ``[solver_assumed] frame_equations = "linear"``)."""
+"""Linear body frames of the production formulation (flexgear.mbs.bodies.add_linear_frame) against Exudyn's
+``ObjectRigidBody`` (the reference formulation)."""
 
 from __future__ import annotations
 
@@ -85,27 +86,16 @@ def test_asymmetric_body_is_refused():
         axisymmetric_frame_mass(MASS, [0.01 * r_g, 0.0, 0.0], np.diag([J_T, J_T, J_P]), 1e-4)
 
 
-def test_linear_frames_need_linear_joints(tmp_path):
-    """``frame_equations = "linear"`` with generic joints (which need Exudyn's rigid bodies): a one-line error that
-    names the file and the field."""
-    text = (VARIANTS / "gearbox.toml").read_text().replace('joint_equations = "linear"',
-                                                          'joint_equations = "generic"')
-    path = tmp_path / "gearbox.toml"
-    path.write_text(text)
-    with pytest.raises(fg.SpecError, match=r"gearbox.toml: field 'solver_assumed.frame_equations'"):
-        fg.load_gearbox(path)
-
-
-def _model1_runs(ramp_time_s: float, end_time_s: float, solver_field: str, values: tuple[str, ...]) -> list:
-    """Model 1 on a shortened load case, once per value of ``[solver_assumed] solver_field``."""
+def _model1_runs(ramp_time_s: float, end_time_s: float) -> list:
+    """Model 1 on a shortened load case in the reference and the production formulation."""
     from flexgear.mbs.run import run_variant
 
     v = fg.load_variant(VARIANTS / "model1.toml")
     g = v.gearbox
     lc = dataclasses.replace(g.load_case, ramp_time_s=ramp_time_s, end_time_s=end_time_s)
     runs = []
-    for value in values:
-        solver = dataclasses.replace(g.solver_assumed, **{solver_field: value})
+    for value in ("reference", "production"):
+        solver = dataclasses.replace(g.solver_assumed, formulation=value)
         run = run_variant(dataclasses.replace(v, gearbox=g.with_changes(load_case=lc, solver_assumed=solver)))
         assert run.ok, run.meta.get("reason")
         runs.append(run)
@@ -113,21 +103,12 @@ def _model1_runs(ramp_time_s: float, end_time_s: float, solver_field: str, value
 
 
 def test_model1_signals_with_linear_frames():
-    """Model 1 (every body rigid, bearings at their seats) with linear frames against Exudyn's rigid bodies and
-    three springs per bearing, 20 ms ramps, steady window 40-60 ms: every signal's mean within 0.1 % and 1x mesh
-    amplitude within 2 % (the agreement rule, flexgear.study.agreement; measured 3e-4 and 1.1e-3)."""
+    """Model 1 (every body rigid, bearings at their seats) in the production formulation (linear frames, the
+    Jacobian economy, a reused sparse ordering) against the reference (Exudyn's rigid bodies and Newton policy),
+    20 ms ramps, steady window 40-60 ms: every signal's mean within 0.1 % and 1x mesh amplitude within 2 % (the
+    agreement rule, flexgear.study.agreement)."""
     from flexgear.study.agreement import signal_agreement
 
-    runs = _model1_runs(0.02, 0.06, "frame_equations", ("exact", "linear"))
+    runs = _model1_runs(0.02, 0.06)
     agreement = signal_agreement(*runs, (0.04, 0.06), runs[0].meta["theory"]["mesh_frequency_hz"])
     assert agreement.ok(), agreement.table.sort_values("mean_diff").to_string()
-
-
-def test_reused_sparse_ordering_keeps_the_solution():
-    """``[solver_assumed] sparse_ordering = "reused"`` (Eigen's SparseLU keeps its column ordering between Jacobians of
-    one pattern) changes only the factorization's cost: model 1's signals equal those with a new ordering per
-    Jacobian within 1e-9 of each signal's scale."""
-    ref, new = (r.signals for r in _model1_runs(0.004, 0.008, "sparse_ordering", ("per_jacobian", "reused")))
-    for col in ref.columns:
-        scale = max(float(np.abs(ref[col]).max()), 1e-300)
-        assert np.abs(new[col] - ref[col]).max() <= 1e-9 * scale, col

@@ -4,7 +4,7 @@ from pathlib import Path
 
 import pytest
 
-from flexgear.spec import COMPONENTS, SpecError, load_gearbox, load_variant, spec_hash
+from flexgear.spec import COMPONENTS, REMOVED_FIELDS, SpecError, load_gearbox, load_variant, spec_hash
 
 VARIANTS = Path(__file__).resolve().parents[1] / "model_variants"
 
@@ -56,6 +56,25 @@ def test_bad_gearbox_names_file_field_and_allowed(tmp_path, old, new, field, all
         load_gearbox(path)
     msg = str(err.value)
     assert str(path) in msg and f"'{field}'" in msg and allowed in msg
+
+
+@pytest.mark.parametrize("removed", sorted(REMOVED_FIELDS))
+def test_removed_field_is_named_in_one_line(tmp_path, removed):
+    """A gearbox file, or a variant's override, with a field or table the schema no longer has: a one-line error
+    naming the file and the field, saying it was removed and what replaced it."""
+    table, _, name = removed.partition(".")
+    text = _gearbox_text()
+    text = text.replace(f"[{table}]", f'[{table}]\n{name} = "x"', 1) if name else text + f"\n[{table}]\nx = 1\n"
+    path = _write(tmp_path, text)
+    with pytest.raises(SpecError) as err:
+        load_gearbox(path)
+    msg = str(err.value)
+    assert "\n" not in msg and str(path) in msg and f"'{removed}': removed (" in msg
+    _write(tmp_path, _gearbox_text())
+    variant = 'name = "v"\ngearbox = "gearbox.toml"\n[components]\n' + "".join(f'{c} = "rigid"\n' for c in COMPONENTS)
+    variant += f"[overrides.{table}]\n" + (f'{name} = "x"\n' if name else "")
+    with pytest.raises(SpecError, match=rf"v.toml: field 'overrides.{removed}': removed \("):
+        load_variant(_write(tmp_path, variant, "v.toml"))
 
 
 def test_missing_table_and_bad_toml(tmp_path):

@@ -28,7 +28,7 @@ import scipy.linalg as la
 
 from flexgear.fe.cms import ReducedBody
 from flexgear.fe.reduced import component_reduced_body, gear_shaft_joints
-from flexgear.spec import GearboxSpec, JointsAssumed
+from flexgear.spec import GearboxSpec
 
 __all__ = ["body_matrices", "joint_rows", "joined_free_modes", "ring_output_shaft_modes"]
 
@@ -93,10 +93,9 @@ def joined_free_modes(bodies: list[ReducedBody], joints: list[tuple[int, str, in
     return np.sqrt(np.maximum(lam[6:6 + k], 0.0)) / (2 * math.pi)
 
 
-def ring_output_shaft_modes(spec: GearboxSpec, joints: JointsAssumed | None = None, level: str = "coarse",
-                            k: int = 10, progress: bool = False) -> np.ndarray:
+def ring_output_shaft_modes(spec: GearboxSpec, level: str = "coarse", k: int = 10,
+                            progress: bool = False) -> np.ndarray:
     """Lowest ``k`` elastic free-free frequencies [Hz] of the reduced ring and output shaft (flexgear.fe.reduced,
-    cached) joined as ``joints`` (default the spec's ``[joints_assumed]``) says."""
-    joined = spec if joints is None else spec.with_changes(joints_assumed=joints)
-    bodies = [component_reduced_body(joined, name, level, progress) for name in ("ring", "output_shaft")]
-    return joined_free_modes(bodies, [(0, a, 1, b, p) for a, b, p in gear_shaft_joints(joined, "ring")], k)
+    cached) joined per bolt as the multibody model joins them."""
+    bodies = [component_reduced_body(spec, name, level, progress) for name in ("ring", "output_shaft")]
+    return joined_free_modes(bodies, [(0, a, 1, b, p) for a, b, p in gear_shaft_joints(spec, "ring")], k)

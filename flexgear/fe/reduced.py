@@ -1,13 +1,13 @@
 """The study's components as reduced flexible bodies: solid -> mesh -> FE model -> Craig-Bampton -> cache.
 
-Interfaces (where a component is connected; RBE3, distributing, by default):
+Interfaces (where a component is connected):
 - sun, planet: the bore (shaft-sun joint, planet bearing seat);
-- ring: its side of the ring-output shaft joint (section 2.1: 12 bolts), as ``[joints_assumed]
-  ring_output_shaft`` says: "bolt_<k>", per bolt its clamped disc on the flange face (rigid with
-  ``bolt_patch = "rbe2"``, flexgear.fe.bolted), or "bolt_circle", the walls of all 12 bolt holes;
+- ring: its side of the ring-output shaft joint (section 2.1: 12 bolts): "bolt_<k>", per bolt its clamped
+  disc on the flange face, a rigid patch (flexgear.fe.bolted);
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
 - output shaft: the same joint interfaces on its web, and "bearing_seat" (``bearing_seat_width_mm``
   at the far end of the tube).
+Seat and joint interfaces are RBE3 (distributing) averages, the bolt patches rigid (RBE2).
 Load circles (attachment modes, flexgear.fe.attachment): each gear's contact bands, one per mesh and
 helix half, at the mesh's operating pitch radius (sun: the sun-planet mesh; planet: both meshes; ring:
 the planet-ring mesh), over the half's face width, loaded along the tooth normal in the gear's local
@@ -38,25 +38,16 @@ from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
-           "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "JOINT_INTERFACES",
-           "joint_point", "gear_shaft_joints", "gear_seat", "bolt_patches"]
+           "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
+           "gear_shaft_joints", "gear_seat"]
 
 """Variant component name -> geometry component name."""
 
 _REDUCTION_VERSION = 4  # 4: attachment modes on the contact bands, whole compressed basis kept
 _TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
-
-
-def _bolt_hole_nodes(fe, section, z_range: tuple[float, float]) -> np.ndarray:
-    """Nodes on the walls of the bolt holes of ``section`` within ``z_range`` [m]."""
-    z = fe.nodes[:, 2]
-    hit = np.zeros(len(fe.nodes), bool)
-    for k in range(section.holes):
-        a = 2 * np.pi * k / section.holes
-        d = np.hypot(fe.nodes[:, 0] - section.hole_circle_radius * np.cos(a),
-                     fe.nodes[:, 1] - section.hole_circle_radius * np.sin(a))
-        hit |= np.abs(d - section.hole_radius) < _TOL
-    return np.flatnonzero(hit & (z > z_range[0] - _TOL) & (z < z_range[1] + _TOL))
+_INTERFACE_KIND = "rbe3"  # seat and joint interfaces: distributing averages (flexgear.fe.cms.reduce kind)
+_BOLT_PATCH_KIND = "rbe2"  # bolt patches: rigid clamped discs
+_WHOLE_BASIS = 0  # cache-key term: the whole compressed basis is kept (no truncation)
 
 
 def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
@@ -84,14 +75,9 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
 
 
 def _ring_joint_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
-    """The ring's or the output shaft's side of their joint, as ``[joints_assumed] ring_output_shaft`` says:
-    "rbe3", one interface "bolt_circle" over the walls of all bolt holes (of the ring's flange, the shaft's
-    web); "bolt_patches", one interface "bolt_<k>" per bolt over its clamped disc on the mating face
-    (flexgear.fe.bolted.clamped_patches)."""
-    if bolt_patches(spec):
-        return [interface(fe, nodes, f"bolt_{k}") for k, nodes in enumerate(clamped_patches(fe, spec))]
-    holed = [p for p in component_layout(spec, component).prisms if p.section.holes][0]
-    return [interface(fe, _bolt_hole_nodes(fe, holed.section, (holed.z0, holed.z1)), "bolt_circle")]
+    """The ring's or the output shaft's side of their joint: one interface "bolt_<k>" per bolt over its clamped
+    disc on the mating face (flexgear.fe.bolted.clamped_patches)."""
+    return [interface(fe, nodes, f"bolt_{k}") for k, nodes in enumerate(clamped_patches(fe, spec))]
 
 
 def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
@@ -161,39 +147,25 @@ def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
     raise ValueError(f"joint_point: gear must be 'sun' or 'ring', got {gear!r}")
 
 
-JOINT_INTERFACES = {"sun": "bore", "input_shaft": "sun_seat", "ring": "bolt_circle", "output_shaft": "bolt_circle"}
-"""Interface of each component in the fixed joints of section 2.1 with one joint per pair (input shaft-sun,
-ring-output shaft with ``[joints_assumed] ring_output_shaft = "rbe3"``)."""
-
-
-def bolt_patches(spec: GearboxSpec) -> bool:
-    """Whether the ring and the output shaft are joined by bolt patches: ``[joints_assumed] ring_output_shaft``,
-    except with a truncated basis (``[reduction_assumed] simulation_modes`` > 0, speed experiments and the quick
-    variants), which cannot carry twelve 6-DOF joints (12 modes against 72 constraints: the joints would be
-    redundant and the solver fails): that uses the single RBE3 joint at the bolt circle."""
-    return spec.joints_assumed.ring_output_shaft == "bolt_patches" and spec.reduction_assumed.simulation_modes == 0
-
-
 def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.ndarray]]:
     """The fixed joints of ``gear`` ("sun" or "ring") and its shaft: (gear interface, shaft interface, point [m]).
 
-    Sun-input shaft: one joint at :func:`joint_point`. Ring-output shaft: one at :func:`joint_point` between the
-    "bolt_circle" interfaces ("rbe3"), or per bolt one between the "bolt_<k>" patches, on the bolt's axis in
-    the flange-web plane ("bolt_patches", ``[joints_assumed] ring_output_shaft``).
+    Sun-input shaft: one joint at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat".
+    Ring-output shaft: per bolt one between the "bolt_<k>" patches, on the bolt's axis in the flange-web plane.
     """
-    shaft = {"sun": "input_shaft", "ring": "output_shaft"}[gear]
-    if gear == "ring" and bolt_patches(spec):
+    if gear == "ring":
         centres, _, z_j = bolt_axes(spec)
         return [(f"bolt_{k}", f"bolt_{k}", np.array([x, y, z_j])) for k, (x, y) in enumerate(centres)]
-    return [(JOINT_INTERFACES[gear], JOINT_INTERFACES[shaft], joint_point(spec, gear))]
+    if gear == "sun":
+        return [("bore", "sun_seat", joint_point(spec, gear))]
+    raise ValueError(f"gear_shaft_joints: gear must be 'sun' or 'ring', got {gear!r}")
 
 
 def gear_seat(spec: GearboxSpec, body: ReducedBody, gear: str) -> Interface:
     """The interface of a gear's reduced body that its deflections are measured from (and held at).
 
     Sun, planet: the bore. Ring: its side of the joint to the output shaft (:func:`gear_shaft_joints`), as one
-    RBE3 interface "seat" over the union of its joint interfaces' nodes, each interface weighted equally (the
-    bolt circle itself, or the 12 bolt patches together).
+    RBE3 interface "seat" over the union of its 12 bolt patches' nodes, each patch weighted equally.
     """
     if gear != "ring":
         return body.interface("bore")
@@ -257,12 +229,11 @@ def _component_reduction(spec: GearboxSpec, component: str, level: str,
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
     circles = component_load_circles(spec, name, red.attachment_order)
-    joint = spec.joints_assumed
-    patches = name in ("ring", "output_shaft") and bolt_patches(spec)
-    # the bolt patches are interfaces: they enter the key (the RBE3 bodies keep their former keys)
-    extra = [("bolt_patches", joint.bolt_patch, joint.bolt_clamp_diameter_mm)] if patches else []
-    key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, red.interface,
-                        red.simulation_modes, [c.key() for c in circles], _REDUCTION_VERSION, *extra)
+    patches = name in ("ring", "output_shaft")
+    # the bolt patches' kind and clamped disc enter the key of the bodies that have them
+    extra = [("bolt_patches", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
+    key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, _INTERFACE_KIND, _WHOLE_BASIS,
+                        [c.key() for c in circles], _REDUCTION_VERSION, *extra)
 
     def build() -> ReducedBody:
         from flexgear.fe.fem import fe_model
@@ -276,10 +247,8 @@ def _component_reduction(spec: GearboxSpec, component: str, level: str,
         mesh = component_mesh(spec, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         itfs = component_interfaces(fe, spec, name)
-        rigid = patches and joint.bolt_patch == "rbe2"  # rigid bolt patches, the other interfaces as configured
-        return reduce(fe, itfs, red.fixed_interface_modes, kind=red.interface, n_compare=0,
-                      keep_modes=red.simulation_modes or None, load_circles=circles,
-                      rigid=tuple(i.name for i in itfs if rigid and i.name.startswith("bolt_")))
+        return reduce(fe, itfs, red.fixed_interface_modes, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
+                      rigid=tuple(i.name for i in itfs if i.name.startswith("bolt_")))
 
     return f"{name}-{level}-{key}", build
 

@@ -63,17 +63,11 @@ def _support(component: str, interface: str, z: float, bearing: Bearing) -> Supp
 
 
 def gearbox_supports(spec: GearboxSpec) -> dict[str, Support]:
-    """The bearings of the study's gearbox ("input_shaft", "output_shaft", "planet") as ``[supports_assumed]`` says.
-
-    ``placement = "gear_centres"`` puts the shaft bearings at the gear mid-plane (z = 0) instead.
-    """
+    """The bearings of the study's gearbox ("input_shaft", "output_shaft", "planet"), each at its seat."""
     b = spec.bearings
-    seats = spec.supports_assumed.placement == "bearing_seats"
     return {
-        "input_shaft": _support("input_shaft", "bearing_seat", _seat_centre(spec, "input_shaft") if seats else 0.0,
-                                b.input_shaft),
-        "output_shaft": _support("output_shaft", "bearing_seat",
-                                 _seat_centre(spec, "output_shaft") if seats else 0.0, b.output_shaft),
+        "input_shaft": _support("input_shaft", "bearing_seat", _seat_centre(spec, "input_shaft"), b.input_shaft),
+        "output_shaft": _support("output_shaft", "bearing_seat", _seat_centre(spec, "output_shaft"), b.output_shaft),
         "planet": _support("planet", "bore", 0.0, b.planet),
     }
 

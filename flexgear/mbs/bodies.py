@@ -6,9 +6,8 @@ at the gear centre with the z axis along the rotation axis. Coordinates of that 
 phi_x and phi_y are the tilt angles in the ground frame (R = R_x(phi_x) R_y(phi_y) R_z(phi_z)).
 Bushings, drives and gear contacts act on these frame coordinates, whatever the body's form.
 
-The frame's inertia is Exudyn's ``ObjectRigidBody`` (exact; its mass matrix depends on the angles, so Exudyn
-rebuilds the whole system's mass matrix in every Newton iteration) or, ``[solver_assumed] frame_equations =
-"linear"``, :func:`add_linear_frame`: the same body to first order in the tilts about its prescribed spin Omega,
+The frame's inertia is, in the production formulation, :func:`add_linear_frame`: the same body to first order
+in the tilts about its prescribed spin Omega,
 
     M q'' + Omega J_p E q' = Q,    E = e_phix e_phiy^T - e_phiy e_phix^T,
 
@@ -18,6 +17,8 @@ gyroscopic term of a body spinning at Omega about its tilted axis (kinetic energ
 order: 1/2 J_t (phi_x'^2 + phi_y'^2) + 1/2 J_p phi_z'^2 + J_p phi_y phi_x' phi_z'). Every body's mass matrix is then
 constant and Exudyn computes it once per run. Left out: the lateral centre-of-mass offset and the inertia's
 asymmetry of the meshed body (< ``frame_axisymmetry_tolerance``, checked), terms of second order in the tilts.
+The reference formulation uses Exudyn's ``ObjectRigidBody`` (exact; its mass matrix depends on the angles, so
+Exudyn rebuilds the whole system's mass matrix in every Newton iteration).
 """
 
 from __future__ import annotations
@@ -59,7 +60,7 @@ class Body:
     position: np.ndarray  # reference position of the frame [m]
     props: MassProperties
     flexible: bool = False
-    frame: LinearFrame | None = None  # frame_equations = "linear": the frame's constant inertia
+    frame: LinearFrame | None = None  # the frame's constant inertia (production), None for ObjectRigidBody
 
 
 def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray, spin_rad_s: float = 0.0,

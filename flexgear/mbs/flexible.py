@@ -34,7 +34,7 @@ class FlexibleBody(Body):
     # modes of the converged basis left out of the time integration (flexgear.mbs.residual.DroppedModes);
     # their static compliance returns at the contacts
     dropped: object | None = None
-    # floating_frame = "linear": the body's spin terms (flexgear.mbs.spin.SpinMatrices) and nominal spin [rad/s]
+    # production formulation: the body's spin terms (flexgear.mbs.spin.SpinMatrices) and nominal spin [rad/s]
     spin: object | None = None
     nominal_spin_rad_s: float = 0.0
     modal_equations: int = -1  # their ObjectGenericODE2 ("linear")
@@ -144,7 +144,7 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
                       stiffness_damping_s: float = 0.0, mass_damping_per_s: float = 0.0,
                       interface_markers: list[str] | dict[str, np.ndarray] | None = None,
                       point_markers: dict[str, list] | None = None, show: bool = True,
-                      floating_frame: str = "ffrf", nominal_spin_rad_s: float = 0.0,
+                      reference: bool = False, nominal_spin_rad_s: float = 0.0,
                       superelement: bool = True, interface_coordinates: tuple[str, ...] = (),
                       sensing_rows: np.ndarray | None = None, linear_frame_tolerance: float | None = None
                       ) -> FlexibleBody:
@@ -159,16 +159,17 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     mode basis; the floating-frame inertia terms come from the real mesh only. ``point_markers``:
     {interface: points [m, body frame]}: one virtual node per point moving rigidly with the interface
     (:func:`interface_point_modes`) and a ``MarkerSuperElementPosition`` on it (bearing springs at a seat).
-    ``floating_frame``: "ffrf" (Exudyn's nonlinear floating-frame terms) or "linear" (flexgear.mbs.spin: the
-    frame an ``ObjectRigidBody``, the modes linear equations at ``nominal_spin_rad_s`` about the body's z
-    axis; the object then only places the markers; add a flexgear.mbs.spin.SpinSchedule for the ramp).
-    ``superelement`` False ("linear" only): no ``ObjectFFRFreducedOrder`` at all (no interface or point markers,
+    Production formulation: the floating frame is linear (flexgear.mbs.spin: the frame a rigid body, the modes
+    linear equations at ``nominal_spin_rad_s`` about the body's z axis; the object then only places the markers;
+    add a flexgear.mbs.spin.SpinSchedule for the ramp). ``reference``: Exudyn's nonlinear floating-frame terms
+    (``computeFFRFterms``) instead. ``superelement`` False (production only): no ``ObjectFFRFreducedOrder`` at
+    all (no interface or point markers,
     no mesh-node sensors; its zero mass matrix cost ~7 % of model 7's step); ``obj`` is then the frame's rigid body.
     ``interface_coordinates`` (without superelement): interfaces whose RBE3 motions become coordinates of their own
     six-coordinate node (:func:`interface_basis`; the other coordinates on one more node), for constraints on them
     (flexgear.mbs.joints); ignored when the basis cannot carry them. ``sensing_rows`` (r, m) with them: the gear
     contacts' sensed coordinates on one more node (``contact_nodes``; flexgear.mbs.train.contact_sensing_rows), so
-    that a mesh constraint spans r columns, not m. ``linear_frame_tolerance`` ("linear" only; None: Exudyn's
+    that a mesh constraint spans r columns, not m. ``linear_frame_tolerance`` (production only; None: Exudyn's
     ``ObjectRigidBody``): the frame's inertia as constant matrices (flexgear.mbs.bodies.add_linear_frame) with
     this axisymmetry tolerance.
     """
@@ -190,10 +191,8 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
     node_item.name = f"{name}_node"
     node = mbs.AddNode(node_item)
     m = reduced.n_modes
-    if floating_frame not in ("ffrf", "linear"):
-        raise ValueError(f"floating_frame must be 'ffrf' or 'linear', got {floating_frame!r}")
-    if not superelement and (floating_frame == "ffrf" or interface_markers or point_markers):
-        raise ValueError(f"{name}: a body without superelement needs floating_frame 'linear' and no markers")
+    if not superelement and (reference or interface_markers or point_markers):
+        raise ValueError(f"{name}: a body without superelement needs the production formulation and no markers")
     names = tuple(interface_coordinates)
     sensing = None if sensing_rows is None or not len(sensing_rows) else np.asarray(sensing_rows, float)
     basis = None if superelement else interface_basis(reduced, names, sensing)
@@ -240,11 +239,11 @@ def add_flexible_body(mbs, name: str, reduced: ReducedBody, position, rotation_m
         mPsiTildePsi=inv["mPsiTildePsi"], mPsiTildePsiTilde=inv["mPsiTildePsiTilde"],
         mPhitTPsi=inv["mPhitTPsi"], mPhitTPsiTilde=inv["mPhitTPsiTilde"],
         mXRefTildePsi=inv["mXRefTildePsi"], mXRefTildePsiTilde=inv["mXRefTildePsiTilde"],
-        computeFFRFterms=floating_frame == "ffrf",
+        computeFFRFterms=reference,
         visualization=VObjectFFRFreducedOrder(show=show, triangleMesh=reduced.surface_triangles if show else []),
     ))
     spin, equations, matrices, linear_frame = None, -1, None, None
-    if floating_frame == "linear":
+    if not reference:
         from flexgear.mbs.spin import add_linear_modal_equations, spin_matrices, transformed
 
         # the inertia about the frame origin, as flexgear.mbs.bodies.add_rigid_body

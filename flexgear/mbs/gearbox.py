@@ -2,7 +2,7 @@
 
 The assembly follows section 2.1 of the study: input shaft fixed to the sun, ring fixed to the
 output shaft (for rigid parts the fixed joint merges the two into one body, which is exact),
-bushings at the input-shaft, output-shaft and planet bearings (Table 2), a gear contact for every
+bearings at the input-shaft and output-shaft seats and the planet bores (Table 2), a gear contact for every
 sun-planet and planet-ring mesh and helix half, the input speed prescribed as a STEP ramp and
 the load torque on the output as a STEP ramp (Table 5).
 
@@ -27,7 +27,6 @@ from flexgear.laws.contact import mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
 from flexgear.mbs.elements import (
-    Bushing,
     add_interface_joint,
     add_load_torque,
     add_speed_drive,
@@ -144,16 +143,14 @@ GEARS = ("sun", "planet", "ring")
 """Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
 
 
-def dynamic_modes(spec: GearboxSpec, geometry: str, frequencies_hz: np.ndarray, cutoff_hz: float) -> int:
+def dynamic_modes(geometry: str, frequencies_hz: np.ndarray, cutoff_hz: float) -> int:
     """How many of a component's modes (free-free ``frequencies_hz``, ascending) the time integration keeps: a gear
     its modes below ``cutoff_hz`` (> 0; the rest return as residual compliance, flexgear.mbs.residual), at least
-    one (the floating-frame object needs one); a shaft, and a ring on bolt patches, every mode (the ring's twelve
-    6-DOF joints need the patches' static modes: on the modes below the cut-off they are redundant and the solver
+    one (the floating-frame object needs one); a shaft, and the ring, every mode (the ring's twelve bolt-patch
+    joints need the patches' static modes: on the modes below the cut-off they are redundant and the solver
     fails)."""
-    from flexgear.fe.reduced import bolt_patches
-
     n = len(frequencies_hz)
-    if cutoff_hz <= 0 or geometry not in GEARS or (geometry == "ring" and bolt_patches(spec)):
+    if cutoff_hz <= 0 or geometry not in GEARS or geometry == "ring":
         return n
     return max(1, int(np.count_nonzero(np.asarray(frequencies_hz) < cutoff_hz)))
 
@@ -175,34 +172,25 @@ def run_cost(variant: Variant) -> float | None:
             return None
         geometry = COMPONENT_GEOMETRY[component]
         count = spec.gears.planet_count if component == "planets" else 1
-        cost += count * float(dynamic_modes(spec, geometry, frequencies, cutoff)) ** 2
+        cost += count * float(dynamic_modes(geometry, frequencies, cutoff)) ** 2
     return cost
 
 
-def _joint_axes(spec: GearboxSpec, shaft: Body) -> str:
-    """The axes of a linear gear-shaft joint's equations (flexgear.mbs.joints): ``[joints_assumed] joint_axes``;
-    "auto": body axes where the ``shaft`` is flexible, ground axes where it is rigid (measured, gearbox.toml)."""
-    axes = spec.joints_assumed.joint_axes
-    if axes == "auto":
-        return "body" if shaft.flexible else "ground"
-    return axes
+def _joint_axes(shaft: Body) -> str:
+    """The axes of a linear gear-shaft joint's equations (flexgear.mbs.joints): body axes where the ``shaft`` is
+    flexible, ground axes where it is rigid."""
+    return "body" if shaft.flexible else "ground"
 
 
-def _linear_joints(spec: GearboxSpec) -> bool:
-    """Whether the gears' joints to their shafts are linear constraints (flexgear.mbs.joints), on the axis or off
-    it (bolt patches): ``[joints_assumed] joint_equations``."""
-    return spec.joints_assumed.joint_equations == "linear"
-
-
-def _seat_loads_carried(spec: GearboxSpec, body: Body) -> bool:
-    """Whether ``body``'s dropped modes answer its seat's own reaction (a linear joint's or bearing's) rather than
-    the contacts' quasi-static one: ``[reduction_assumed] residual_seat_loads`` (flexgear.mbs.residual)."""
-    return getattr(body, "dropped", None) is not None and spec.reduction_assumed.residual_seat_loads == "dynamic"
+def _seat_loads_carried(body: Body) -> bool:
+    """Whether ``body`` has dropped modes, which then answer its seat's own reaction (a linear joint's or
+    bearing's; flexgear.mbs.residual)."""
+    return getattr(body, "dropped", None) is not None
 
 
 def _is_gear_seat(spec: GearboxSpec, body: Body, interface: str) -> bool:
     """Whether ``interface`` of ``body`` is the seat its residual is measured from (flexgear.fe.reduced.gear_seat:
-    the bore; the ring's one joint interface, or the union of its bolt patches)."""
+    the bore; the ring's union of its bolt patches)."""
     from flexgear.fe.reduced import gear_seat
 
     seat, joint = gear_seat(spec, body.reduced, body.name), body.reduced.interface(interface)
@@ -210,10 +198,10 @@ def _is_gear_seat(spec: GearboxSpec, body: Body, interface: str) -> bool:
 
 
 def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
-    """The axisymmetry tolerance of linear body frames, None for Exudyn's ``ObjectRigidBody``
-    (``[solver_assumed] frame_equations``, flexgear.mbs.bodies.add_linear_frame)."""
+    """The axisymmetry tolerance of the production formulation's linear body frames, None for the reference's
+    ``ObjectRigidBody`` (flexgear.mbs.bodies.add_linear_frame)."""
     sv = spec.solver_assumed
-    return sv.frame_axisymmetry_tolerance if sv.frame_equations == "linear" else None
+    return None if sv.reference else sv.frame_axisymmetry_tolerance
 
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
@@ -233,24 +221,22 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node.
     """
     frame_tol = _linear_frame_tolerance(spec)
+    reference = spec.solver_assumed.reference
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position, spin_rad_s, frame_tol)
     from dataclasses import replace
 
     from flexgear.mbs.flexible import add_flexible_body
 
-    markers = support is not None and spec.supports_assumed.seat_equations == "markers"
-    points = {support.interface: support_points(support)} if markers else None
-    coordinates = []  # interfaces of linear joints and seats: on their own coordinates if so configured
-    if joints and _linear_joints(spec):
-        coordinates += list(joints or {})
-        joints = {}  # linear joints (flexgear.mbs.joints) need no interface markers
-    if support is not None and not markers:
-        coordinates.append(support.interface)
-    if spec.reduction_assumed.modal_coordinates != "interface":
-        coordinates = []
+    # production: linear joints and seats (flexgear.mbs.joints) on their interfaces' own coordinates, no markers;
+    # reference: Exudyn's generic joints on interface markers, seat springs on point markers
+    points = {support.interface: support_points(support)} if support is not None and reference else None
+    coordinates = []
+    if not reference:
+        coordinates = list(joints or {}) + ([support.interface] if support is not None else [])
+        joints = {}
     full = reduced(spec, geometry, level)
-    keep = dynamic_modes(spec, geometry, full.frequencies_hz, cutoff_hz)
+    keep = dynamic_modes(geometry, full.frequencies_hz, cutoff_hz)
     kept = full.truncated(keep) if keep < full.n_modes else full
     sensing = None
     if coordinates and geometry in GEARS and kept.n_modes > 6 * len(coordinates):  # room beside the interfaces
@@ -261,9 +247,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     body = add_flexible_body(mbs, name, kept, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=joints or [], point_markers=points,
-                             show=False, floating_frame=spec.reduction_assumed.floating_frame,
-                             nominal_spin_rad_s=spin_rad_s, superelement=superelement or bool(joints or points)
-                             or spec.reduction_assumed.floating_frame == "ffrf",
+                             show=False, reference=reference,
+                             nominal_spin_rad_s=spin_rad_s, superelement=superelement or reference,
                              interface_coordinates=tuple(dict.fromkeys(coordinates)), sensing_rows=sensing,
                              linear_frame_tolerance=frame_tol)
     if keep == full.n_modes:
@@ -283,14 +268,14 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
     ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
     exact); otherwise they are two bodies joined by fixed joints at their interfaces
-    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring per bolt or at the bolt circle as
-    ``[joints_assumed]`` says): a flexible body through its interface node set's RBE3 (or rigid patch)
-    motion, a rigid one at the joint's point. The input bearing and the
+    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring per bolt): a flexible body through its
+    interface node set's RBE3 (or rigid patch) motion, a rigid one at the joint's point. The input bearing and the
     drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
-    body when shaft and gear are one): with ``[supports_assumed] placement = "bearing_seats"`` at the
-    shafts' bearing seats and the planets' bores (flexgear.geometry.supports, flexgear.mbs.elements.add_support,
-    interface_spin_marker), through the seat interfaces' virtual-node motion of a flexible body;
-    with "gear_centres" on the frame coordinates at the frame origin (gear mid-plane).
+    body when shaft and gear are one), at the shafts' bearing seats and the planets' bores
+    (flexgear.geometry.supports, flexgear.mbs.elements.add_support, interface_spin_marker), through the seat
+    interfaces' motion of a flexible body. Production formulation: linear joints and seats
+    (flexgear.mbs.joints), linear frames (flexgear.mbs.bodies, flexgear.mbs.spin); ``[solver_assumed] formulation
+    = "reference"``: Exudyn's generic joints, marker seats, ``ObjectRigidBody`` and ``ObjectFFRFreducedOrder``.
     Rigid components carry the mass properties of the variant's ``rigid_mass_properties``: "mesh",
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
     "exact", the exact geometry's; ``mass_source`` overrides both. ``superelements``: every flexible body keeps
@@ -314,7 +299,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     th = theory(spec)
     geo = gear_set_geometry(spec)
     level = variant.mesh_level
-    seats = spec.supports_assumed.placement == "bearing_seats"
+    reference = spec.solver_assumed.reference
     lc = spec.load_case
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
@@ -334,7 +319,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                   {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin,
                                   superelement=superelements, contacts=contacts)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   {b: p for _, b, p in joints}, supports[shaft] if seats else None, spin_rad_s=spin,
+                                   {b: p for _, b, p in joints}, supports[shaft], spin_rad_s=spin,
                                    superelement=superelements)
             bodies += [lead, other]
             pairs.append((lead, other, joints, spin / th.input_speed))  # spin per drive angle
@@ -342,7 +327,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
         bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
-                                     props, reduced, support=supports["planet"] if seats else None,
+                                     props, reduced, support=supports["planet"],
                                      cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed,
                                      superelement=superelements, contacts=contacts))
     by_body = {bd.name: bd for bd in bodies}
@@ -351,13 +336,13 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     linear_gears, body_axes = [], []  # gears whose joints are linear constraints; those written in body axes
     for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
         label = f"joint_{lead.name}_{other.name}"
-        if _linear_joints(spec):
+        if not reference:
             from flexgear.mbs.joints import LinearInterfaceJoint
 
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
-            carried = (_seat_loads_carried(spec, lead) and len(found) == 1
+            carried = (_seat_loads_carried(lead) and len(found) == 1
                        and _is_gear_seat(spec, lead, found[0][0]))
-            axes = _joint_axes(spec, other)
+            axes = _joint_axes(other)
             made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
                                          residual=carried, axes=axes) for k, (a, b, p) in enumerate(found)]
             if axes == "body":
@@ -370,25 +355,20 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             continue
         joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
                              for k, (a, b, p) in enumerate(found)]
-    b = spec.bearings
-    bushings = [Bushing.from_bearing(ends["sun"], b.input_shaft), Bushing.from_bearing(ends["ring"], b.output_shaft)]
-    bushings += [Bushing.from_bearing(f"planet{i + 1}", b.planet) for i in range(geo.planet_count)]
     planets = [f"planet{i + 1}" for i in range(geo.planet_count)]
-    if seats:  # bearings at their seats (flexgear.geometry.supports), not on the frames
-        bushings = []
-        placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
-        for body, key in placed:
-            if by_body[body].flexible and spec.supports_assumed.seat_equations == "linear":
-                from flexgear.mbs.joints import LinearSeat
+    placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
+    for body, key in placed:  # bearings at their seats (flexgear.geometry.supports)
+        if by_body[body].flexible and not reference:
+            from flexgear.mbs.joints import LinearSeat
 
-                spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
-                carried = _seat_loads_carried(spec, by_body[body])
-                seat = LinearSeat(mbs, by_body[body], supports[key], spin, residual=carried)
-                turning += seat.turning()
-                if carried:
-                    seat_residuals[body] = (seat.residual_node, seat.centre)
-                continue
-            add_support(mbs, by_body[body], supports[key])
+            spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
+            carried = _seat_loads_carried(by_body[body])
+            seat = LinearSeat(mbs, by_body[body], supports[key], spin, residual=carried)
+            turning += seat.turning()
+            if carried:
+                seat_residuals[body] = (seat.residual_node, seat.centre)
+            continue
+        add_support(mbs, by_body[body], supports[key])
     if turning:
         from flexgear.mbs.joints import TurningBlocks
 
@@ -400,12 +380,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
         extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s, frames))
     # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
-    train = add_gear_train(mbs, bodies, bushings, contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
+    train = add_gear_train(mbs, bodies, [], contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
                            friction=spec.contact.friction_coefficient > 0.0,
                            contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m, seat_residuals=seat_residuals)
     springs = train.springs
-    seat = "bearing_seat" if seats else None  # drive and load at the shafts' seats (spline, flange)
+    seat = "bearing_seat"  # drive and load at the shafts' seats (spline, flange)
     spin_in = interface_spin_marker(mbs, by_body[ends["sun"]], seat)
     spin_out = interface_spin_marker(mbs, by_body[ends["ring"]], seat)
     drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])

@@ -1,6 +1,7 @@
 """Gear-shaft joints and seat bearings of flexible bodies as linear equations about the prescribed spin.
 
-``[joints_assumed] joint_equations`` and ``[supports_assumed] seat_equations`` choose them.
+They are the production formulation; the reference formulation uses Exudyn's ``ObjectJointGeneric`` and
+spring-dampers on marker points instead.
 
 Exudyn's ``ObjectJointGeneric`` on two ``MarkerSuperElementRigid`` markers evaluates the markers' full
 kinematics, and their derivatives by automatic differentiation, in every Newton iteration: with 35-mode
@@ -18,18 +19,17 @@ coordinate, flexgear.fe.cms.ReducedBody.interface_motion). A fixed joint makes b
 with R_n. They are one ``ObjectConnectorCoordinateVector`` over the two bodies' coordinates, rewritten
 before each step (:meth:`LinearInterfaceJoint.__call__`), one marker per body; its multipliers lambda
 (``Force`` output) are the joint's force [N] (ground x, y, z) and moment [N m] (ground x, y, z) on the second body.
-On the axis (the sun's bore, the ring's bolt-circle RBE3) the frame columns are constant; off the axis (the
-ring's bolts on bolt patches) the lever R_n p of the frame rotations turns as well (:func:`frame_form`).
+On the axis (the sun's bore) the frame columns are constant; off the axis (the ring's bolt patches) the lever
+R_n p of the frame rotations turns as well (:func:`frame_form`).
 
-``[joints_assumed] joint_axes`` says in which axes the six equations are written ("auto": per joint, below).
-"ground": as above, the
+The six equations are written in ground or in body axes. "ground": as above, the
 modal columns turn (R_n Psi) and, off the axis, the frame rotations' lever. "body": the same equations
 premultiplied by Q_n^T = blockdiag(R_n^T, R_n^T) (:func:`body_axes_form`), an exact row transformation, so
 the solution is the same; the modal columns are then constant and the frame columns (R_n^T u, R_n^T phi) turn.
 The modified Newton method keeps a Jacobian over many steps while the coefficients turn; with a flexible
 shaft, turning frame columns cost it fewer Newton iterations than turning modal ones (benchmarks/bench_newton.py
 counts them per step), with a rigid
-shaft more Jacobians (model 4: 88 -> 148 per 1000 steps); "auto" takes body axes where the shaft is flexible.
+shaft more Jacobians; so a joint takes body axes where its shaft is flexible, ground axes where it is rigid.
 The multipliers are then the force and moment in the gear's body axes.
 
 A bearing at a flexible body's seat (flexgear.geometry.supports: three springs on the axis) acts on the seat
@@ -189,7 +189,7 @@ class LinearInterfaceJoint:
         offset = c @ self.q_ref
         if axes == "body" and np.abs(offset[[0, 1, 3, 4]]).max() > 1e-12 * max(1.0, np.abs(offset).max()):
             # the offset would turn: Q^T C q_ref is constant only while the frames' reference offsets lie on the axis
-            raise ValueError(f"{name}: joint_axes 'body' needs the bodies' frames on the common axis")
+            raise ValueError(f"{name}: body axes need the bodies' frames on the common axis")
         # Exudyn's equation: scalingMarker1 q_1 - scalingMarker0 q_0 - offset = 0
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
             name=name, markerNumbers=markers, scalingMarker0=-c[:, :split], scalingMarker1=c[:, split:],

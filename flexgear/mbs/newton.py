@@ -8,13 +8,13 @@ law's tangent k e delta^(e-1) varies most; model 1 needs about 3 iterations per 
 after 0.2 s, ``benchmarks/bench_newton.py``) and in the flexible variants, whose linear joints and seats
 turn with the spin (``benchmarks/profile_mbs.py --trace-newton``).
 
-:class:`JacobianEconomy` (``[solver_assumed] jacobian_updates = "economy"``) watches, after every step, the
-iterations the step took. Since the last Jacobian the steps have paid ``E = sum(n_k) - count x min(n_k)``
+:class:`JacobianEconomy` (the production formulation; the reference keeps Exudyn's rule alone) watches, after every
+step, the iterations the step took. Since the last Jacobian the steps have paid ``E = sum(n_k) - count x min(n_k)``
 iterations above the fewest any of them needed; when ``E`` reaches ``r``, a Jacobian's cost in iterations
 (``[solver_assumed] jacobian_cost_iterations``), it asks Exudyn for a Jacobian at the next step
-(``conv.jacobianUpdateRequested``). That is the break-even rule of the ski-rental problem: the extra
-iterations paid never exceed about one Jacobian's cost per refresh, and a Jacobian is bought only when the
-iterations it saves have already cost as much.
+(``conv.jacobianUpdateRequested``). That is the break-even rule of the ski-rental problem: the extra iterations
+paid never exceed about one Jacobian's cost per refresh, and a Jacobian is bought only when the iterations it saves
+have already cost as much.
 
 ``r`` is a fixed setting, so that a run is deterministic (the same state, the same Jacobians). The run also
 measures it, for the report only (:attr:`JacobianEconomy.measured_ratio`, the run's metadata
@@ -22,7 +22,7 @@ measures it, for the report only (:attr:`JacobianEconomy.measured_ratio`, the ru
 without a Jacobian (least squares in running sums; ``b`` the cost of one iteration) and a Jacobian's cost the
 mean excess ``t - (a + b n)`` of the steps with one. The converged solution is the same to the Newton
 tolerance (the tolerance and the iteration are unchanged, only the matrix they use is fresher);
-``tests/test_newton.py`` checks the agreement rule (flexgear.study.agreement) against Exudyn's own Jacobian policy.
+``tests/test_newton.py`` checks it against Exudyn's own Jacobian policy.
 """
 
 from __future__ import annotations

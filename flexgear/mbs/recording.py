@@ -90,12 +90,13 @@ class Recorder:
 
 
 def solver_settings(t_end: float, step_size: float, spectral_radius: float = 0.8, newton_iterations: int = 3,
-                    relative_tolerance: float = 1e-6, progress: bool = False, linear_solver: str = "dense",
-                    record_every_steps: int = 1, reuse_pattern: bool = False):
+                    relative_tolerance: float = 1e-6, progress: bool = False, record_every_steps: int = 1,
+                    reference: bool = False):
     """Exudyn ``SimulationSettings``: generalized-alpha, modified Newton (Jacobian update after at most
-    ``newton_iterations``), dense or sparse linear solver, one thread, no solution file, sensors every
-    ``record_every_steps`` steps; ``reuse_pattern``: the sparse LU keeps its ordering between Jacobians of one
-    pattern. Times in s. The one solver set-up of the examples and the study."""
+    ``newton_iterations``), Eigen's sparse LU, one thread, no solution file, sensors every ``record_every_steps``
+    steps. The LU keeps its ordering between Jacobians of one pattern, except in the ``reference`` formulation
+    (a new ordering per Jacobian, Exudyn's default). Times in s. The one solver set-up of the examples and the
+    study."""
     import exudyn as exu
 
     if not (t_end > 0 and step_size > 0):
@@ -109,9 +110,8 @@ def solver_settings(t_end: float, step_size: float, spectral_radius: float = 0.8
     ti.newton.maxModifiedNewtonIterations = newton_iterations
     ti.newton.relativeTolerance = relative_tolerance
     ti.verboseMode = 1 if progress else 0
-    s.linearSolver.solverType = (exu.LinearSolverType.EigenSparse if linear_solver == "sparse"
-                                 else exu.LinearSolverType.EXUdense)
-    s.linearSolver.reuseAnalyzedPattern = bool(reuse_pattern and linear_solver == "sparse")
+    s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
+    s.linearSolver.reuseAnalyzedPattern = not reference
     s.parallel.numberOfThreads = 1
     s.solution.file.write = False
     s.solution.sensors.writePeriod = step_size * (record_every_steps - 0.5)
@@ -137,7 +137,7 @@ def simulation_settings(variant: Variant, t_end: float, progress: bool):
     sv = variant.gearbox.solver_assumed
     return solver_settings(t_end, variant.gearbox.load_case.step_size_s, sv.spectral_radius,
                            sv.newton_max_modified_iterations, sv.newton_relative_tolerance, progress,
-                           sv.linear_solver, sv.record_every_steps, sv.sparse_ordering == "reused")
+                           sv.record_every_steps, sv.reference)
 
 
 def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:

@@ -1,11 +1,11 @@
 """Simulation (Exudyn backend): build a variant, integrate the load case, return a RunResult.
 
 Solver: generalized-alpha (spectral radius from ``[solver_assumed]``), modified Newton with a
-Jacobian update after at most ``newton_max_modified_iterations`` iterations, dense linear solver,
+Jacobian update after at most ``newton_max_modified_iterations`` iterations, Eigen's sparse LU,
 one thread, no solution file; sensors store every ``record_every_steps``-th step in memory.
 
-Divergence guard (:class:`RunGuard`, a post-step user function; it also drives the Jacobian economy of
-``[solver_assumed] jacobian_updates = "economy"``, flexgear.mbs.newton): the run stops and is recorded as
+Divergence guard (:class:`RunGuard`, a post-step user function; it also drives the Jacobian economy of the
+production formulation, flexgear.mbs.newton): the run stops and is recorded as
 failed, with its reason, when the state is not finite (NaN), when a shaft spins faster than
 ``runaway_speed_factor`` times its nominal speed (a runaway), when the wall time exceeds
 ``wall_time_budget_s`` (all three in ``[solver_assumed]``), or when Newton's method fails (Exudyn's
@@ -147,7 +147,7 @@ class RunGuard:
         self.t0 = time.perf_counter()
         self.bar = Progress(t_end, f"run {variant.name}", "s", enabled=progress, fmt="{:.4g}")
         sv = variant.gearbox.solver_assumed
-        self.economy = JacobianEconomy(sv.jacobian_cost_iterations) if sv.jacobian_updates == "economy" else None
+        self.economy = None if sv.reference else JacobianEconomy(sv.jacobian_cost_iterations)
 
     def __call__(self, mbs, t: float) -> bool:
         if self.economy is not None:

@@ -1,4 +1,4 @@
-"""Linear floating-frame formulation of a spinning flexible body (``[reduction_assumed] floating_frame = "linear"``).
+"""Linear floating-frame formulation of a spinning flexible body (the production formulation).
 
 Exudyn's ``ObjectFFRFreducedOrder`` with its floating-frame terms evaluates the full nonlinear coupling of
 frame and modes (mass matrix (6 + m)^2 and quadratic velocity vector every step; its Jacobian by numerical
@@ -17,7 +17,7 @@ Exudyn uses) are
 
 with Omega(t) the body's prescribed spin (the drive's STEP ramp times the body's nominal speed,
 flexgear.theory). The frame itself is an ``ObjectRigidBody`` with the body's exact mass properties on the
-same node, or its linear form (flexgear.mbs.bodies.add_linear_frame, ``[solver_assumed] frame_equations``).
+same node, or its linear form (flexgear.mbs.bodies.add_linear_frame, production).
 Left out (second order): the inertia tensor's change with q, the terms in the tilt rates and in
 the angular acceleration. One ``ObjectGenericODE2`` per body carries M, K(Omega), D(Omega) (constant
 Jacobian); :class:`SpinSchedule` moves K and D with the ramp and writes the centrifugal load.
@@ -104,7 +104,7 @@ class SpinSchedule:
     """
 
     def __init__(self, mbs, bodies: list, ramp_time: float, update_interval: float, frames: list = ()):
-        """``bodies``: flexible bodies with ``floating_frame = "linear"`` (flexgear.mbs.flexible.FlexibleBody:
+        """``bodies``: flexible bodies of the production formulation (flexgear.mbs.flexible.FlexibleBody:
         ``modal_nodes``, ``modal_equations``, ``spin``, ``nominal_spin_rad_s``, ``reduced``, ``modal_matrices``);
         ``frames``: linear body frames (flexgear.mbs.bodies.LinearFrame), whose gyroscopic term moves likewise."""
         from exudyn.itemInterface import ObjectGenericODE2
