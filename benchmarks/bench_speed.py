@@ -1,7 +1,7 @@
 """How fast do the variants run: model 7 against model 1 (goal <= 6), model 1 against its floor (goal <= 1.2), the
 matrix's workers against its single runs (goal <= 0.55), and each variant's full load case against theory?
 
-Run: nice -n 5 python benchmarks/bench_speed.py [ratios] [--t-end 0.6] [--repeat 3] [--updates exudyn economy]
+Run: nice -n 5 python benchmarks/bench_speed.py [ratios] [--t-end 0.6] [--repeat 3] [--updates reference production]
      nice -n 5 python benchmarks/bench_speed.py matrix [--t-end 0.6] [--repeat 3] [--workers 2] [model*.toml ...]
      nice -n 5 python benchmarks/bench_speed.py variants [--t-end 0.6] [--out results/bench] [model*.toml ...]
 
@@ -10,8 +10,8 @@ Run: nice -n 5 python benchmarks/bench_speed.py [ratios] [--t-end 0.6] [--repeat
   is warmed first (a 1e-4 s run: meshes, reduced bodies and compiled kernels cached), then the rounds interleave
   the cases so that the machine's load hits them alike. Printed per case: each run's wall time (build + solve, as
   flexgear.mbs.run.run_variant reports it), solve-only wall time and CPU time with medians, then the ratios
-  (:func:`ratio_line`). ``--updates`` runs every case with each Jacobian policy (``[solver_assumed]
-  jacobian_updates``, flexgear.mbs.newton) side by side.
+  (:func:`ratio_line`). ``--updates`` runs every case in each formulation (``[solver_assumed]
+  formulation``: production or reference) side by side.
 - ``matrix``: per round every variant run alone, one after the other, in this process, their wall times summed;
   then the whole matrix (flexgear.study.matrix.run_matrix: worker processes, saving, screening) into a fresh
   temporary folder, its wall time from call to return; the ratio matrix / sum. On a shared 2-core machine the
@@ -89,9 +89,9 @@ def floor_variant(variant: Variant) -> Variant:
     return dataclasses.replace(variant, gearbox=gb, name=f"{variant.name}_floor")
 
 
-def with_jacobian_updates(variant: Variant, updates: str) -> Variant:
-    """``variant`` with ``[solver_assumed] jacobian_updates = updates`` (flexgear.mbs.newton)."""
-    return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("solver_assumed", jacobian_updates=updates))
+def with_formulation(variant: Variant, formulation: str) -> Variant:
+    """``variant`` with ``[solver_assumed] formulation`` ("production" or "reference")."""
+    return dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("solver_assumed", formulation=formulation))
 
 
 def shortened(variant: Variant, ramp: float, t_end: float) -> Variant:
@@ -143,7 +143,7 @@ def ratios(a: argparse.Namespace) -> None:
     variants = {}
     for suffix, updates in zip(suffixes, a.updates or [None], strict=True):
         for k, v in chosen.items():
-            variants[k + suffix] = v if updates is None else with_jacobian_updates(v, updates)
+            variants[k + suffix] = v if updates is None else with_formulation(v, updates)
     t_end = a.t_end if a.t_end is not None else model1.gearbox.load_case.end_time_s
     print(f"bench_speed ratios: t_end {t_end} s, step {model1.gearbox.load_case.step_size_s} s, {a.repeat} rounds; "
           f"{load_average()}", flush=True)
@@ -248,7 +248,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--variants-dir", default=str(ROOT / "model_variants"), help="ratios: folder of model1/7.toml")
     ap.add_argument("--cases", nargs="+", default=["model1", "floor", "model7"], choices=["model1", "floor", "model7"])
-    ap.add_argument("--updates", nargs="+", default=None, choices=["exudyn", "economy"],
+    ap.add_argument("--updates", nargs="+", default=None, choices=["reference", "production"],
                     help="ratios: Jacobian policies to compare (default: the variants' own)")
     ap.add_argument("--workers", type=int, default=2, help="matrix: worker processes")
     ap.add_argument("--out", default="results/bench", help="variants: folder of the runs and the CSV")

@@ -6,7 +6,7 @@ Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then
-solved as a run solves it (the Jacobian economy of ``[solver_assumed] jacobian_updates``, the collector's
+solved as a run solves it (the Jacobian economy of the production formulation, the collector's
 generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
 case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
 step (the ``Python`` timer is the pre-step user functions), Newton iterations and Jacobians per step;
@@ -56,7 +56,7 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
             settings.displayComputationTime = True
             settings.displayStatistics = True
     sv = variant.gearbox.solver_assumed
-    if sv.jacobian_updates == "economy":  # as flexgear.mbs.run's post-step guard drives it
+    if not sv.reference:  # as flexgear.mbs.run's post-step guard drives it
         economy = JacobianEconomy(sv.jacobian_cost_iterations)
         mbs.SetPostStepUserFunction(lambda mbs, t: economy(mbs) or True)
     prof = cProfile.Profile() if profile else None

@@ -134,7 +134,7 @@ def test_model4_with_the_cutoff_keeps_the_whole_basis_means(variant):
     dynamic. Mean mesh forces within 0.1 % and their 1x mesh amplitudes within 2 % (the agreement rule), and so the
     load deflections' 1x. The study's variant (cut-off 8x, the bolted ring kept whole): measured within 0.04 %
     with the sun's dropped modes answering its joint's force (+0.7 % sun-planet with the quasi-static seat
-    reaction, +2.3 % without the residual's damping: benchmarks/bench_residual.py), sun-planet load deflections
+    reaction, +2.3 % without the residual's damping), sun-planet load deflections
     within 0.2 % (5.6 %). The quick variant (cut-off 4x, the ring on one RBE3 joint and cut as well, its dropped
     modes answering that joint's force): mesh forces within 0.04 % (2.3 % quasi-static), load deflections within
     0.25 % (15 %)."""
