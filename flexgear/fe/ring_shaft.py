@@ -16,7 +16,7 @@ pair than two bodies joined per bolt (flexgear.fe.reduced, flexgear.fe.bolted):
   the sum of the ring's and the shaft's (flexgear.fe.tied): a rigid twin of the pair has the same.
 - **One of the pair rigid** (:func:`rigid_partner_body`): every clamped disc moves with the one rigid part, so the
   flexible part's 12 bolt patches are one rigid multi-point interface "bolt_patches" (6 coordinates, its nodes
-  the union of the discs moving as one rigid body, RBE2) at the joint point on the axis in the flange-web plane;
+  the union of the discs moving as one rigid body, RBE2) at their centroid, on the axis in the flange-web plane;
   the shaft keeps its bearing seat, the ring its contact bands. One fixed joint to the rigid part replaces 12.
 
 Both are cached by a hash of every input (flexgear.fe.reduced.cached_reduced_body).
@@ -143,15 +143,16 @@ def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress
 
 def bolt_patch_group(fe: FEModel, spec: GearboxSpec) -> Interface:
     """The clamped discs of ``fe`` (ring or output shaft, flexgear.fe.bolted.clamped_patches) as one interface
-    "bolt_patches": their nodes, each disc weighted equally, the point the joint point (on the axis in the
-    flange-web plane z_j). Rigid (RBE2) in :func:`rigid_partner_body`: the weights only define the
-    interface's RBE3 reading, which equals its rigid motion."""
-    _, _, z_j = bolt_axes(spec)
+    "bolt_patches": their nodes, each disc weighted equally, the point their weighted centroid (on the axis in the
+    flange-web plane z_j, to the mesh's asymmetry). Rigid (RBE2) in :func:`rigid_partner_body`: the weights only
+    define the interface's RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid
+    motion: the translation at the point and the rotation."""
     patches = clamped_patches(fe, spec)
     nodes = np.concatenate(patches)
     weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
     order = np.argsort(nodes)
-    return Interface(BOLT_PATCHES, nodes[order], weights[order], np.array([0.0, 0.0, z_j]))
+    nodes, weights = nodes[order], weights[order]
+    return Interface(BOLT_PATCHES, nodes, weights, weights @ fe.nodes[nodes])
 
 
 def rigid_partner_interfaces(fe: FEModel, spec: GearboxSpec, component: str) -> list[Interface]:
