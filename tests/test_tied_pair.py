@@ -27,6 +27,20 @@ def pair(gearbox):
     return tied.fe, body, tied.interface("ring", ring_seat(ring, gearbox))
 
 
+def test_tied_body_mass_properties_are_the_sum_of_the_parts(gearbox, pair):
+    """The rigid/flexible twin rule for the joined body: its mass properties (read alone from the cache, as a rigid
+    twin reads them) equal the ring's and the shaft's bodies' combined."""
+    from flexgear.fe.reduced import component_mass_properties
+    from flexgear.fe.ring_shaft import PAIR, tied_pair_mass_properties
+    from flexgear.geometry.massprops import combine_mass_properties
+
+    parts = combine_mass_properties(*(component_mass_properties(gearbox, c, "coarse") for c in PAIR))
+    for props in (tied_pair_mass_properties(gearbox, "coarse"), pair[1].props):
+        assert props.mass == pytest.approx(parts.mass, rel=1e-12)
+        np.testing.assert_allclose(props.com, parts.com, atol=1e-12)
+        np.testing.assert_allclose(props.inertia, parts.inertia, atol=1e-12 * np.abs(parts.inertia).max())
+
+
 def test_tied_body_free_free_modes_within_1_percent_of_full_fe(pair):
     fe, body, _ = pair
     full = full_free_modes(fe, 10, free_body_solver(fe))[0]
