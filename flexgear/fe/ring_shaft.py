@@ -112,15 +112,16 @@ def _tied_build(spec: GearboxSpec, level: str, progress: bool) -> Callable[[], R
         t0 = time.perf_counter()
         ring, shaft = pair_fe_models(spec, level, progress)
         tied = tied_pair(ring, shaft, spec)
-        seat = ring_seat(ring, spec)  # ring nodes keep their indices in the tied model
+        seat = tied.interface("ring", ring_seat(ring, spec))
         itfs = tied_pair_interfaces(tied, shaft, spec)
-        del shaft
+        n_ring = ring.n_nodes
+        del ring, shaft  # the parts' matrices: the reduction holds the tied model's alone
         red = spec.reduction_assumed
         circles = component_load_circles(spec, "ring", red.attachment_order)
         t_tie = time.perf_counter() - t0
         body = reduce(tied, itfs, red.fixed_interface_modes, n_compare=0, load_circles=circles)
-        info = {**body.info, "n_nodes_ring": float(ring.n_nodes), "fe_and_tie_time_s": t_tie}
-        return dataclasses.replace(body, interfaces=[*body.interfaces, tied.interface("ring", seat)], info=info)
+        info = {**body.info, "n_nodes_ring": float(n_ring), "fe_and_tie_time_s": t_tie}
+        return dataclasses.replace(body, interfaces=[*body.interfaces, seat], info=info)
 
     return build
 
