@@ -12,8 +12,9 @@ Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections buil
   frequencies (flexgear.fe.cms.full_free_modes on the tied model, which equals flexgear.fe.bolted's tie) and with
   ``--bolted`` also flexgear.fe.bolted.ring_output_shaft_fe_modes itself (its own solver: minutes, 4 GB); the
   largest compliance error at the ring's contacts (kernel loads, bearing seat held) relative to the largest
-  entry, and of the bearing seat's six RBE3 compliances (ring side held); and today's ring with its 12 patches all
-  held against the one-rigid-interface ring held at "bolt_patches" (the same physics: lowest ten frequencies).
+  entry, and of the bearing seat's six RBE3 compliances (ring side held); and today's ring and shaft with their 12
+  patches all held against the one-rigid-interface bodies held at "bolt_patches" (the same physics: lowest ten
+  frequencies).
 Results are printed and, with ``--out``, written as JSON (atomically).
 """
 
@@ -148,13 +149,14 @@ def checks_section(level: str, bolted: bool) -> dict:
         lam = la.eigh(basis.T @ stiffness @ basis, basis.T @ mass @ basis, eigvals_only=True)
         return np.sqrt(lam[:10]) / (2 * np.pi)
 
-    today = component_reduced_body(spec, "ring", level)
-    patches = [i.name for i in today.interfaces if i.name.startswith("bolt_")]
-    one = rigid_partner_body(spec, "ring", level)
-    f_today, f_one = held_hz(today, patches), held_hz(one, ["bolt_patches"])
-    out["ring_held_today_hz"], out["ring_held_one_interface_hz"] = f_today.tolist(), f_one.tolist()
-    print(f"ring held at its bolts: {len(patches)} patches ({today.n_modes} modes) vs one rigid interface "
-          f"({one.n_modes} modes): largest difference {np.abs(f_one / f_today - 1).max():.2e}")
+    for component in ("ring", "output_shaft"):
+        today = component_reduced_body(spec, component, level)
+        patches = [i.name for i in today.interfaces if i.name.startswith("bolt_")]
+        one = rigid_partner_body(spec, component, level)
+        f_today, f_one = held_hz(today, patches), held_hz(one, ["bolt_patches"])
+        out[f"{component}_held_today_hz"], out[f"{component}_held_one_interface_hz"] = f_today.tolist(), f_one.tolist()
+        print(f"{component} held at its bolts: {len(patches)} patches ({today.n_modes} modes) vs one rigid interface "
+              f"({one.n_modes} modes): largest difference {np.abs(f_one / f_today - 1).max():.2e}")
     return out
 
 
