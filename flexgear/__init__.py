@@ -1,7 +1,8 @@
 """flexgear: dynamics of geared transmissions on Exudyn, rigid or flexible, screened against theory.
 
 The public API (``__all__``) builds any gearbox in a few lines: gear geometry (``gear_pair_geometry``),
-bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``), bearings
+bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``; parts bolted or
+bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``), bearings
 (``Bushing``, ``add_planet_bearing``), fixed joints (``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
 on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
@@ -26,7 +27,8 @@ _LAZY = {
     "annulus_mass_properties": "geometry.massprops",
     "MassProperties": "geometry.massprops", "combine_mass_properties": "geometry.massprops",
     # FE and reduction
-    "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.cms",
+    "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.tied",
+    "Tie": "fe.tied", "TiedFE": "fe.tied", "tie_parts": "fe.tied",
     "LoadCircle": "fe.attachment", "static_compliance": "fe.compliance",
     # laws
     "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",

@@ -1,0 +1,194 @@
+"""The ring and the output shaft reduced together: one body for the bolted pair, no bolt joints between them.
+
+Section 2.1: the ring's flange is bolted to the output shaft's web at 12 holes. Two exact, smaller forms of the
+pair than two bodies joined per bolt (flexgear.fe.reduced, flexgear.fe.bolted):
+
+- **Both flexible** (:func:`tied_pair_body`): the two FE models tied over the bolts' clamped discs as the full-FE
+  reference ties them (flexgear.fe.bolted: the shaft's web nodes in each disc follow the ring's flange face,
+  flexgear.fe.tied eq. 1) and reduced as one body (flexgear.fe.tied.reduce), with the reduction of every
+  component body (flexgear.fe.reduced): RBE3 interfaces, ``[reduction_assumed] fixed_interface_modes``
+  fixed-interface modes, attachment modes of the ring's contact bands (``attachment_order``). Its interface is
+  the output shaft's bearing seat ("bearing_seat"), the pair's only seat; the ring's contact bands are the ring's
+  own (the ring's nodes come first, with their indices in the ring's model). Beside it the body carries the
+  measuring interface "ring_seat" (no static modes of its own): the ring's side of the joint, the union of its
+  clamped discs, each disc weighted equally (as flexgear.fe.reduced.gear_seat takes it for the ring alone), the
+  seat the ring's deflections are measured from. Its mass properties are those of the tied FE model, exactly
+  the sum of the ring's and the shaft's (flexgear.fe.tied): a rigid twin of the pair has the same.
+- **One of the pair rigid** (:func:`rigid_partner_body`): every clamped disc moves with the one rigid part, so the
+  flexible part's 12 bolt patches are one rigid multi-point interface "bolt_patches" (6 coordinates, its nodes
+  the union of the discs moving as one rigid body, RBE2) at their centroid, on the axis in the flange-web plane;
+  the shaft keeps its bearing seat, the ring its contact bands. One fixed joint to the rigid part replaces 12.
+
+Both are cached by a hash of every input (flexgear.fe.reduced.cached_reduced_body).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from flexgear.fe.bolted import bolt_axes, clamped_patches
+from flexgear.fe.cms import Interface, ReducedBody
+from flexgear.fe.fem import FEModel
+from flexgear.fe.reduced import _read_cached, cached_reduced_body, component_interfaces, component_load_circles
+from flexgear.fe.tied import Tie, TiedFE, reduce, tie_parts
+from flexgear.geometry.layout import geometry_hash
+from flexgear.geometry.massprops import MassProperties
+from flexgear.progress import say
+from flexgear.spec import GearboxSpec
+
+__all__ = ["PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
+           "tied_pair_body", "tied_pair_mass_properties", "bolt_patch_group", "rigid_partner_interfaces",
+           "rigid_partner_body"]
+
+PAIR = ("ring", "output_shaft")
+"""The bolted pair's parts, in the order of the tied model (the ring first: its nodes keep their indices)."""
+RING_SEAT = "ring_seat"
+"""Name of the tied body's measuring interface on the ring's side of the joint."""
+BOLT_PATCHES = "bolt_patches"
+"""Name of the one rigid multi-point interface of :func:`rigid_partner_body`."""
+_TIED_VERSION = 1
+"""Bump when the tied reduction changes without an input changing (enters the cache keys)."""
+
+
+def part_fe_model(spec: GearboxSpec, component: str, level: str = "coarse", progress: bool = False) -> FEModel:
+    """FE model of ``component`` at mesh ``level``: the level's element order on the cached first-order mesh
+    topology, as flexgear.fe.reduced builds every component's."""
+    from flexgear.fe.fem import fe_model
+    from flexgear.fe.mesh import component_mesh
+
+    order = spec.meshing_assumed[level].element_order
+    return fe_model(component_mesh(spec, component, level, order=1, progress=progress).ngsolve_mesh(),
+                    spec.material_assumed, order)
+
+
+def pair_fe_models(spec: GearboxSpec, level: str = "coarse", progress: bool = False) -> tuple[FEModel, FEModel]:
+    """FE models of the ring and the output shaft (:func:`part_fe_model`)."""
+    return tuple(part_fe_model(spec, name, level, progress) for name in PAIR)
+
+
+def tied_pair(ring: FEModel, shaft: FEModel, spec: GearboxSpec, clamp_radius: float | None = None) -> TiedFE:
+    """Ring and output shaft tied over the bolts' clamped discs (flexgear.fe.bolted.clamped_patches of the shaft's
+    web face as slave nodes, the ring's flange face the master, the plane z = z_j): the tie of
+    flexgear.fe.bolted.tie_matrix, as a flexgear.fe.tied.TiedFE with parts named as :data:`PAIR`."""
+    _, _, z_j = bolt_axes(spec)
+    slaves = np.concatenate(clamped_patches(shaft, spec, clamp_radius))
+    return tie_parts([ring, shaft], [Tie(0, 1, slaves, (0.0, 0.0, z_j))], PAIR)
+
+
+def ring_seat(ring: FEModel, spec: GearboxSpec) -> Interface:
+    """The ring's side of the joint: the union of its clamped discs (node indices of ``ring``), each disc's nodes
+    weighted equally and each disc in all 1 / (number of bolts)."""
+    patches = clamped_patches(ring, spec)
+    nodes = np.concatenate(patches)
+    weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
+    order = np.argsort(nodes)
+    nodes, weights = nodes[order], weights[order]
+    return Interface(RING_SEAT, nodes, weights, weights @ ring.nodes[nodes])
+
+
+def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> list[Interface]:
+    """The reduction interfaces of the tied pair: the output shaft's bearing seat (flexgear.fe.reduced), its node
+    indices mapped into the tied model."""
+    seat = next(i for i in component_interfaces(shaft, spec, "output_shaft") if i.name == "bearing_seat")
+    return [tied.interface("output_shaft", seat)]
+
+
+def _tied_key(spec: GearboxSpec, level: str) -> str:
+    red = spec.reduction_assumed
+    circles = component_load_circles(spec, "ring", red.attachment_order)
+    key = geometry_hash(spec, "tied", PAIR, spec.meshing_assumed[level], red.fixed_interface_modes,
+                        [c.key() for c in circles], spec.joints_assumed.bolt_clamp_diameter_mm, _TIED_VERSION)
+    return f"ring_output_shaft_tied-{level}-{key}"
+
+
+def _tied_build(spec: GearboxSpec, level: str, progress: bool) -> Callable[[], ReducedBody]:
+    def build() -> ReducedBody:
+        if progress:
+            say(f"  ring + output_shaft ({level}): building the tied pair's reduced body")
+        t0 = time.perf_counter()
+        ring, shaft = pair_fe_models(spec, level, progress)
+        tied = tied_pair(ring, shaft, spec)
+        seat = tied.interface("ring", ring_seat(ring, spec))
+        itfs = tied_pair_interfaces(tied, shaft, spec)
+        n_ring = ring.n_nodes
+        del ring, shaft  # the parts' matrices: the reduction holds the tied model's alone
+        red = spec.reduction_assumed
+        circles = component_load_circles(spec, "ring", red.attachment_order)
+        t_tie = time.perf_counter() - t0
+        body = reduce(tied, itfs, red.fixed_interface_modes, n_compare=0, load_circles=circles)
+        info = {**body.info, "n_nodes_ring": float(n_ring), "fe_and_tie_time_s": t_tie}
+        return dataclasses.replace(body, interfaces=[*body.interfaces, seat], info=info)
+
+    return build
+
+
+def tied_pair_body(spec: GearboxSpec, level: str = "coarse", progress: bool = False) -> ReducedBody:
+    """The reduced body of the ring and the output shaft tied together (module docstring), cached."""
+    return cached_reduced_body(_tied_key(spec, level), _tied_build(spec, level, progress))
+
+
+def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress: bool = False) -> MassProperties:
+    """Mass properties of :func:`tied_pair_body` (of the tied FE model: the sum of the ring's and the shaft's),
+    read alone from the cache when the body is there, else from the body built and cached."""
+    def read(path) -> MassProperties:
+        with np.load(path, allow_pickle=False) as z:
+            return MassProperties(float(z["mass"]), z["com"], z["inertia"])
+
+    props = _read_cached(_tied_key(spec, level), read)
+    return props if props is not None else tied_pair_body(spec, level, progress).props
+
+
+def bolt_patch_group(fe: FEModel, spec: GearboxSpec) -> Interface:
+    """The clamped discs of ``fe`` (ring or output shaft, flexgear.fe.bolted.clamped_patches) as one interface
+    "bolt_patches": their nodes, each disc weighted equally, the point their weighted centroid (on the axis in the
+    flange-web plane z_j, to the mesh's asymmetry). Rigid (RBE2) in :func:`rigid_partner_body`: the weights only
+    define the interface's RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid
+    motion: the translation at the point and the rotation."""
+    patches = clamped_patches(fe, spec)
+    nodes = np.concatenate(patches)
+    weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
+    order = np.argsort(nodes)
+    nodes, weights = nodes[order], weights[order]
+    return Interface(BOLT_PATCHES, nodes, weights, weights @ fe.nodes[nodes])
+
+
+def rigid_partner_interfaces(fe: FEModel, spec: GearboxSpec, component: str) -> list[Interface]:
+    """Interfaces of ``component`` (ring or output_shaft) joined to a rigid partner: "bolt_patches" (rigid) and,
+    for the shaft, its bearing seat (flexgear.fe.reduced)."""
+    itfs = [bolt_patch_group(fe, spec)]
+    if component == "output_shaft":
+        itfs += [i for i in component_interfaces(fe, spec, component) if i.name == "bearing_seat"]
+    return itfs
+
+
+def _rigid_partner_key(spec: GearboxSpec, component: str, level: str) -> str:
+    red = spec.reduction_assumed
+    circles = component_load_circles(spec, component, red.attachment_order)
+    key = geometry_hash(spec, "rigid_partner", component, spec.meshing_assumed[level], red.fixed_interface_modes,
+                        [c.key() for c in circles], spec.joints_assumed.bolt_clamp_diameter_mm, _TIED_VERSION)
+    return f"{component}-rigid_partner-{level}-{key}"
+
+
+def rigid_partner_body(spec: GearboxSpec, component: str, level: str = "coarse",
+                       progress: bool = False) -> ReducedBody:
+    """The reduced body of ``component`` ("ring" or "output_shaft") whose bolted partner is rigid: the 12 clamped
+    discs one rigid interface "bolt_patches" (:func:`bolt_patch_group`), the shaft's bearing seat, the ring's
+    contact bands as attachment modes; the reduction settings of every component body. Cached."""
+    if component not in PAIR:
+        raise ValueError(f"rigid_partner_body: component must be one of {PAIR}, got {component!r}")
+
+    def build() -> ReducedBody:
+        if progress:
+            say(f"  {component} ({level}): building the reduced body with one rigid bolt-patch interface")
+        fe = part_fe_model(spec, component, level, progress)
+        itfs = rigid_partner_interfaces(fe, spec, component)
+        red = spec.reduction_assumed
+        return reduce(fe, itfs, red.fixed_interface_modes, n_compare=0,
+                      load_circles=component_load_circles(spec, component, red.attachment_order),
+                      rigid=(BOLT_PATCHES,))
+
+    return cached_reduced_body(_rigid_partner_key(spec, component, level), build)
