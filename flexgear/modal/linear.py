@@ -260,7 +260,7 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
             mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Current)
             if pre is not None:
                 pre(mbs, t_star)
-            if not mbs.SolveStatic(ss, showHints=False):
+            if not _solve_static(mbs, ss):
                 raise RuntimeError(f"{variant.name}: no static equilibrium at t = {t_star:g} s")
             q0 = np.array(mbs.systemData.GetODE2Coordinates())
             if pre is None:
@@ -269,6 +269,27 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
         exu.config.printToConsole = was
     mbs.systemData.SetODE2Coordinates(q0, exu.ConfigurationType.Initial)
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
+
+
+RETRY_RELATIVE_TOLERANCE = 1e-10
+"""Newton's relative tolerance of a second static solve where the first (1e-12) stalls at round-off (a relative
+error of a few 1e-12 at some gear angles): a residual still 1e-10 of the load, far below any modal quantity."""
+
+
+def _solve_static(mbs, ss) -> bool:
+    """Exudyn's static solve with :func:`_settings`; once more at :data:`RETRY_RELATIVE_TOLERANCE` if Newton stalls
+    at round-off. The Newton state is reset to the same start for the second attempt."""
+    import exudyn as exu
+
+    start = np.array(mbs.systemData.GetODE2Coordinates())
+    try:
+        if mbs.SolveStatic(ss, showHints=False):
+            return True
+    except exu.SolverError:
+        pass
+    mbs.systemData.SetODE2Coordinates(start, exu.ConfigurationType.Current)
+    ss.staticSolver.newton.relativeTolerance = max(ss.staticSolver.newton.relativeTolerance, RETRY_RELATIVE_TOLERANCE)
+    return bool(mbs.SolveStatic(ss, showHints=False))
 
 
 def _settings(t_star: float):
