@@ -144,9 +144,11 @@ def checks(a: argparse.Namespace) -> None:
             assert result.ok, result.meta.get("reason")
             sig = result.signals
             t = sig["time_s"].to_numpy()
-            dt = float(t[1] - t[0])
+            dt = float(t[-1] - t[-2])  # the recorded step (a run may start with shorter ones)
             f_mesh = mesh_frequency_hz(spec, n)
             k = int(round(math.floor(WINDOW_S * f_mesh) / f_mesh / dt))
+            if not np.allclose(np.diff(t[-k - 1:]), dt, rtol=1e-6):
+                raise RuntimeError("the analysed window is not uniformly sampled")
             print(f"  {n:g} rpm ({factor:g} x): time run {time.perf_counter() - t0:.0f} s, settled "
                   f"{result.meta.get('settled')} at {result.meta.get('settled_at_s')} s, window {k * dt:.4f} s")
             for column in COLUMNS:

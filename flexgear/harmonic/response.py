@@ -239,15 +239,23 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
     means = np.array([c.stiffness.mean for c in contacts])
 
     def selectors(lm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Contact deflections, bearing-node translations and output spin per z; static deflections."""
+        """Contact deflections, bearing-node translations and output spin per z; static deflections. Where a
+        contact's law acts on delta - e (a flexible gear's residual compliance, LinearModel.contact_residuals),
+        the deflection is delta - e."""
         rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
+        residual = getattr(lm, "contact_residuals", {})
+        law_rows = lm.basis[rows].copy()
+        delta0 = np.array([lm.static_deflections[nm] for nm in names])
+        for j, nm in enumerate(names):
+            if nm in residual:
+                law_rows[j] -= lm.basis[residual[nm]]
+                delta0[j] -= lm.static_residuals[nm]
         full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
         in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
         out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
         accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
         out_row = _frame_row(lm, out_comp, "phi_z")
-        delta0 = np.array([lm.static_deflections[nm] for nm in names])
-        return lm.basis[rows], lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
+        return law_rows, lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
 
     geo = gear_set_geometry(spec)
     th = theory(spec)

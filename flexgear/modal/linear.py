@@ -95,6 +95,10 @@ class LinearModel:
     flexible: tuple[str, ...] = ()
     parts: dict[int, list[tuple[str, np.ndarray]]] = field(default_factory=dict)
     static_deflections: dict[str, float] = field(default_factory=dict)  # contact name -> delta_0 [m]
+    # contact name -> index in full_coordinates of its residual deflection e (flexgear.mbs.residual: the contact law
+    # acts on delta - e where a flexible gear's dropped modes return as residual compliance); absent: none
+    contact_residuals: dict[str, int] = field(default_factory=dict)
+    static_residuals: dict[str, float] = field(default_factory=dict)  # contact name -> e_0 [m] at the operating point
 
     @property
     def n(self) -> int:
@@ -346,6 +350,11 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
         rows = [mbs.GetNodeODE2Index(node) + k for node in model.aux_nodes
                 for k in range(len(mbs.GetNode(node)["referenceCoordinates"]))]  # contacts in order
         static = {contact.name: float(q[i]) for contact, i in zip(model.contacts, rows, strict=True)}
+        residuals: dict[str, int] = {}
+        if int(model.residual_node) >= 0 and model.residual is not None:  # the laws act on delta - e (residual.py)
+            first = mbs.GetNodeODE2Index(model.residual_node)
+            residuals = {model.contacts[int(r)].name: first + k for k, r in enumerate(model.residual.rows)}
+        static_residuals = {name: float(q[i]) for name, i in residuals.items()}
         parts = _mass_parts(built, model, mbs)
     finally:
         sc.Reset()
@@ -359,7 +368,8 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     flexible = tuple(_component_name(nm) for nm, b in model.bodies.items() if b.flexible)
     components = _components(spec.gears.planet_count)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
-                       basis, tuple(labels), m, k, components, flexible, parts, static)
+                       basis, tuple(labels), m, k, components, flexible, parts, static, residuals,
+                       static_residuals)
 
 
 def _components(planets: int) -> tuple[str, ...]:
