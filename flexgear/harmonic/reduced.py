@@ -19,14 +19,14 @@ f_c = ``ratio`` omega / 2 pi respond dynamically; the others respond quasi-stati
     V_m = [Phi_m,  Phi_t Q_m],    Q_m = orth(Lambda_t^-1 Phi_t^T B)                     (2)
 
 keeps the m modes below f_c and adds the residual static part of the truncated modes t (the static responses of
-the modes above f_c to the excitation's force directions B, the contacts' rows g^T, orthonormalised: Q_m^T Q_m = I,
-so V_m^T M V_m = I). On V_m the problem
+the modes above f_c to the excitation's force directions B, the contacts' rows g^T, and their mass corrections
+Lambda_t^-j Phi_t^T B, orthonormalised: Q_m^T Q_m = I, so V_m^T M V_m = I). On V_m the problem
 
     (V^T K(Omega) V - omega^2 I + i omega V^T (D + Omega G_1) V) y = V^T F,    x = V y           (3)
 
-is exact at omega = 0 (V spans K_0^-1 B through the modes kept and the static residual) and, for omega below
-f_c / ratio, misses only the truncated modes' dynamic amplification, 1 / (1 - (omega / omega_k)^2) - 1 <
-1 / (ratio^2 - 1) of their (small) quasi-static share. Each harmonic of each speed gets its own m; the projected
+is exact at omega = 0 (V spans K_0^-1 B through the modes kept and the static residual); of the truncated modes'
+dynamic amplification 1 / (1 - (omega / omega_k)^2) it misses the terms beyond the residual's order (the coupling
+of the modes through D and G is kept within V). Each harmonic of each speed gets its own m; the projected
 matrices are computed once per m.
 """
 
@@ -39,14 +39,15 @@ import numpy as np
 
 __all__ = ["SpinFit", "fit_spin", "ModalSolver", "MODAL_CUTOFF_RATIO"]
 
-MODAL_CUTOFF_RATIO = 3.0
-"""f_c / f of the modal solve (module docstring, eq. 3): modes up to three times the excitation frequency are
-dynamic; the quasi-static share of the others is then in error by at most 1 / (3^2 - 1) = 12.5 % of itself."""
+MODAL_CUTOFF_RATIO = 1.5
+"""f_c / f of the modal solve (module docstring, eq. 3): modes up to 1.5 times the excitation frequency are
+dynamic; with :data:`RESIDUAL_ORDER` = 3 the others' response is exact to order (f / f_k)^6 < 1.5^-6 = 9 % of
+their (quasi-static, small) share."""
 
-RESIDUAL_ORDER = 2
-"""Residual vectors per force direction (module docstring, eq. 2): 1, the static response Lambda_t^-1 Phi_t^T B of
-the truncated modes; 2, also its first mass correction Lambda_t^-2 Phi_t^T B, which makes the truncated modes'
-response exact to order (omega / omega_k)^2 instead of order 0."""
+RESIDUAL_ORDER = 3
+"""Residual vectors per force direction (module docstring, eq. 2): the static response Lambda_t^-1 Phi_t^T B of
+the truncated modes and its mass corrections Lambda_t^-j Phi_t^T B, j = 2..order: the truncated modes' response
+1 / (lambda_k - omega^2) = sum_j omega^(2 j - 2) / lambda_k^j is then exact up to order (omega^2 / lambda_k)^order."""
 
 BLOCK_STEP = 1.0 / 40.0
 """The modes kept at a frequency are rounded up to a multiple of this fraction of all modes: at most 40 + 1
@@ -152,8 +153,8 @@ class ModalSolver:
         n = self.lam.size
         if m < n:
             y = [self._b[m:] / self.lam[m:, None]]  # the truncated modes' static responses (modal coordinates)
-            for _ in range(1, self.residual_order):
-                y.append(y[-1] / self.lam[m:, None])  # and their mass corrections
+            for _ in range(1, self.residual_order):  # and their mass corrections, scaled by lambda_m (same span)
+                y.append(y[-1] * (self.lam[m] / self.lam[m:, None]))
             u, s, _ = np.linalg.svd(np.hstack(y), full_matrices=False)
             q = u[:, s > _RANK_TOL * s[0]] if s.size and s[0] > 0.0 else np.zeros((n - m, 0))
         else:
