@@ -66,3 +66,11 @@ def test_files_in_the_results_folder(tmp_path):
     assert text.splitlines() == ["model1: the reference over 2000-4000 rpm"]
     assert (tmp_path / "speed_screening.txt").read_text() == text
     assert (tmp_path / "speed_screening.csv").stat().st_size > 0
+
+
+def test_matrix_takes_a_speed_range():
+    from flexgear.cli import _parser
+
+    args = _parser().parse_args(["matrix", "model_variants/model1.toml", "--speeds-rpm", "1000:3000:1000"])
+    assert args.speeds_rpm == [1000.0, 2000.0, 3000.0]
+    assert _parser().parse_args(["matrix", "model_variants/model1.toml"]).speeds_rpm is None
