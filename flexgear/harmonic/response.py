@@ -198,7 +198,10 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
         variant = dataclasses.replace(variant, gearbox=_excited(variant.gearbox, harmonics))
         nodes, models = _linear_models(variant, speeds, linearization)
     spin = linearization == "spin" and len(models) == 2
-    return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0, spin, modal_cutoff_ratio)
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices: one thread each is fastest on a shared machine
+        return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0, spin, modal_cutoff_ratio)
 
 
 def _check_contacts(lm: Any, names: list[str]) -> None:
