@@ -9,7 +9,8 @@ Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 
   7000 rpm x ``--harmonics`` harmonics (the default: two linearisations, the spin fit and the modal solve) and
   flexgear.mbs.run.run_variant of model 7 to 0.1 s (the build included, as a run reports it); wall and CPU time,
   medians and the ratio. Then the modal solve against the dense solve of all coordinates at every tenth speed and
-  the highest (the grid's highest speed sets the linearisations' gear angles and modes): the largest difference of each indicator family relative to that family's largest amplitude per harmonic.
+  the highest (the grid's highest speed sets the linearisations' gear angles and modes): the largest difference
+  of each indicator family relative to that family's largest amplitude per harmonic.
 - ``checks``: each variant under the ISO 6336 law without friction (the linearisation's scope), its own number of
   stiffness harmonics. The response over 500-7000 rpm locates the peaks of K_v - 1; the first whose height is at
   least :data:`STRONG` of the highest is the first strong crossing n_c. At n_c x :data:`BESIDE` (below, on, above)
