@@ -15,7 +15,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from flexgear.harmonic.cli import SWEEP_SPEED
-from flexgear.modal.cli import CAMPBELL, SCREENING
+from flexgear.modal.cli import CAMPBELL, SCREENING, speeds_rpm
 from flexgear.modal.cli import SUBCOMMAND as MODES
 from flexgear.progress import Progress, say
 
@@ -85,6 +85,10 @@ def _args_matrix(p: argparse.ArgumentParser) -> None:
     p.add_argument("--reference", default=None, metavar="NAME",
                    help="screen against this variant (dynamic indicators, Bias against its values) instead of "
                         "theory (default: [screening] reference of the gearbox file)")
+    p.add_argument("--speeds-rpm", type=speeds_rpm, default=None, metavar="A:B:S",
+                   help="also screen the variants' frequency-domain indicators over these input speeds in rpm, "
+                        "START:STOP:STEP or a list a,b,c, against the reference (flexgear.study.speed_screening; "
+                        "default: none)")
 
 
 def cmd_matrix(a: argparse.Namespace) -> int:
@@ -94,6 +98,14 @@ def cmd_matrix(a: argparse.Namespace) -> int:
                        scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget, reference=a.reference)
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    if a.speeds_rpm:
+        from flexgear.study.speed_screening import screen_speed_range
+
+        text = screen_speed_range(a.variants, a.out, a.speeds_rpm, a.reference)
+        selection = Path(a.out) / "selection.txt"
+        if selection.is_file():
+            print(f"Westgard: {selection.read_text().splitlines()[0]}")
+        print(f"Over the speed range (-> {Path(a.out) / 'speed_screening.txt'}):\n{text}", end="")
     return 0
 
 

@@ -24,8 +24,9 @@ def args_sweep_speed(p: argparse.ArgumentParser) -> None:
                    help="input speeds in rpm, START:STOP:STEP or a list a,b,c (default: 500:7000:200)")
     p.add_argument("--harmonics", type=int, default=10, metavar="H", help="mesh harmonics 1..H (default: 10)")
     p.add_argument("--lumped", action="store_true", help="the lumped model of the variant's gearbox")
-    p.add_argument("--linearization", choices=("quadratic", "each"), default="quadratic",
-                   help="multibody model: linearise at three speeds and interpolate, or at each (default: quadratic)")
+    p.add_argument("--linearization", choices=("spin", "quadratic", "each"), default="spin",
+                   help="multibody model: linearise at two speeds and fit the spin terms (G ~ Omega, K ~ Omega^2), "
+                        "at three and interpolate, or at each speed (default: spin)")
     p.add_argument("--out", default="results", metavar="DIR",
                    help="results folder; the files go to OUT/<variant name>/sweep_speed[_lumped]/ "
                         "(default: %(default)s)")

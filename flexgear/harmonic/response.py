@@ -19,11 +19,13 @@ where the teeth lose contact (|F_dyn| comparable to F_0: the law's kink is not l
 
 Response at each speed of the grid and each harmonic h = 1..H, omega = 2 pi h f_mesh(speed):
 
-    (-omega^2 M + i omega (D + G) + K) X_h = F_h                    (direct dense complex solve)
+    (-omega^2 M + i omega (D + G) + K) X_h = F_h
 
-with M, D, G, K the linearised model at that speed (multibody: flexgear.modal.linear.linearize, interpolated in the
-speed between a few linearisations; lumped: flexgear.lumped.model.assemble). Outputs (complex amplitudes of
-x(t) = Re(X e^{i omega t}); ``amplitude`` = |X|, ``phase`` = arg X [rad], time origin at mesh phase 0):
+with M, D, G, K the linearised model at that speed (multibody: flexgear.modal.linear.linearize at two speeds and
+the exact spin dependence G ~ Omega, K ~ Omega^2 between them, solved on a truncated modal basis with its
+residual static part, flexgear.harmonic.reduced; lumped: flexgear.lumped.model.assemble, a dense solve).
+Outputs (complex amplitudes of x(t) = Re(X e^{i omega t}); ``amplitude`` = |X|, ``phase`` = arg X [rad], time
+origin at mesh phase 0):
 
 - ``outer_mesh_force_<i>_n``, ``inner_mesh_force_<i>_n`` [N]: each mesh's dynamic normal force, the sum over its
   contacts (helix halves) of F_dyn,h = (k_t + i omega c) x_delta,h + F_0 C_h (the direct stiffness-variation term
@@ -34,9 +36,9 @@ x(t) = Re(X e^{i omega t}); ``amplitude`` = |X|, ``phase`` = arg X [rad], time o
 - ``transmission_error_m`` [m]: dynamic transmission error at the output, TE = -r_b,out theta_out sign(omega_out)
   (flexgear.mbs.deflection.transmission_error: the input is prescribed, so its dynamic part is the output's);
   the output member's frame spin (a flexible output shaft's elastic twist to its load seat is left out);
-- ``dynamic_factor`` [-] (``harmonic`` 0, the sum over harmonics): K_v = 1 + max over meshes of
-  sum_h |F_dyn,h| / F_static, the peak of the dynamic over the static mesh load if all harmonics peaked together
-  (an upper bound of the time signal's max(F)/mean(F), ISO 6336-1's K_v read as a peak factor).
+- ``dynamic_factor`` [-] (``harmonic`` 0): K_v = max over meshes of max over a mesh cycle of
+  F(phi) / F_static, F(phi) = F_static + Re sum_h F_dyn,h e^{i h phi} (the steady waveform's peak: the time
+  signal's max(F)/mean(F), flexgear.study.indicators, ISO 6336-1's K_v read as a peak factor).
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ import numpy as np
 from flexgear.harmonic.base import (
     DEFAULT_HARMONICS,
     INDICATOR_UNITS,
+    RPM,
     Response,
     _excited,
     _mesh_name,
@@ -61,8 +64,10 @@ from flexgear.harmonic.base import (
     _sweep,
     mesh_frequency_hz,
 )
+from flexgear.harmonic.reduced import MODAL_CUTOFF_RATIO
 
-__all__ = ["Response", "harmonic_response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS"]
+__all__ = ["Response", "harmonic_response", "linearize_same_angle", "mesh_frequency_hz", "INDICATOR_UNITS",
+           "DEFAULT_HARMONICS", "LINEARIZATIONS"]
 
 
 def _lagrange(nodes: np.ndarray, x: float) -> np.ndarray:
@@ -75,20 +80,51 @@ def _lagrange(nodes: np.ndarray, x: float) -> np.ndarray:
     return w
 
 
-def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> tuple[np.ndarray, list[Any]]:
-    """(speeds [rpm] of the linearisations, the flexgear.modal.linear.LinearModel at each)."""
+LINEARIZATIONS = ("spin", "quadratic", "each")
+"""The ways :func:`harmonic_response` linearises a variant over the speed grid (its docstring)."""
+
+SPIN_FIT_FRACTION = 0.5
+"""The second speed of the ``"spin"`` fit as a fraction of the grid's highest (the first): any other speed fixes
+eq. 1 of flexgear.harmonic.reduced; one half keeps Omega_a^2 - Omega_b^2 large."""
+
+
+def linearize_same_angle(variant: Any, speed_rpm: float, reference_rpm: float) -> Any:
+    """flexgear.modal.linear.linearize at ``speed_rpm`` [rpm] with the gears at the angles and with the dynamic modes
+    of ``reference_rpm``: t* = T/2 + theta_ref / omega, theta_ref = omega_ref T / 2 (the STEP ramp over T: the
+    same angles at every speed, flexgear.modal.campbell), and the gears' dynamic cut-off ([reduction_assumed]
+    dynamic_cutoff_mesh_orders x f_mesh) at reference_rpm's mesh frequency, so that every speed has the same
+    coordinates (the time model's cut-off follows its own speed: above the reference speed's mesh orders it keeps
+    fewer dynamic modes than this linearisation)."""
     from flexgear.modal.linear import linearize
 
+    if not (speed_rpm > 0.0 and reference_rpm > 0.0):
+        raise ValueError(f"speeds must be > 0 rpm, got {speed_rpm}, {reference_rpm}")
+    spec = variant.gearbox
+    ratio = reference_rpm / speed_rpm
+    orders = spec.reduction_assumed.dynamic_cutoff_mesh_orders
+    spec = spec.with_fields("reduction_assumed", dynamic_cutoff_mesh_orders=orders * ratio)
+    t_star = 0.5 * spec.load_case.ramp_time_s * (1.0 + ratio)
+    return linearize(dataclasses.replace(variant, gearbox=spec), speed_rpm=float(speed_rpm), t_star=t_star)
+
+
+def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> tuple[np.ndarray, list[Any]]:
+    """(speeds [rpm] of the linearisations, the flexgear.modal.linear.LinearModel at each, on the first one's
+    coordinates unless ``each``)."""
+    from flexgear.modal.linear import linearize
+
+    if linearization not in LINEARIZATIONS:
+        raise ValueError(f"linearization: expected one of {', '.join(LINEARIZATIONS)}, got {linearization!r}")
     if linearization == "each":
         nodes = np.unique(speeds_rpm)
-    elif linearization == "quadratic":
-        lo, hi = float(speeds_rpm.min()), float(speeds_rpm.max())
-        nodes = np.unique([lo, 0.5 * (lo + hi), hi])
+        return nodes, [linearize(variant, speed_rpm=float(n)) for n in nodes]
+    lo, hi = float(speeds_rpm.min()), float(speeds_rpm.max())
+    if lo <= 0.0:
+        raise ValueError(f"linearization {linearization!r}: speeds > 0 rpm expected, got {lo:g}")
+    if linearization == "spin":
+        nodes = np.array([hi, SPIN_FIT_FRACTION * hi])
     else:
-        raise ValueError(f"linearization: expected 'quadratic' or 'each', got {linearization!r}")
-    models = [linearize(variant, speed_rpm=float(n)) for n in nodes]
-    if linearization == "each":
-        return nodes, models
+        nodes = np.unique([lo, 0.5 * (lo + hi), hi])
+    models = [linearize_same_angle(variant, float(n), hi) for n in nodes]
     return nodes, [models[0]] + [_in_coordinates(lm, models[0]) for lm in models[1:]]
 
 
@@ -122,7 +158,7 @@ def _frame_row(lm: Any, components: Sequence[str], name: str) -> int:
 
 
 def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS, *,
-                      linearization: str = "quadratic") -> Response:
+                      linearization: str = "spin", modal_cutoff_ratio: float | None = MODAL_CUTOFF_RATIO) -> Response:
     """Harmonic response (module docstring) of a variant at ``speeds_rpm`` [rpm], mesh harmonics 1..``harmonics``.
 
     ``model_or_variant``: a flexgear.spec.Variant or the path of its file (the multibody model, rigid or flexible,
@@ -130,11 +166,18 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
     matrices at its own speed for every speed of the grid: spin terms frozen); or a flexgear.spec.GearboxSpec (the
     lumped model: :func:`lumped_harmonic_response`).
 
-    ``linearization``: ``"quadratic"`` linearises at the grid's lowest, middle and highest speed and interpolates
-    M, D, G, K, the reduction basis and the static deflections quadratically in the speed (exact where they are
-    quadratic in Omega: gyroscopic terms ~ Omega, spin softening ~ Omega^2, a speed-independent operating point);
-    ``"each"`` linearises at every speed (about a second each for model 1, 6 s for model 7); needed where the
-    linearised models' sizes change with the speed (flexible variants whose reduction depends on it).
+    ``linearization``: ``"spin"`` (default) linearises at the grid's highest speed and at
+    :data:`SPIN_FIT_FRACTION` of it, both at the same gear angles and dynamic modes (:func:`linearize_same_angle`),
+    fits eq. 1 of flexgear.harmonic.reduced (M, D constant, G ~ Omega, K and the static deflections
+    ~ Omega^2: exact for these models) and solves every speed from it; ``"quadratic"`` linearises at the lowest,
+    middle and highest speed (same angles and modes) and interpolates every matrix by the parabola through them
+    (also exact for eq. 1, one linearisation more); ``"each"`` linearises at every speed as the time model is
+    built there (its own dynamic modes and the gear angles at the end of the ramp; about 1 s each for model 1,
+    3-10 s for model 7).
+
+    ``modal_cutoff_ratio``: with ``"spin"``, each harmonic is solved on the modes below this multiple of its
+    frequency plus the residual static part of the others (flexgear.harmonic.reduced.ModalSolver); None: the dense
+    solve of all coordinates.
     """
     from flexgear.modal.linear import LinearModel
     from flexgear.spec import GearboxSpec, load_variant
@@ -154,7 +197,11 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
         variant = model_or_variant if not isinstance(model_or_variant, str | Path) else load_variant(model_or_variant)
         variant = dataclasses.replace(variant, gearbox=_excited(variant.gearbox, harmonics))
         nodes, models = _linear_models(variant, speeds, linearization)
-    return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0)
+    spin = linearization == "spin" and len(models) == 2
+    from threadpoolctl import threadpool_limits
+
+    with threadpool_limits(limits=1, user_api="blas"):  # small matrices: one thread each is fastest on a shared machine
+        return _mbs_sweep(variant, nodes, models, speeds, harmonics, t0, spin, modal_cutoff_ratio)
 
 
 def _check_contacts(lm: Any, names: list[str]) -> None:
@@ -172,7 +219,7 @@ def _check_contacts(lm: Any, names: list[str]) -> None:
 
 
 def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.ndarray, harmonics: int,
-               t0: float) -> Response:
+               t0: float, spin: bool = False, modal_cutoff_ratio: float | None = None) -> Response:
     from flexgear.geometry.involute import gear_set_geometry
     from flexgear.laws.contact import normal_force
     from flexgear.mbs.gearbox import mesh_contacts
@@ -195,15 +242,23 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
     means = np.array([c.stiffness.mean for c in contacts])
 
     def selectors(lm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """Contact deflections, bearing-node translations and output spin per z; static deflections."""
+        """Contact deflections, bearing-node translations and output spin per z; static deflections. Where a
+        contact's law acts on delta - e (a flexible gear's residual compliance, LinearModel.contact_residuals),
+        the deflection is delta - e."""
         rows = [i for i, c in enumerate(lm.full_coordinates) if c.kind == "deflection"]
+        residual = getattr(lm, "contact_residuals", {})
+        law_rows = lm.basis[rows].copy()
+        delta0 = np.array([lm.static_deflections[nm] for nm in names])
+        for j, nm in enumerate(names):
+            if nm in residual:
+                law_rows[j] -= lm.basis[residual[nm]]
+                delta0[j] -= lm.static_residuals[nm]
         full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
         in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
         out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
         accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
         out_row = _frame_row(lm, out_comp, "phi_z")
-        delta0 = np.array([lm.static_deflections[nm] for nm in names])
-        return lm.basis[rows], lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
+        return law_rows, lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
 
     geo = gear_set_geometry(spec)
     th = theory(spec)
@@ -225,6 +280,10 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
             raise ValueError("a contact is unloaded at the operating point: no first-order excitation")
         return f0, kt, cc
 
+    if spin:
+        return _sweep(_spin_operating(models, nodes, selectors, law_terms, coef, mesh, mesh_names, spec,
+                                      modal_cutoff_ratio),
+                      speeds, harmonics, variant.name, mesh_frequency_hz(spec, 1.0), t0)
     parts = [(m.mass, m.damping + m.gyroscopic, m.stiffness, *selectors(m)) for m in models]
     cache: dict[tuple[float, ...], tuple] = {}
 
@@ -242,3 +301,36 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
         return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh)
 
     return _sweep(operating, speeds, harmonics, variant.name, mesh_frequency_hz(spec, 1.0), t0)
+
+
+def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_terms: Any, coef: np.ndarray,
+                    mesh: np.ndarray, mesh_names: tuple[str, ...], spec: Any,
+                    modal_cutoff_ratio: float | None) -> Any:
+    """The operating point at each speed from the spin fit (flexgear.harmonic.reduced eq. 1) of the two
+    linearisations ``models`` at ``nodes`` [rpm]; solved on the modal basis unless ``modal_cutoff_ratio`` is None."""
+    from flexgear.harmonic.reduced import ModalSolver, fit_spin
+
+    a, b = models
+    sel_a, sel_b = selectors(a), selectors(b)
+    for x, y in zip(sel_a[:3], sel_b[:3], strict=True):
+        if not np.allclose(x, y, rtol=1e-9, atol=1e-12 * max(np.abs(x).max(), 1e-300)):
+            raise ValueError("the two linearisations select different contact or output coordinates: use "
+                             "linearization='each'")
+    rows, acc, te, _ = sel_a
+
+    def terms(lm: Any, sel: tuple) -> dict[str, np.ndarray]:
+        return {"mass": lm.mass, "damping": lm.damping, "gyroscopic": lm.gyroscopic, "stiffness": lm.stiffness,
+                "delta": sel[3]}
+
+    fit = fit_spin(nodes[0] * RPM, nodes[1] * RPM, terms(a, sel_a), terms(b, sel_b))
+    modal = None if modal_cutoff_ratio is None else ModalSolver(fit, rows.T, modal_cutoff_ratio)
+
+    def operating(speed_rpm: float) -> _Operating:
+        w = speed_rpm * RPM
+        f0, kt, cc = law_terms(fit.static_deflections(w))
+        omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
+        solver = None if modal is None else (lambda om, c: modal.solve(w, om, c))
+        return _Operating(fit.mass, fit.damping + fit.gyroscopic(w), fit.stiffness(w), rows, kt, cc, f0, coef, mesh,
+                          mesh_names, acc, te, omega_mesh, solver)
+
+    return operating

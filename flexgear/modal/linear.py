@@ -95,6 +95,10 @@ class LinearModel:
     flexible: tuple[str, ...] = ()
     parts: dict[int, list[tuple[str, np.ndarray]]] = field(default_factory=dict)
     static_deflections: dict[str, float] = field(default_factory=dict)  # contact name -> delta_0 [m]
+    # contact name -> index in full_coordinates of its residual deflection e (flexgear.mbs.residual: the contact law
+    # acts on delta - e where a flexible gear's dropped modes return as residual compliance); absent: none
+    contact_residuals: dict[str, int] = field(default_factory=dict)
+    static_residuals: dict[str, float] = field(default_factory=dict)  # contact name -> e_0 [m] at the operating point
 
     @property
     def n(self) -> int:
@@ -260,7 +264,7 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
             mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Current)
             if pre is not None:
                 pre(mbs, t_star)
-            if not mbs.SolveStatic(ss, showHints=False):
+            if not _solve_static(mbs, ss):
                 raise RuntimeError(f"{variant.name}: no static equilibrium at t = {t_star:g} s")
             q0 = np.array(mbs.systemData.GetODE2Coordinates())
             if pre is None:
@@ -269,6 +273,27 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
         exu.config.printToConsole = was
     mbs.systemData.SetODE2Coordinates(q0, exu.ConfigurationType.Initial)
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
+
+
+RETRY_RELATIVE_TOLERANCE = 1e-10
+"""Newton's relative tolerance of a second static solve where the first (1e-12) stalls at round-off (a relative
+error of a few 1e-12 at some gear angles): a residual still 1e-10 of the load, far below any modal quantity."""
+
+
+def _solve_static(mbs, ss) -> bool:
+    """Exudyn's static solve with :func:`_settings`; once more at :data:`RETRY_RELATIVE_TOLERANCE` if Newton stalls
+    at round-off. The Newton state is reset to the same start for the second attempt."""
+    import exudyn as exu
+
+    start = np.array(mbs.systemData.GetODE2Coordinates())
+    try:
+        if mbs.SolveStatic(ss, showHints=False):
+            return True
+    except exu.SolverError:
+        pass
+    mbs.systemData.SetODE2Coordinates(start, exu.ConfigurationType.Current)
+    ss.staticSolver.newton.relativeTolerance = max(ss.staticSolver.newton.relativeTolerance, RETRY_RELATIVE_TOLERANCE)
+    return bool(mbs.SolveStatic(ss, showHints=False))
 
 
 def _settings(t_star: float):
@@ -325,6 +350,11 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
         rows = [mbs.GetNodeODE2Index(node) + k for node in model.aux_nodes
                 for k in range(len(mbs.GetNode(node)["referenceCoordinates"]))]  # contacts in order
         static = {contact.name: float(q[i]) for contact, i in zip(model.contacts, rows, strict=True)}
+        residuals: dict[str, int] = {}
+        if int(model.residual_node) >= 0 and model.residual is not None:  # the laws act on delta - e (residual.py)
+            first = mbs.GetNodeODE2Index(model.residual_node)
+            residuals = {model.contacts[int(r)].name: first + k for k, r in enumerate(model.residual.rows)}
+        static_residuals = {name: float(q[i]) for name, i in residuals.items()}
         parts = _mass_parts(built, model, mbs)
     finally:
         sc.Reset()
@@ -338,7 +368,8 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     flexible = tuple(_component_name(nm) for nm, b in model.bodies.items() if b.flexible)
     components = _components(spec.gears.planet_count)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
-                       basis, tuple(labels), m, k, components, flexible, parts, static)
+                       basis, tuple(labels), m, k, components, flexible, parts, static, residuals,
+                       static_residuals)
 
 
 def _components(planets: int) -> tuple[str, ...]:
