@@ -261,10 +261,11 @@ def _provenance_pages(d: ReportData) -> list[Page]:
 
 
 def build_report(results_dir: str | Path, output: str | Path = Path("reports/screening_report.pdf"),
-                 westgard_png: str | Path | None = None, also: tuple[str | Path, ...] = ()) -> Path:
+                 westgard_png: str | Path | None = None, also: tuple[str | Path, ...] = (), modal: bool = True) -> Path:
     """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF): page 1 the verdict,
     then the details, the assumptions in an appendix. ``westgard_png``: also the verdict's diagram as a PNG.
-    ``also``: results folders of other load cases or laws whose verdicts page 1 sets beside this one."""
+    ``also``: results folders of other load cases or laws whose verdicts page 1 sets beside this one. ``modal``: add
+    the modal pages (flexgear.report.modal_pages: modal tables, Campbell diagram, run-up maps, speed response)."""
     d = gather(results_dir)
     others = [gather(o) for o in also if Path(o).is_dir()]
     output = Path(output)
@@ -273,6 +274,10 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
     body: list[Page] = [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
     if rp.shown_runs(d):
         body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d)]
+    if modal:
+        from flexgear.report.modal_pages import modal_pages
+
+        body += modal_pages(d, others=others)
     body += rp.sweep_pages(d)
     body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
     body += [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
