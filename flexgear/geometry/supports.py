@@ -1,6 +1,6 @@
 """Where the gearbox is supported: bearing positions from the component layout and Table 2 stiffnesses.
 
-One home for the support assumptions both models use (``[supports_assumed]`` in gearbox.toml): the
+One home for the support assumptions both models use (every bearing at its seat): the
 multibody model puts its bushings, drive and load at these points (flexgear.mbs.elements), the lumped
 model condenses the same bushings to its gear-centre nodes (:func:`condensed_radial_stiffness`).
 

@@ -137,7 +137,7 @@ class LumpedParameters:
           the in-plane mass the apparent mass at the gear centre of the joined parts, see ``mi``;
           ring + output shaft for the star arrangement; for the planetary arrangement the output
           shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*)
-        - bearing stiffness: the Table 2 bearing at its place (``[supports_assumed]``, flexgear.geometry.supports)
+        - bearing stiffness: the Table 2 bearing at its seat (flexgear.geometry.supports)
           condensed to the gear centre, 1/k = 1/k_r + L^2/k_t (L: gear to bearing centre; the tilt statically
           condensed); damping c = k * damping_per_stiffness_s
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width

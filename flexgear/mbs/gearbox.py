@@ -64,7 +64,7 @@ class GearboxModel:
     residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
     residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
     # gears whose joints are flexgear.mbs.joints constraints (Force output: force, moment in ground axes, or in the
-    # gear's body axes for the gears in body_axes_joints: [joints_assumed] joint_axes)
+    # gear's body axes for the gears in body_axes_joints: those on a flexible shaft)
     linear_joints: tuple[str, ...] = ()
     body_axes_joints: tuple[str, ...] = ()
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
