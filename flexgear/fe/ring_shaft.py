@@ -79,15 +79,22 @@ def tied_pair(ring: FEModel, shaft: FEModel, spec: GearboxSpec, clamp_radius: fl
     return tie_parts([ring, shaft], [Tie(0, 1, slaves, (0.0, 0.0, z_j))], PAIR)
 
 
-def ring_seat(ring: FEModel, spec: GearboxSpec) -> Interface:
-    """The ring's side of the joint: the union of its clamped discs (node indices of ``ring``), each disc's nodes
-    weighted equally and each disc in all 1 / (number of bolts)."""
-    patches = clamped_patches(ring, spec)
+def _patch_union(fe: FEModel, spec: GearboxSpec, name: str) -> Interface:
+    """The clamped discs of ``fe`` (flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in
+    ascending order, each disc's nodes weighted equally and each disc in all 1 / (number of bolts), the point
+    their weighted centroid."""
+    patches = clamped_patches(fe, spec)
     nodes = np.concatenate(patches)
     weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
     order = np.argsort(nodes)
     nodes, weights = nodes[order], weights[order]
-    return Interface(RING_SEAT, nodes, weights, weights @ ring.nodes[nodes])
+    return Interface(name, nodes, weights, weights @ fe.nodes[nodes])
+
+
+def ring_seat(ring: FEModel, spec: GearboxSpec) -> Interface:
+    """The ring's side of the joint: the union of its clamped discs (node indices of ``ring``), each disc's nodes
+    weighted equally and each disc in all 1 / (number of bolts)."""
+    return _patch_union(ring, spec, RING_SEAT)
 
 
 def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> list[Interface]:
@@ -148,12 +155,7 @@ def bolt_patch_group(fe: FEModel, spec: GearboxSpec) -> Interface:
     flange-web plane z_j, to the mesh's asymmetry). Rigid (RBE2) in :func:`rigid_partner_body`: the weights only
     define the interface's RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid
     motion: the translation at the point and the rotation."""
-    patches = clamped_patches(fe, spec)
-    nodes = np.concatenate(patches)
-    weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
-    order = np.argsort(nodes)
-    nodes, weights = nodes[order], weights[order]
-    return Interface(BOLT_PATCHES, nodes, weights, weights @ fe.nodes[nodes])
+    return _patch_union(fe, spec, BOLT_PATCHES)
 
 
 def rigid_partner_interfaces(fe: FEModel, spec: GearboxSpec, component: str) -> list[Interface]:
