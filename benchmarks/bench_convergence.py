@@ -1,10 +1,9 @@
 """How close are the reduced bodies to full FE: for each component, how many attachment orders and fixed-interface
-modes does the contact compliance and the free-free spectrum need; and does the ring-output shaft joint of the
-reduced bodies give the first ten modes of ring + output shaft within 5 % of full FE?
+modes does the contact compliance and the free-free spectrum need? (The tied ring and output shaft against full
+FE: benchmarks/bench_tied.py.)
 
 Run: python benchmarks/bench_convergence.py [--level coarse] [--orders 0 2 4 8] [--modes 0 10 20 40]
                                             [--kernel-orders 4 8 16 32] [component ...]
-     python benchmarks/bench_convergence.py --ring-joint [--level coarse] [--clamp-diameter-mm D]
 
 Per component (sun, planet, ring; shafts: frequencies only), all on the same FE model, interface held
 as the gear's joint (RBE3, flexgear.fe.compliance):
@@ -20,21 +19,11 @@ as the gear's joint (RBE3, flexgear.fe.compliance):
   order K (the part above the kernel, local: tooth bending, foundation), for each K, against the tooth
   compliance of the ISO 6336 mesh stiffness 1 / (c_gamma b_half) ([lumped_assumed] of gearbox.toml)
   and the study's impact law linearised at the theoretical mean mesh force per half.
-
-``--ring-joint``: full FE of ring + output shaft (flexgear.fe.bolted: the web face tied to the flange face over
-each bolt's clamped disc, ``[joints_assumed] bolt_clamp_diameter_mm``, by multipoint constraints) against the two
-reduced bodies joined as the multibody model joins them (flexgear.fe.joined): "RBE3", one RBE3 interface over all
-12 bolt-hole walls of each body and one fixed joint at the bolt circle; "bolt patches (rigid)", per bolt a rigid
-patch (RBE2) over its clamped disc on each face, joined pairwise; "bolt patches (RBE3)", the same discs as RBE3
-patches. Printed per mode the full FE frequency, each joint's and its error [%], then each joint's largest error
-against the 5 % criterion. The full FE eigenproblem of the coarse level is the largest one here (time and memory
-printed by the run).
 """
 
 from __future__ import annotations
 
 import argparse
-import dataclasses
 import time
 
 import numpy as np
@@ -139,36 +128,6 @@ def study(spec, component: str, level: str, orders: list[int], modes: list[int],
     print(f"[{component} done in {time.perf_counter() - t0:.0f} s]", flush=True)
 
 
-def ring_joint(spec, level: str, clamp_diameter_mm: float | None) -> None:
-    """The ``--ring-joint`` comparison (module docstring)."""
-    import resource
-
-    from flexgear.fe.bolted import ring_output_shaft_fe_modes
-    from flexgear.fe.joined import ring_output_shaft_modes
-
-    if clamp_diameter_mm is not None:
-        spec = spec.with_changes(joints_assumed=dataclasses.replace(
-            spec.joints_assumed, bolt_clamp_diameter_mm=clamp_diameter_mm))
-    t0 = time.perf_counter()
-    full = ring_output_shaft_fe_modes(spec, level, N_JOINT_MODES)
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss * 1024 / 1e9  # ru_maxrss: KiB (Linux)
-    print(f"full FE ({level}, clamp discs {spec.joints_assumed.bolt_clamp_diameter_mm} mm): "
-          f"{time.perf_counter() - t0:.1f} s, peak RSS so far {peak:.1f} GB")
-    t0 = time.perf_counter()
-    freqs = {"bolt patches (rigid)": ring_output_shaft_modes(spec, level, N_JOINT_MODES, progress=True)}
-    print(f"reduced bodies joined per bolt: {time.perf_counter() - t0:.1f} s")
-    print(f"{'mode':>4} {'full FE Hz':>11}" + "".join(f" {label + ' Hz':>25} {'err %':>7}" for label in freqs))
-    for m in range(N_JOINT_MODES):
-        row = f"{m + 1:>4} {full[m]:>11.1f}"
-        for f in freqs.values():
-            row += f" {f[m]:>25.1f} {100 * (f[m] / full[m] - 1):>+7.2f}"
-        print(row)
-    for label, f in freqs.items():
-        worst = float(np.max(np.abs(f / full - 1)))
-        verdict = "meets" if worst <= CRITERION else "misses"
-        print(f"{label}: largest error {100 * worst:.2f} %, {verdict} the {100 * CRITERION:.0f} % criterion")
-
-
 def main() -> None:
     from pathlib import Path
 
@@ -181,14 +140,8 @@ def main() -> None:
     ap.add_argument("--modes", type=int, nargs="+", default=[0, 10, 20, 40])
     ap.add_argument("--kernel-orders", type=int, nargs="*", default=[4, 8, 16, 32])
     ap.add_argument("--gearbox", default=str(Path(__file__).resolve().parents[1] / "model_variants/gearbox.toml"))
-    ap.add_argument("--ring-joint", action="store_true", help="the joined ring + output shaft against full FE")
-    ap.add_argument("--clamp-diameter-mm", type=float, default=None,
-                    help="--ring-joint: override [joints_assumed] bolt_clamp_diameter_mm (both models)")
     args = ap.parse_args()
     spec = load_gearbox(args.gearbox)
-    if args.ring_joint:
-        ring_joint(spec, args.level, args.clamp_diameter_mm)
-        return
     for component in args.components:
         study(spec, component, args.level, sorted(args.orders), sorted(args.modes), args.kernel_orders)
 

@@ -1,10 +1,10 @@
 """Small stand-in flexible bodies for fast tests: plain annuli instead of the toothed gears.
 
 Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm. Coarse first-order
-meshes (a few hundred nodes, about a second each) with the bore (ring: outer surface) as the RBE3
-interface, named as the gearbox's joints expect (flexgear.fe.reduced.gear_shaft_joints: one rigid patch per
-bolt on the ring's and output shaft's interface surface, centred at the bolt's angle, as wide as its clamped
-disc).
+meshes (a few hundred nodes, about a second each) with the bore as the RBE3 interface "bore"; the ring's
+interface "bolt_patches" as the gearbox's joint expects (flexgear.fe.reduced.gear_shaft_joints): one patch per
+bolt on its outer surface, centred at the bolt's angle, as wide as its clamped disc, all patches one rigid
+interface. Flexible shafts (and so the tied ring and output shaft) have no stand-in.
 They exercise the flexible-gear machinery; the real components come from
 flexgear.fe.reduced.component_reduced_body.
 """
@@ -18,7 +18,9 @@ from flexgear.geometry.involute import gear_set_geometry
 
 @cache
 def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, material, modes: int,
-             names: tuple[str, ...], patch_half_width: float, rigid: bool):
+             name: str, bolts: int, patch_half_width: float):
+    """Reduced annulus with one interface ``name`` on its outer (``interface_outer``) or inner surface: the whole
+    surface (RBE3), or with ``bolts`` > 0 the union of one patch per bolt, rigid."""
     import ngsolve as ngs
     from netgen.occ import Cylinder, OCCGeometry, Pnt, Z
 
@@ -30,41 +32,31 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
     radius = r_out if interface_outer else r_in
     sel = np.flatnonzero(np.abs(r - radius) < 1e-6)
-    if len(names) == 1:
-        return reduce(fe, [interface(fe, sel, names[0])], 20, n_compare=0, keep_modes=modes or None)
+    if bolts == 0:
+        return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes or None)
     angle = np.arctan2(fe.nodes[sel, 1], fe.nodes[sel, 0])
-    itfs = []
-    nearest = np.round(angle / (2 * np.pi) * len(names)) % len(names)
-    for k, name in enumerate(names):  # bolt k at 2 pi k / n: its nearest nodes within the patch's half-width
-        off = np.angle(np.exp(1j * (angle - 2 * np.pi * k / len(names))))
-        itfs.append(interface(fe, sel[(nearest == k) & (np.abs(off) * radius <= patch_half_width)], name))
-    return reduce(fe, itfs, 20, n_compare=0, keep_modes=modes or None, rigid=names if rigid else ())
+    nearest = np.round(angle / (2 * np.pi) * bolts) % bolts
+    off = np.angle(np.exp(1j * (angle - 2 * np.pi * nearest / bolts)))  # from the nearest bolt's angle
+    patches = sel[np.abs(off) * radius <= patch_half_width]
+    return reduce(fe, [interface(fe, patches, name)], 20, n_compare=0, keep_modes=modes or None, rigid=(name,))
 
 
 def annulus_source(spec, component: str, level: str):
-    """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox."""
-    from flexgear.fe.reduced import gear_shaft_joints
+    """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox: sun, planet and ring."""
+    from flexgear.fe.reduced import BOLT_PATCHES
 
     geo = gear_set_geometry(spec)
-    side = {"sun": 0, "input_shaft": 1, "ring": 0, "output_shaft": 1}
-    pair = "sun" if component in ("sun", "input_shaft") else "ring"
-    name = tuple(j[side[component]] for j in gear_shaft_joints(spec, pair)) if component in side else ("bore",)
     half = spec.joints_assumed.bolt_clamp_diameter_mm * 0.5e-3
-    rigid = True  # rigid bolt patches, as flexgear.fe.reduced reduces them
     width = spec.gears_assumed.face_width_m + spec.gears_assumed.half_gap_m
     modes = 0  # the whole basis
     if component == "ring":
         return _annulus(geo.ring.reference_radius, geo.ring.root_radius + 0.008, width, True,
-                        spec.material_assumed, modes, name, half, rigid)
+                        spec.material_assumed, modes, BOLT_PATCHES, spec.components_assumed.ring_bolt_count, half)
     if component in ("sun", "planet"):
         gear = geo.sun if component == "sun" else geo.planet
         bore = getattr(spec.components_assumed, f"{component}_bore_diameter_mm") * 0.5e-3
-        return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes, name, half, rigid)
-    c = spec.components_assumed
-    outer = getattr(c, f"{component}_outer_diameter_mm") * 0.5e-3
-    inner = getattr(c, f"{component}_inner_diameter_mm") * 0.5e-3
-    length = getattr(c, f"{component}_length_mm") * 1e-3
-    return _annulus(inner, outer, length, False, spec.material_assumed, modes, name, half, rigid)
+        return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes, "bore", 0, half)
+    raise ValueError(f"annulus_source: no stand-in for {component!r} (sun, planet and ring have one)")
 
 
 STANDIN_ASYMMETRY_TOLERANCE = 3e-3

@@ -76,7 +76,7 @@ def test_gear_compliance_under_kernel_loads_equals_full_fe(component):
     spec, name, fe, body = component
     points, normals = component_contacts(spec, name)
     kernel = component_load_circles(spec, name, spec.reduction_assumed.contact_fourier_order)
-    held = gear_seat(spec, body, name)  # the bore
+    held = gear_seat(body, name)  # the bore
     full = fg.static_compliance(fe, points, normals, held, kernel=kernel)
     reduced = fg.static_compliance(body, points, normals, held, kernel=kernel)
     assert np.max(np.abs(reduced - full)) < 0.02 * np.max(np.abs(full))

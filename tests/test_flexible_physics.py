@@ -69,8 +69,8 @@ def test_flexible_sun_and_ring_change_the_inner_ripple(runs):
 
 def _measured_and_predicted(gb, result, gear: str, kind: str) -> tuple[np.ndarray, np.ndarray]:
     """Per mesh (5,), averaged over 13 times of the window: the load-induced deflection the run reports and
-    static_compliance (the gear held as the multibody model holds it: the sun at its bore, the ring at each of its
-    joints to the output shaft, the bolt circle or every bolt patch; the contact kernel's loads) times the mesh
+    static_compliance (the gear held as the multibody model holds it: the sun at its bore, the ring at its bolt
+    patches; the contact kernel's loads) times the mesh
     forces split equally over the helix halves."""
     from flexgear.fe.compliance import static_compliance
     from flexgear.fe.reduced import component_load_circles, component_reduced_body
@@ -91,7 +91,7 @@ def _measured_and_predicted(gb, result, gear: str, kind: str) -> tuple[np.ndarra
         rot = np.array([[np.cos(ang), np.sin(ang), 0.0], [-np.sin(ang), np.cos(ang), 0.0], [0.0, 0.0, 1.0]])
         points = np.array([rot @ np.asarray(c.point) for c in mine])
         normals = np.array([rot @ np.asarray(c.normal) for c in mine])
-        comp = static_compliance(red, points, normals, held_interfaces(gb, gear), kernel=circles)
+        comp = static_compliance(red, points, normals, held_interfaces(red, gear), kernel=circles)
         forces = np.repeat([s[f"{kind}_mesh_force_{i}_n"].iloc[row] for i in range(1, 6)], 2) / 2.0
         predicted.append((comp @ forces).reshape(5, 2).mean(1))
         measured.append([s[f"{kind}_deflection_load_{i}_m"].iloc[row] for i in range(1, 6)])

@@ -25,23 +25,26 @@ def _at(form, a: float) -> np.ndarray:
 
 
 def test_body_axes_form_is_the_rotated_rows():
-    """Modal rows (turning as R_z) become constant; an off-axis frame lever's rows equal Q^T times the ground rows
-    at every angle; rows that do not turn as R_z (a second harmonic in body axes) are refused."""
+    """Modal rows (turning as R_z) become constant; a frame lever on the axis gives rows equal to Q^T times the
+    ground rows at every angle; rows that do not turn as R_z (a second harmonic in body axes) are refused, and so
+    is a joint off the axis."""
     rng = np.random.default_rng(3)
     rows = rng.normal(size=(6, 7))
     const, cos_part, sin_part = body_axes_form(turning_form(rows))
     assert np.allclose(const, rows, rtol=0, atol=1e-14) and not cos_part.any() and not sin_part.any()
-    ground = frame_form(np.array([0.12, -0.05, 0.03]))  # a bolt off the axis: its lever turns
+    ground = frame_form(np.array([0.0, 0.0, 0.03]))  # a joint on the axis: constant in ground axes
     body = body_axes_form(ground)
     for a in rng.uniform(-np.pi, np.pi, 5):
         assert np.allclose(_at(body, a), _q_transposed(a) @ _at(ground, a), rtol=0, atol=1e-14)
-    # in body axes the lever is the bolt's own place p: the rows are [R^T, -p~ R^T] on the ground frame coordinates
+    # in body axes the rows are [R^T, -p~ R^T] on the ground frame coordinates
     a = 1.1
     r_t = _q_transposed(a)[:3, :3]
-    p_tilde = np.array([[0.0, -0.03, -0.05], [0.03, 0.0, -0.12], [0.05, 0.12, 0.0]])
+    p_tilde = np.array([[0.0, -0.03, 0.0], [0.03, 0.0, 0.0], [0.0, 0.0, 0.0]])
     assert np.allclose(_at(body, a)[:3], np.hstack([r_t, -p_tilde @ r_t]), rtol=0, atol=1e-14)
     with pytest.raises(ValueError, match="second harmonic"):
         body_axes_form((np.zeros((6, 6)), np.eye(6), np.zeros((6, 6))))
+    with pytest.raises(ValueError, match="off the spin axis"):
+        frame_form(np.array([0.12, -0.05, 0.03]))
 
 
 @pytest.mark.parametrize("case, body_axes", [("model3", ("sun", "ring")), ("model4", ())])

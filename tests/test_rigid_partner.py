@@ -1,8 +1,9 @@
-"""One of the bolted pair rigid (flexgear.fe.ring_shaft.rigid_partner_body): the flexible part's 12 clamped discs as
-one rigid interface of 6 coordinates, against the full FE model of that part with every clamped-disc node held by
-the rigid partner (here: held still, u = 0 on the discs), coarse meshes. Clamped modes (the partner held) and
-static compliance: the ring's at its contact bands under contact-kernel loads, the shaft's at its bearing seat
-under its six RBE3 loads. Each part's FE model, factorisation and eigenpairs take 30-60 s: heavy."""
+"""The ring's and the output shaft's reduced bodies (flexgear.fe.reduced: the form the multibody model joins to a
+rigid partner): the part's 12 clamped discs as one rigid interface of 6 coordinates, against the full FE model of
+that part with every clamped-disc node held by the rigid partner (here: held still, u = 0 on the discs), coarse
+meshes. Clamped modes (the partner held) and static compliance: the ring's at its contact bands under
+contact-kernel loads, the shaft's at its bearing seat under its six RBE3 loads. Each part's FE model,
+factorisation and eigenpairs take 30-60 s: heavy."""
 
 import numpy as np
 import pytest
@@ -58,11 +59,12 @@ def held_frequencies(body, name: str, k: int) -> np.ndarray:
 @pytest.fixture(scope="module", params=["ring", "output_shaft"])
 def part(gearbox, request):
     """(name, FE model, reduced body with one rigid bolt-patch interface, the full model clamped on the discs)."""
-    from flexgear.fe.ring_shaft import part_fe_model, rigid_partner_body
+    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.fe.ring_shaft import part_fe_model
 
     name = request.param
     fe = part_fe_model(gearbox, name, "coarse")
-    body = rigid_partner_body(gearbox, name, "coarse")
+    body = component_reduced_body(gearbox, name, "coarse")
     assert np.array_equal(body.nodes, fe.nodes)
     return name, fe, body, Clamped(fe, body.interface("bolt_patches").nodes)
 

@@ -153,14 +153,14 @@ def test_seat_bearing_matrix_is_the_three_springs(gearbox):
 
 def test_turning_blocks_kernel_equals_the_rotation():
     """The compiled kernel that turns the linear joints' and seats' coefficients writes, at each column's own
-    spin a, blockdiag(R_z(a), R_z(a)) rows for modal columns and [I, -(R_z(a) p)~; 0, I] for the frame columns of
-    a point p off the axis (a bolt), each into its constraint's matrix; numpy reference TurningBlocks.turned."""
+    spin a, blockdiag(R_z(a), R_z(a)) rows for modal columns and the constant [I, -p~; 0, I] for the frame
+    columns of a point p on the axis, each into its constraint's matrix; numpy reference TurningBlocks.turned."""
     from flexgear.laws.ramps import drive_angle
     from flexgear.mbs.joints import TurningBlocks, frame_form, turning_form
 
     rng = np.random.default_rng(5)
     rows = rng.normal(size=(6, 3))
-    point = np.array([0.21, -0.07, 0.03])
+    point = np.array([0.0, 0.0, 0.03])
     joint = (1, "scalingMarker0", *(np.hstack([f, m]) for f, m in zip(frame_form(point), turning_form(rows),
                                                                        strict=True)), 1.0)
     seat = (2, "scalingMarker1", *turning_form(rows[:, :2]), -0.3)
@@ -192,10 +192,10 @@ def test_turning_blocks_kernel_equals_the_rotation():
 
 
 def test_interface_coordinates_are_an_exact_change_of_coordinates(gearbox):
-    """The output shaft's basis with its ring joint and bearing seat as coordinates (flexgear.mbs.flexible.
-    interface_basis): the first twelve coordinates are the two interfaces' RBE3 motions (P T = [I, 0]), the mass
-    matrix is blockdiag((P P^T)^-1, I) exactly, and the free frequencies in the new coordinates are the modal
-    ones (generalised eigenvalues of T^T Lambda T, T^T T) within 1e-9."""
+    """The output shaft's basis with its ring joint (bolt patches) and bearing seat as coordinates
+    (flexgear.mbs.flexible.interface_basis): the first twelve coordinates are the two interfaces' RBE3 motions
+    (P T = [I, 0]), the mass matrix is blockdiag((P P^T)^-1, I) exactly, and the free frequencies in the new
+    coordinates are the modal ones (generalised eigenvalues of T^T Lambda T, T^T T) within 1e-9."""
     import scipy.linalg
 
     from flexgear.fe.reduced import gear_shaft_joints
@@ -215,8 +215,10 @@ def test_interface_coordinates_are_an_exact_change_of_coordinates(gearbox):
 
 
 def test_interface_coordinates_shrink_model7s_constraints(gearbox):
-    """Model 7 on interface coordinates: the ring joint's constraint spans six modal columns per body, the ring's
-    mesh constraints its sensed coordinates only (its contact tables vanish on every other coordinate)."""
+    """Model 7 on interface coordinates: the ring and the output shaft are one body (no joint between them), the
+    ring's mesh constraints span its sensed coordinates only (its contact tables vanish on every other coordinate);
+    model 4 (flexible ring, rigid output shaft): the ring joint's constraint spans the ring's frame and the six
+    coordinates of its bolt patches, and the shaft's frame."""
     import exudyn as exu
 
     from flexgear.mbs.gearbox import build_star_gearbox
@@ -225,8 +227,11 @@ def test_interface_coordinates_shrink_model7s_constraints(gearbox):
     spec = v.gearbox
     mbs = exu.SystemContainer().AddSystem()
     model = build_star_gearbox(mbs, v)
-    joint = mbs.GetObject(mbs.GetObjectNumber("joint_ring_output_shaft"))
-    assert np.shape(joint["scalingMarker0"]) == (6, 12) and np.shape(joint["scalingMarker1"]) == (6, 12)
+    assert "output_shaft" not in model.bodies and "ring" not in model.joints
+    mbs4 = exu.SystemContainer().AddSystem()
+    build_star_gearbox(mbs4, fg.load_variant(VARIANTS / "model4.toml"))
+    joint = mbs4.GetObject(mbs4.GetObjectNumber("joint_ring_output_shaft"))
+    assert np.shape(joint["scalingMarker0"]) == (6, 12) and np.shape(joint["scalingMarker1"]) == (6, 6)
     # the ring's contacts sense one node: at most 2 x (2 x 8 + 1) coordinates (two helix halves, Fourier order 8)
     ring = model.bodies["ring"]
     sensed = ring.node_columns(ring.contact_nodes)

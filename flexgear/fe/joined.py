@@ -27,10 +27,8 @@ import numpy as np
 import scipy.linalg as la
 
 from flexgear.fe.cms import ReducedBody
-from flexgear.fe.reduced import component_reduced_body, gear_shaft_joints
-from flexgear.spec import GearboxSpec
 
-__all__ = ["body_matrices", "joint_rows", "joined_free_modes", "ring_output_shaft_modes"]
+__all__ = ["body_matrices", "joint_rows", "joined_free_modes"]
 
 
 def _skew(v: np.ndarray) -> np.ndarray:
@@ -91,11 +89,3 @@ def joined_free_modes(bodies: list[ReducedBody], joints: list[tuple[int, str, in
     if lam[6] < 1e-8 * lam[-1] or np.any(np.abs(lam[:6]) > 1e-6 * lam[6]):
         raise RuntimeError(f"joined assembly: expected six rigid-body modes, eigenvalues start {lam[:8]}")
     return np.sqrt(np.maximum(lam[6:6 + k], 0.0)) / (2 * math.pi)
-
-
-def ring_output_shaft_modes(spec: GearboxSpec, level: str = "coarse", k: int = 10,
-                            progress: bool = False) -> np.ndarray:
-    """Lowest ``k`` elastic free-free frequencies [Hz] of the reduced ring and output shaft (flexgear.fe.reduced,
-    cached) joined per bolt as the multibody model joins them."""
-    bodies = [component_reduced_body(spec, name, level, progress) for name in ("ring", "output_shaft")]
-    return joined_free_modes(bodies, [(0, a, 1, b, p) for a, b, p in gear_shaft_joints(spec, "ring")], k)

@@ -2,12 +2,14 @@
 
 Interfaces (where a component is connected):
 - sun, planet: the bore (shaft-sun joint, planet bearing seat);
-- ring: its side of the ring-output shaft joint (section 2.1: 12 bolts): "bolt_<k>", per bolt its clamped
-  disc on the flange face, a rigid patch (flexgear.fe.bolted);
+- ring: its side of the ring-output shaft joint (section 2.1: 12 bolts): "bolt_patches", the clamped discs of
+  all bolts on the flange face (flexgear.fe.bolted) moving together as one rigid body (RBE2): the joint to a
+  rigid output shaft, which holds every disc in one rigid motion;
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
-- output shaft: the same joint interfaces on its web, and "bearing_seat" (``bearing_seat_width_mm``
-  at the far end of the tube).
-Seat and joint interfaces are RBE3 (distributing) averages, the bolt patches rigid (RBE2).
+- output shaft: "bolt_patches" on its web likewise (the joint to a rigid ring), and "bearing_seat"
+  (``bearing_seat_width_mm`` at the far end of the tube).
+When both are flexible they are one body, reduced together (flexgear.fe.ring_shaft).
+Seat and joint interfaces are RBE3 (distributing) averages, the bolt patches' union rigid (RBE2).
 Load circles (attachment modes, flexgear.fe.attachment): each gear's contact bands, one per mesh and
 helix half, at the mesh's operating pitch radius (sun: the sun-planet mesh; planet: both meshes; ring:
 the planet-ring mesh), over the half's face width, loaded along the tooth normal in the gear's local
@@ -29,7 +31,7 @@ import numpy as np
 
 from flexgear.cache import atomic_write_bytes, cache_dir, load_or_build, read_entry
 from flexgear.fe.attachment import LoadCircle
-from flexgear.fe.bolted import bolt_axes, clamped_patches
+from flexgear.fe.bolted import clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.geometry.involute import gear_set_geometry, helix_halves, tooth_normal_local
 from flexgear.geometry.layout import component_layout, geometry_hash
@@ -39,14 +41,20 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
            "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
-           "gear_shaft_joints", "gear_seat"]
+           "gear_shaft_joints", "gear_seat", "patch_union", "BOLT_PATCHES", "RING_SEAT"]
+
+BOLT_PATCHES = "bolt_patches"
+"""Name of the ring's and the output shaft's rigid interface over the clamped discs of all bolts."""
+RING_SEAT = "ring_seat"
+"""Name of the measuring interface of the tied ring and output shaft on the ring's side of the joint
+(flexgear.fe.ring_shaft): the seat the ring's deflections are measured from."""
 
 """Variant component name -> geometry component name."""
 
 _REDUCTION_VERSION = 4  # 4: attachment modes on the contact bands, whole compressed basis kept
 _TOL = 1e-6  # m: nodes on an exact cylinder/plane of the OCC geometry
 _INTERFACE_KIND = "rbe3"  # seat and joint interfaces: distributing averages (flexgear.fe.cms.reduce kind)
-_BOLT_PATCH_KIND = "rbe2"  # bolt patches: rigid clamped discs
+_BOLT_PATCH_KIND = "rbe2"  # the bolt patches' union: the clamped discs moving as one rigid body
 _WHOLE_BASIS = 0  # cache-key term: the whole compressed basis is kept (no truncation)
 
 
@@ -59,7 +67,7 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
     if component == "ring":
-        return _ring_joint_interfaces(fe, spec, component)
+        return [patch_union(fe, spec, BOLT_PATCHES)]
     tube = [p for p in component_layout(spec, component).prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
@@ -69,15 +77,23 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
         joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
-        joints = _ring_joint_interfaces(fe, spec, component)
+        joints = [patch_union(fe, spec, BOLT_PATCHES)]
         far = (z > tube.z1 - seat - _TOL)
     return [*joints, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
-def _ring_joint_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
-    """The ring's or the output shaft's side of their joint: one interface "bolt_<k>" per bolt over its clamped
-    disc on the mating face (flexgear.fe.bolted.clamped_patches)."""
-    return [interface(fe, nodes, f"bolt_{k}") for k, nodes in enumerate(clamped_patches(fe, spec))]
+def patch_union(fe, spec: GearboxSpec, name: str) -> Interface:
+    """The clamped discs of ``fe`` (the ring's flange face or the output shaft's web face,
+    flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in ascending order, each disc's
+    nodes weighted equally and each disc in all 1 / (number of bolts), the point their weighted centroid (on the
+    axis in the flange-web plane, to the mesh's asymmetry). Rigid (RBE2) as a reduction interface: the weights
+    only define its RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid motion."""
+    patches = clamped_patches(fe, spec)
+    nodes = np.concatenate(patches)
+    weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
+    order = np.argsort(nodes)
+    nodes, weights = nodes[order], weights[order]
+    return Interface(name, nodes, weights, weights @ fe.nodes[nodes])
 
 
 def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
@@ -148,31 +164,29 @@ def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
 
 
 def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.ndarray]]:
-    """The fixed joints of ``gear`` ("sun" or "ring") and its shaft: (gear interface, shaft interface, point [m]).
+    """The fixed joint of ``gear`` ("sun" or "ring") and its shaft: [(gear interface, shaft interface, point [m])].
 
-    Sun-input shaft: one joint at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat".
-    Ring-output shaft: per bolt one between the "bolt_<k>" patches, on the bolt's axis in the flange-web plane.
+    Sun-input shaft: at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat". Ring-output
+    shaft (one of them rigid; both flexible they are one body, flexgear.fe.ring_shaft): at :func:`joint_point`
+    between the two "bolt_patches" interfaces (every clamped disc in the rigid part's motion).
     """
     if gear == "ring":
-        centres, _, z_j = bolt_axes(spec)
-        return [(f"bolt_{k}", f"bolt_{k}", np.array([x, y, z_j])) for k, (x, y) in enumerate(centres)]
+        return [(BOLT_PATCHES, BOLT_PATCHES, joint_point(spec, gear))]
     if gear == "sun":
         return [("bore", "sun_seat", joint_point(spec, gear))]
     raise ValueError(f"gear_shaft_joints: gear must be 'sun' or 'ring', got {gear!r}")
 
 
-def gear_seat(spec: GearboxSpec, body: ReducedBody, gear: str) -> Interface:
-    """The interface of a gear's reduced body that its deflections are measured from (and held at).
+def gear_seat(body: ReducedBody, gear: str) -> Interface:
+    """The interface of a gear's reduced body that its deflections are measured from.
 
-    Sun, planet: the bore. Ring: its side of the joint to the output shaft (:func:`gear_shaft_joints`), as one
-    RBE3 interface "seat" over the union of its 12 bolt patches' nodes, each patch weighted equally.
+    Sun, planet: the bore. Ring: its side of the joint to the output shaft: "bolt_patches", or on the tied ring
+    and output shaft (flexgear.fe.ring_shaft) the measuring interface "ring_seat" over the same discs.
     """
     if gear != "ring":
         return body.interface("bore")
-    parts = [body.interface(a) for a, _, _ in gear_shaft_joints(spec, "ring")]
-    nodes = np.concatenate([i.nodes for i in parts])
-    weights = np.concatenate([i.weights for i in parts]) / len(parts)
-    return Interface("seat", nodes, weights, weights @ body.nodes[nodes])
+    names = {i.name for i in body.interfaces}
+    return body.interface(RING_SEAT if RING_SEAT in names else BOLT_PATCHES)
 
 
 def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",
@@ -230,8 +244,8 @@ def _component_reduction(spec: GearboxSpec, component: str, level: str,
     red = spec.reduction_assumed
     circles = component_load_circles(spec, name, red.attachment_order)
     patches = name in ("ring", "output_shaft")
-    # the bolt patches' kind and clamped disc enter the key of the bodies that have them
-    extra = [("bolt_patches", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
+    # the bolt patches' union, its kind and clamped disc enter the key of the bodies that have it
+    extra = [(BOLT_PATCHES, "union", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
     key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, _INTERFACE_KIND, _WHOLE_BASIS,
                         [c.key() for c in circles], _REDUCTION_VERSION, *extra)
 
@@ -248,7 +262,7 @@ def _component_reduction(spec: GearboxSpec, component: str, level: str,
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         itfs = component_interfaces(fe, spec, name)
         return reduce(fe, itfs, red.fixed_interface_modes, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
-                      rigid=tuple(i.name for i in itfs if i.name.startswith("bolt_")))
+                      rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES))
 
     return f"{name}-{level}-{key}", build
 

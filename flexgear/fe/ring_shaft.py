@@ -14,12 +14,12 @@ pair than two bodies joined per bolt (flexgear.fe.reduced, flexgear.fe.bolted):
   clamped discs, each disc weighted equally (as flexgear.fe.reduced.gear_seat takes it for the ring alone), the
   seat the ring's deflections are measured from. Its mass properties are those of the tied FE model, exactly
   the sum of the ring's and the shaft's (flexgear.fe.tied): a rigid twin of the pair has the same.
-- **One of the pair rigid** (:func:`rigid_partner_body`): every clamped disc moves with the one rigid part, so the
-  flexible part's 12 bolt patches are one rigid multi-point interface "bolt_patches" (6 coordinates, its nodes
-  the union of the discs moving as one rigid body, RBE2) at their centroid, on the axis in the flange-web plane;
-  the shaft keeps its bearing seat, the ring its contact bands. One fixed joint to the rigid part replaces 12.
+- **One of the pair rigid**: every clamped disc moves with the one rigid part, so the flexible part is reduced
+  with one rigid multi-point interface "bolt_patches" over all discs (flexgear.fe.reduced.patch_union: 6
+  coordinates, not 72), its own body of flexgear.fe.reduced; one fixed joint to the rigid part replaces 12.
 
-Both are cached by a hash of every input (flexgear.fe.reduced.cached_reduced_body).
+The tied body is cached by a hash of every input (flexgear.fe.reduced.cached_reduced_body); :func:`reduced_body`
+gives it under the name :data:`TIED_PAIR`, any other component's body by its name.
 """
 
 from __future__ import annotations
@@ -33,23 +33,28 @@ import numpy as np
 from flexgear.fe.bolted import bolt_axes, clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody
 from flexgear.fe.fem import FEModel
-from flexgear.fe.reduced import _read_cached, cached_reduced_body, component_interfaces, component_load_circles
+from flexgear.fe.reduced import (
+    RING_SEAT,
+    _read_cached,
+    cached_reduced_body,
+    component_interfaces,
+    component_load_circles,
+    component_reduced_body,
+    patch_union,
+)
 from flexgear.fe.tied import Tie, TiedFE, reduce, tie_parts
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
 from flexgear.spec import GearboxSpec
 
-__all__ = ["PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
-           "tied_pair_body", "tied_pair_mass_properties", "bolt_patch_group", "rigid_partner_interfaces",
-           "rigid_partner_body"]
+__all__ = ["PAIR", "TIED_PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
+           "tied_pair_body", "tied_pair_mass_properties", "reduced_body"]
 
 PAIR = ("ring", "output_shaft")
 """The bolted pair's parts, in the order of the tied model (the ring first: its nodes keep their indices)."""
-RING_SEAT = "ring_seat"
-"""Name of the tied body's measuring interface on the ring's side of the joint."""
-BOLT_PATCHES = "bolt_patches"
-"""Name of the one rigid multi-point interface of :func:`rigid_partner_body`."""
+TIED_PAIR = "+".join(PAIR)
+"""Name of the tied ring and output shaft as a reduced body source (:func:`reduced_body`)."""
 _TIED_VERSION = 1
 """Bump when the tied reduction changes without an input changing (enters the cache keys)."""
 
@@ -79,22 +84,10 @@ def tied_pair(ring: FEModel, shaft: FEModel, spec: GearboxSpec, clamp_radius: fl
     return tie_parts([ring, shaft], [Tie(0, 1, slaves, (0.0, 0.0, z_j))], PAIR)
 
 
-def _patch_union(fe: FEModel, spec: GearboxSpec, name: str) -> Interface:
-    """The clamped discs of ``fe`` (flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in
-    ascending order, each disc's nodes weighted equally and each disc in all 1 / (number of bolts), the point
-    their weighted centroid."""
-    patches = clamped_patches(fe, spec)
-    nodes = np.concatenate(patches)
-    weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
-    order = np.argsort(nodes)
-    nodes, weights = nodes[order], weights[order]
-    return Interface(name, nodes, weights, weights @ fe.nodes[nodes])
-
-
 def ring_seat(ring: FEModel, spec: GearboxSpec) -> Interface:
     """The ring's side of the joint: the union of its clamped discs (node indices of ``ring``), each disc's nodes
     weighted equally and each disc in all 1 / (number of bolts)."""
-    return _patch_union(ring, spec, RING_SEAT)
+    return patch_union(ring, spec, RING_SEAT)
 
 
 def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> list[Interface]:
@@ -149,48 +142,9 @@ def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress
     return props if props is not None else tied_pair_body(spec, level, progress).props
 
 
-def bolt_patch_group(fe: FEModel, spec: GearboxSpec) -> Interface:
-    """The clamped discs of ``fe`` (ring or output shaft, flexgear.fe.bolted.clamped_patches) as one interface
-    "bolt_patches": their nodes, each disc weighted equally, the point their weighted centroid (on the axis in the
-    flange-web plane z_j, to the mesh's asymmetry). Rigid (RBE2) in :func:`rigid_partner_body`: the weights only
-    define the interface's RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid
-    motion: the translation at the point and the rotation."""
-    return _patch_union(fe, spec, BOLT_PATCHES)
-
-
-def rigid_partner_interfaces(fe: FEModel, spec: GearboxSpec, component: str) -> list[Interface]:
-    """Interfaces of ``component`` (ring or output_shaft) joined to a rigid partner: "bolt_patches" (rigid) and,
-    for the shaft, its bearing seat (flexgear.fe.reduced)."""
-    itfs = [bolt_patch_group(fe, spec)]
-    if component == "output_shaft":
-        itfs += [i for i in component_interfaces(fe, spec, component) if i.name == "bearing_seat"]
-    return itfs
-
-
-def _rigid_partner_key(spec: GearboxSpec, component: str, level: str) -> str:
-    red = spec.reduction_assumed
-    circles = component_load_circles(spec, component, red.attachment_order)
-    key = geometry_hash(spec, "rigid_partner", component, spec.meshing_assumed[level], red.fixed_interface_modes,
-                        [c.key() for c in circles], spec.joints_assumed.bolt_clamp_diameter_mm, _TIED_VERSION)
-    return f"{component}-rigid_partner-{level}-{key}"
-
-
-def rigid_partner_body(spec: GearboxSpec, component: str, level: str = "coarse",
-                       progress: bool = False) -> ReducedBody:
-    """The reduced body of ``component`` ("ring" or "output_shaft") whose bolted partner is rigid: the 12 clamped
-    discs one rigid interface "bolt_patches" (:func:`bolt_patch_group`), the shaft's bearing seat, the ring's
-    contact bands as attachment modes; the reduction settings of every component body. Cached."""
-    if component not in PAIR:
-        raise ValueError(f"rigid_partner_body: component must be one of {PAIR}, got {component!r}")
-
-    def build() -> ReducedBody:
-        if progress:
-            say(f"  {component} ({level}): building the reduced body with one rigid bolt-patch interface")
-        fe = part_fe_model(spec, component, level, progress)
-        itfs = rigid_partner_interfaces(fe, spec, component)
-        red = spec.reduction_assumed
-        return reduce(fe, itfs, red.fixed_interface_modes, n_compare=0,
-                      load_circles=component_load_circles(spec, component, red.attachment_order),
-                      rigid=(BOLT_PATCHES,))
-
-    return cached_reduced_body(_rigid_partner_key(spec, component, level), build)
+def reduced_body(spec: GearboxSpec, component: str, level: str = "coarse", progress: bool = False) -> ReducedBody:
+    """The reduced body of ``component`` (flexgear.fe.reduced.component_reduced_body), or of the tied ring and
+    output shaft for :data:`TIED_PAIR` (:func:`tied_pair_body`); cached."""
+    if component == TIED_PAIR:
+        return tied_pair_body(spec, level, progress)
+    return component_reduced_body(spec, component, level, progress)

@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from flexgear.fe.reduced import gear_seat, gear_shaft_joints
+from flexgear.fe.reduced import BOLT_PATCHES, RING_SEAT, gear_seat
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import frame_rows, normal_lever
@@ -77,9 +77,14 @@ def centrifugal_response(reduced, held: list[str]) -> np.ndarray:
     return np.linalg.solve(a, rhs)[:m]
 
 
-def held_interfaces(spec, geometry: str) -> list[str]:
-    """Interfaces of a gear held in its centrifugal response: the ring's joints to the output shaft, else the bore."""
-    return [a for a, _, _ in gear_shaft_joints(spec, "ring")] if geometry == "ring" else ["bore"]
+def held_interfaces(reduced, geometry: str) -> list[str]:
+    """Interfaces of a gear's reduced body held in its centrifugal response: where the multibody model holds it.
+    The bore; the ring at its bolt patches, or, tied to the output shaft (flexgear.fe.ring_shaft), at the
+    shaft's bearing seat."""
+    if geometry != "ring":
+        return ["bore"]
+    names = {i.name for i in reduced.interfaces}
+    return ["bearing_seat"] if RING_SEAT in names else [BOLT_PATCHES]
 
 
 def _body_geometry(name: str) -> str:
@@ -117,11 +122,11 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
             red = body.reduced
             if body_name not in offsets:
                 geometry = _body_geometry(body_name)
-                joints = held_interfaces(model.spec, geometry)
+                joints = held_interfaces(red, geometry)
                 dropped = getattr(body, "dropped", None)  # truncated: the whole basis' answer (flexgear.mbs.residual)
                 q_c_unit = (dropped.centrifugal_held[:red.n_modes] if dropped is not None else
                             centrifugal_response(red, joints))
-                seat = gear_seat(model.spec, red, geometry)
+                seat = gear_seat(red, geometry)
                 # in the body's coordinates q~, as the contact tables and the recorded coordinates
                 offsets[body_name] = (body.to_coordinates(red.interface_motion(seat)), seat.point,
                                       body.coordinates_of(q_c_unit))

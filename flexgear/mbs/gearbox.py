@@ -19,6 +19,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexgear.fe.ring_shaft import TIED_PAIR
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
@@ -118,9 +119,9 @@ def _exact_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
 
 
 def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
-    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.fe.ring_shaft import reduced_body
 
-    return component_reduced_body(spec, component, level, progress=True)
+    return reduced_body(spec, component, level, progress=True)
 
 
 def _default_mass_source(spec: GearboxSpec, component: str, level: str) -> MassProperties:
@@ -146,9 +147,8 @@ GEARS = ("sun", "planet", "ring")
 def dynamic_modes(geometry: str, frequencies_hz: np.ndarray, cutoff_hz: float) -> int:
     """How many of a component's modes (free-free ``frequencies_hz``, ascending) the time integration keeps: a gear
     its modes below ``cutoff_hz`` (> 0; the rest return as residual compliance, flexgear.mbs.residual), at least
-    one (the floating-frame object needs one); a shaft, and the ring, every mode (the ring's twelve bolt-patch
-    joints need the patches' static modes: on the modes below the cut-off they are redundant and the solver
-    fails)."""
+    one (the floating-frame object needs one); a shaft, and the ring, every mode (the ring carries no residual:
+    tied to the output shaft its deflections are measured from a seat that is not its support)."""
     n = len(frequencies_hz)
     if cutoff_hz <= 0 or geometry not in GEARS or geometry == "ring":
         return n
@@ -188,12 +188,12 @@ def _seat_loads_carried(body: Body) -> bool:
     return getattr(body, "dropped", None) is not None
 
 
-def _is_gear_seat(spec: GearboxSpec, body: Body, interface: str) -> bool:
+def _is_gear_seat(body: Body, interface: str) -> bool:
     """Whether ``interface`` of ``body`` is the seat its residual is measured from (flexgear.fe.reduced.gear_seat:
-    the bore; the ring's union of its bolt patches)."""
+    the bore; the ring's bolt patches)."""
     from flexgear.fe.reduced import gear_seat
 
-    seat, joint = gear_seat(spec, body.reduced, body.name), body.reduced.interface(interface)
+    seat, joint = gear_seat(body.reduced, body.name), body.reduced.interface(interface)
     return np.array_equal(seat.nodes, joint.nodes) and np.allclose(seat.weights, joint.weights, rtol=1e-12, atol=0.0)
 
 
@@ -208,7 +208,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
                    cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
-                   superelement: bool = True, contacts: list[GearContact] = ()) -> Body:
+                   superelement: bool = True, contacts: list[GearContact] = (), source: str | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
@@ -218,7 +218,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     the bodies of one build (the five planets compute them once); ``spin_rad_s``: the nominal spin about the
     body's z axis [rad/s] (the linear floating frame's spin terms, flexgear.mbs.spin); ``superelement``: whether a
     flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible);
-    ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node.
+    ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node;
+    ``source``: the reduced body to load when it is not ``geometry``'s own (the tied ring and output shaft).
     """
     frame_tol = _linear_frame_tolerance(spec)
     reference = spec.solver_assumed.reference
@@ -235,7 +236,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if not reference:
         coordinates = list(joints or {}) + ([support.interface] if support is not None else [])
         joints = {}
-    full = reduced(spec, geometry, level)
+    full = reduced(spec, source or geometry, level)
     keep = dynamic_modes(geometry, full.frequencies_hz, cutoff_hz)
     kept = full.truncated(keep) if keep < full.n_modes else full
     sensing = None
@@ -267,11 +268,13 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
     ring-output shaft) that are both rigid are one rigid body (the fixed joint of section 2.1 is then
-    exact); otherwise they are two bodies joined by fixed joints at their interfaces
-    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring per bolt): a flexible body through its
-    interface node set's RBE3 (or rigid patch) motion, a rigid one at the joint's point. The input bearing and the
-    drive act on the input shaft, the output bearing and the load on the output shaft (on the merged
-    body when shaft and gear are one), at the shafts' bearing seats and the planets' bores
+    exact); a flexible ring and output shaft are one flexible body, reduced together (flexgear.fe.ring_shaft, no
+    joint between them); otherwise they are two bodies joined by a fixed joint at their interfaces
+    (flexgear.fe.reduced.gear_shaft_joints: the sun at its bore, the ring at its bolt patches, rigid in the
+    rigid partner's motion): a flexible body through its interface's RBE3 (or rigid patch) motion, a rigid one at
+    the joint's point. The input bearing and the drive act on the input shaft, the output bearing and the load on
+    the output shaft (on the merged or tied body when shaft and gear are one), at the shafts' bearing seats and
+    the planets' bores
     (flexgear.geometry.supports, flexgear.mbs.elements.add_support, interface_spin_marker), through the seat
     interfaces' motion of a flexible body. Production formulation: linear joints and seats
     (flexgear.mbs.joints), linear frames (flexgear.mbs.bodies, flexgear.mbs.spin); ``[solver_assumed] formulation
@@ -313,6 +316,11 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
             bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), spin, _linear_frame_tolerance(spec)))
             ends[gear] = gear
+        elif gear == "ring" and form[gear] == form[shaft]:  # both flexible: one body, reduced together
+            bodies.append(_add_component(mbs, gear, "flexible", gear, np.zeros(3), spec, level, props, reduced,
+                                         support=supports[shaft], spin_rad_s=spin, superelement=superelements,
+                                         contacts=contacts, source=TIED_PAIR))
+            ends[gear] = gear
         else:
             joints = gear_shaft_joints(spec, gear)
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
@@ -341,7 +349,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
             carried = (_seat_loads_carried(lead) and len(found) == 1
-                       and _is_gear_seat(spec, lead, found[0][0]))
+                       and _is_gear_seat(lead, found[0][0]))
             axes = _joint_axes(other)
             made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
                                          residual=carried, axes=axes) for k, (a, b, p) in enumerate(found)]

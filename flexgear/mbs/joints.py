@@ -19,8 +19,8 @@ coordinate, flexgear.fe.cms.ReducedBody.interface_motion). A fixed joint makes b
 with R_n. They are one ``ObjectConnectorCoordinateVector`` over the two bodies' coordinates, rewritten
 before each step (:meth:`LinearInterfaceJoint.__call__`), one marker per body; its multipliers lambda
 (``Force`` output) are the joint's force [N] (ground x, y, z) and moment [N m] (ground x, y, z) on the second body.
-On the axis (the sun's bore) the frame columns are constant; off the axis (the ring's bolt patches) the lever
-R_n p of the frame rotations turns as well (:func:`frame_form`).
+Every joint lies on the axis (the sun's bore, the ring's bolt patches at their centroid), where the frame
+columns are constant (:func:`frame_form`).
 
 The six equations are written in ground or in body axes. "ground": as above, the
 modal columns turn (R_n Psi) and, off the axis, the frame rotations' lever. "body": the same equations
@@ -47,6 +47,9 @@ import numpy as np
 from flexgear.laws.compiled import ramp_state, turn_columns
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
+_ON_AXIS_M = 1e-9
+"""A joint point within this distance [m] of the spin axis lies on it (the exact geometry places it there)."""
+
 __all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "add_frame_bearing", "body_axes_form", "frame_form",
            "interface_rows", "linear_bearing", "seat_matrices", "turning_form"]
 
@@ -69,15 +72,13 @@ def turning_form(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def frame_form(point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(C, A, B) (6, 6) of the frame coordinates (u, phi) of a body turned by the spin a: ground translation of
-    its ``point`` p [m] (from the frame origin, reference orientation) and rotation, [I, -(R_z(a) p)~; 0, I] =
-    C + cos(a) A + sin(a) B; constant (C) for a point on the axis."""
-    px, py, _ = (float(v) for v in point)
-    cos_part, sin_part = np.zeros((6, 6)), np.zeros((6, 6))
-    # -(r~) rows (0, r_z, -r_y), (-r_z, 0, r_x), (r_y, -r_x, 0) with r_x = c p_x - s p_y, r_y = s p_x + c p_y
-    cos_part[0, 5], cos_part[1, 5], cos_part[2, 3], cos_part[2, 4] = -py, px, py, -px
-    sin_part[0, 5], sin_part[1, 5], sin_part[2, 3], sin_part[2, 4] = -px, -py, px, py
-    return frame_rows(point) - cos_part, cos_part, sin_part  # at a = 0: frame_rows(p)
+    """(C, A, B) (6, 6) of the frame coordinates (u, phi) of a body turned by the spin: ground translation of
+    its ``point`` p [m] (from the frame origin, on the spin axis) and rotation, [I, -p~; 0, I], constant (C; A = B
+    = 0: a point on the axis does not move with the spin). A point off the axis raises ValueError."""
+    p = np.asarray(point, float)
+    if np.hypot(p[0], p[1]) > _ON_AXIS_M:
+        raise ValueError(f"frame_form: point {p.tolist()} m is off the spin axis (linear joints lie on the axis)")
+    return frame_rows(p), np.zeros((6, 6)), np.zeros((6, 6))
 
 
 def body_axes_form(form: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -138,8 +139,8 @@ def add_frame_bearing(mbs, body: Body, support) -> int:
 class LinearInterfaceJoint:
     """A fixed joint of ``body`` (interface ``interfaces[0]``) and ``other`` (``interfaces[1]``) at ``point``.
 
-    ``point`` [m, ground frame at the reference]: on the axis its frame columns are constant; off the axis (a
-    ring's bolt) they turn with the spin as well (:func:`frame_form`). ``spin_per_drive_angle`` the bodies'
+    ``point`` [m, ground frame at the reference]: on the bodies' common axis, where their frame columns are
+    constant (:func:`frame_form`). ``spin_per_drive_angle`` the bodies'
     nominal spin per prescribed drive angle (both turn together). ``obj`` is the constraint; :meth:`turning`
     gives its blocks that a :class:`TurningBlocks` pre-step function turns with the spin. ``residual``: the
     gear's (``body``) interface moves by six more coordinates, ``residual_node``, its dropped modes' motion e_s

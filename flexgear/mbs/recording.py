@@ -14,7 +14,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
-from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body
 
 if TYPE_CHECKING:
@@ -162,16 +161,13 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
     sensors["output_spin"] = mbs.AddSensor(SensorNode(nodeNumber=model.output_spin[0],
                                                       outputVariableType=ovt.Coordinates, storeInternal=True))
     for gear, joints in model.joints.items():
-        for k, (joint, point) in enumerate(joints):
+        for k, (joint, _) in enumerate(joints):
             if gear in model.linear_joints:  # multipliers: force [N] and moment [N m], ground or body axes (joints)
                 sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
                     objectNumber=joint, outputVariableType=ovt.Force, storeInternal=True))
                 continue
             sensors[f"joint_{gear}_{k}"] = mbs.AddSensor(SensorObject(
                 objectNumber=joint, outputVariableType=ovt.TorqueLocal, storeInternal=True))
-            if np.hypot(point[0], point[1]) > 0.0:  # off the axis: its force has a moment about the axis
-                sensors[f"joint_{gear}_{k}_force"] = mbs.AddSensor(SensorObject(
-                    objectNumber=joint, outputVariableType=ovt.ForceLocal, storeInternal=True))
     if model.kinematics is not None:
         for k, node in enumerate(model.aux_nodes):  # the contacts' deflections, pair by pair (rows in order)
             sensors[f"deflections/{k}"] = mbs.AddSensor(SensorNode(nodeNumber=node, outputVariableType=ovt.Coordinates,
@@ -195,36 +191,15 @@ def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
 
 
 def joint_axis_torque(mbs, model: GearboxModel, sensors: dict[str, int], gear: str) -> tuple[np.ndarray, np.ndarray]:
-    """Time [s] and the torque [N·m] about the axis that ``gear``'s joints to its shaft transmit together.
+    """Time [s] and the torque [N·m] about the axis that ``gear``'s joint to its shaft transmits.
 
-    T_z = sum_k (M_z,k - (x_k F_y,k - y_k F_x,k)) over its joints at points (x_k, y_k, z_k) of the gear's frame,
-    with each joint's local torque M and force F (``TorqueLocal``, ``ForceLocal``; the local frames share the
-    axis z). The minus: Exudyn's generic joint constrains p_m1 - p_m0 (force +lambda_t on marker 1's body) but
-    the z rotation through t_x0 . t_y1 = 0 (moment -lambda_5 on it), so its force and torque outputs act on
-    different bodies; T_z has the sign of the single joint's M_z. Checked: model 4's twelve bolt joints then
-    carry the load torque within 0.2 % (with a plus, 12 % off).
+    The joint lies on the axis (flexgear.fe.reduced.gear_shaft_joints), so its forces have no moment about it:
+    T_z is the joint's moment M_z, the multiplier's sixth entry of a linear joint (flexgear.mbs.joints, on the
+    shaft), ``TorqueLocal`` z of Exudyn's generic joint (the reference formulation; local frames share the axis).
     """
     total = None
-    for k, (_, point) in enumerate(model.joints[gear]):
+    for k, _ in enumerate(model.joints[gear]):
         data = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}"]))
-        if gear in model.linear_joints:  # multipliers on the shaft: force F and moment M at the point
-            torque = data[:, 6].copy()  # M_z, plus (X x F)_z at the point's place X = R_z(phi_n) p off the axis
-            off_axis = np.hypot(point[0], point[1]) > 0.0
-            if off_axis and gear in model.body_axes_joints:
-                torque += point[0] * data[:, 2] - point[1] * data[:, 1]  # F in the body axes, where X is p
-            elif off_axis:  # F in ground axes
-                lc = model.spec.load_case
-                th = model.theory  # the gear's spin per drive angle
-                ratio = (th.output_speed if gear == "ring" else th.input_speed) / th.input_speed
-                phi = ratio * drive_angle(data[:, 0], lc.ramp_time_s, lc.input_speed_rad_s)
-                x = np.cos(phi) * point[0] - np.sin(phi) * point[1]
-                y = np.sin(phi) * point[0] + np.cos(phi) * point[1]
-                torque += x * data[:, 2] - y * data[:, 1]
-            total = torque if total is None else total + torque
-            continue
-        torque = data[:, 3].copy()
-        if f"joint_{gear}_{k}_force" in sensors:
-            force = np.asarray(mbs.GetSensorStoredData(sensors[f"joint_{gear}_{k}_force"]))
-            torque -= point[0] * force[:, 2] - point[1] * force[:, 1]
-        total = torque if total is None else total + torque
+        torque = data[:, 6] if gear in model.linear_joints else data[:, 3]
+        total = torque.copy() if total is None else total + torque
     return data[:, 0], total

@@ -94,8 +94,8 @@ def dropped_modes(spec, full, keep: int, geometry: str) -> DroppedModes:
     """Modes ``keep:`` of gear ``geometry``'s reduced body ``full`` (flexgear.fe.cms.ReducedBody) as dropped."""
     from flexgear.fe.reduced import gear_seat
 
-    seat = gear_seat(spec, full, geometry)
-    held = held_interfaces(spec, geometry)
+    seat = gear_seat(full, geometry)
+    held = held_interfaces(full, geometry)
     whole = centrifugal_response(full, held)
     free = centrifugal_modal_load(full) / full.stiffness
     free[:keep] = 0.0

@@ -17,6 +17,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import pandas as pd
 
+from flexgear.fe.ring_shaft import TIED_PAIR
+
 if TYPE_CHECKING:
     from flexgear.mbs.gearbox import GearboxModel
 
@@ -27,13 +29,14 @@ _MERGED = {"sun": "input_shaft", "ring": "output_shaft"}
 
 def state_bodies(model: GearboxModel) -> dict[str, dict]:
     """Per body: the component geometries it carries (a rigid gear merged with its rigid shaft carries
-    both), whether it is flexible, its mode count and probe node."""
+    both; the flexible ring and output shaft, tied, the tied pair's body), whether it is flexible, its mode
+    count and probe node."""
     out = {}
     for name, body in model.bodies.items():
         if name.startswith("planet"):
             geometries = ["planet"]
-        elif name in _MERGED and _MERGED[name] not in model.bodies:
-            geometries = [name, _MERGED[name]]
+        elif name in _MERGED and _MERGED[name] not in model.bodies:  # merged rigid, or tied flexible
+            geometries = [TIED_PAIR] if body.flexible else [name, _MERGED[name]]
         else:
             geometries = [name]
         entry = {"geometries": geometries, "flexible": bool(body.flexible), "position": list(map(float, body.position))}

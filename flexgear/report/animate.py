@@ -60,10 +60,7 @@ def body_meshes(result: RunResult, reduced_source=None) -> list[BodyMesh]:
         raise ValueError(f"run {result.name!r} has no recorded states: run it with `flexgear run VARIANT --states N`")
     variant = load_variant(result.meta["source"])
     if reduced_source is None:
-        from flexgear.fe.reduced import component_reduced_body
-
-        def reduced_source(spec, component, level):
-            return component_reduced_body(spec, component, level)
+        from flexgear.fe.ring_shaft import reduced_body as reduced_source
     out = []
     for name, info in bodies.items():
         parts, tris, rows, probe, count = [], [], [], -1, 0
