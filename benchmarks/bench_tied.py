@@ -1,20 +1,24 @@
-"""The bolted ring and output shaft as one tied body, or with one rigid bolt-patch interface, beside today's two
-bodies with a rigid patch per bolt: coordinates, cold build time and peak memory, and the checks against full FE.
+"""The bolted ring and output shaft: what do the joined forms (one tied body when both are flexible, one rigid
+bolt-patch interface and one joint when one of them is rigid) cost and change against two bodies joined per bolt?
 
-Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections build checks] [--bolted] [--out FILE]
+Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections build checks mbs] [--bolted]
+                                               [--baseline DIR] [--variants 1 3 4 5 6 7] [--t-end S] [--out FILE]
 
-- build: each body built cold in its own process from the cached meshes (the reduction without its cache; the
-  meshes are the same for every form): today's "ring" and "output_shaft" (flexgear.fe.reduced, a rigid patch per
-  bolt), the tied pair (flexgear.fe.ring_shaft.tied_pair_body) and the one-rigid-interface forms
-  (flexgear.fe.ring_shaft.rigid_partner_body). Per body: flexible coordinates, wall and CPU time, the process's
-  peak resident set (getrusage ru_maxrss).
+- build: each body built cold in its own process from the cached meshes (the reduction without its cache): the
+  ring's and the output shaft's bodies (flexgear.fe.reduced) and the tied pair (flexgear.fe.ring_shaft); with
+  ``--baseline DIR`` (a checkout of the code to compare with, e.g. ``git worktree add --detach DIR <commit>``)
+  also that code's ring and output shaft, side by side. Per body: modes, wall and CPU time, the process's peak
+  resident set (getrusage ru_maxrss).
 - checks: the tied body (cached) against the full FE model of the tied pair: the first ten elastic free-free
   frequencies (flexgear.fe.cms.full_free_modes on the tied model, which equals flexgear.fe.bolted's tie) and with
   ``--bolted`` also flexgear.fe.bolted.ring_output_shaft_fe_modes itself (its own solver: minutes, 4 GB); the
   largest compliance error at the ring's contacts (kernel loads, bearing seat held) relative to the largest
-  entry, and of the bearing seat's six RBE3 compliances (ring side held); and today's ring and shaft with their 12
-  patches all held against the one-rigid-interface bodies held at "bolt_patches" (the same physics: lowest ten
-  frequencies).
+  entry, and of the bearing seat's six RBE3 compliances (ring side held).
+- mbs (needs ``--baseline``): each variant of ``model_variants/`` run for ``--t-end`` (default the study's load
+  case, 0.6 s) by this code and by the baseline's, alternately, each in its own process on warm caches: the
+  system's second-order coordinates and constraint rows, wall and CPU time of the run, and the agreement of every
+  signal over the last ``--window`` seconds (flexgear.study.agreement: means within 0.1 %, 1x mesh amplitudes
+  within 2 %); then model 7's time against the baseline's and against model 1's.
 Results are printed and, with ``--out``, written as JSON (atomically).
 """
 
@@ -30,39 +34,27 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
-CASES = ("ring", "output_shaft", "tied", "ring_rigid_partner", "output_shaft_rigid_partner")
+CASES = ("ring", "output_shaft", "tied")
+BASELINE_CASES = ("ring", "output_shaft")
 
 
 def _builder(spec, case: str, level: str):
     """The uncached build function of ``case``."""
-    if case in ("ring", "output_shaft"):
-        from flexgear.fe.reduced import _component_reduction
-
-        return _component_reduction(spec, case, level, False)[1]
     if case == "tied":
         from flexgear.fe.ring_shaft import _tied_build
 
         return _tied_build(spec, level, False)
-    from flexgear.fe.reduced import component_load_circles
-    from flexgear.fe.ring_shaft import BOLT_PATCHES, part_fe_model, rigid_partner_interfaces
-    from flexgear.fe.tied import reduce
+    from flexgear.fe.reduced import _component_reduction
 
-    component = case.removesuffix("_rigid_partner")
-
-    def build():
-        fe = part_fe_model(spec, component, level)
-        red = spec.reduction_assumed
-        return reduce(fe, rigid_partner_interfaces(fe, spec, component), red.fixed_interface_modes, n_compare=0,
-                      load_circles=component_load_circles(spec, component, red.attachment_order), rigid=(BOLT_PATCHES,))
-
-    return build
+    return _component_reduction(spec, case, level, False)[1]
 
 
 def child(case: str, level: str) -> None:
-    """Build ``case`` in this process; print one JSON line."""
+    """Build ``case`` in this process (on the code and gearbox file of the working directory); print one JSON
+    line."""
     from flexgear.spec import load_gearbox
 
-    spec = load_gearbox(ROOT / "model_variants" / "gearbox.toml")
+    spec = load_gearbox(Path.cwd() / "model_variants" / "gearbox.toml")
     build = _builder(spec, case, level)
     t0, c0 = time.perf_counter(), time.process_time()
     body = build()
@@ -72,29 +64,100 @@ def child(case: str, level: str) -> None:
                       "peak_rss_gb": usage.ru_maxrss * 1024 / 1e9}))
 
 
-def build_section(level: str) -> list[dict]:
+def _child_json(args: list[str], root: Path) -> dict:
+    """Run this script with ``args`` in a process on the code at ``root``; its last printed line as JSON."""
+    env = {**os.environ, "PYTHONPATH": str(root)}
+    out = subprocess.run([sys.executable, __file__, *args], capture_output=True, text=True, env=env, cwd=root)
+    if out.returncode != 0:
+        return {"status": "failed", "reason": out.stderr.strip().splitlines()[-1] if out.stderr.strip() else "?"}
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
+def build_section(level: str, baseline: Path | None) -> list[dict]:
     rows = []
-    for case in CASES:
-        out = subprocess.run([sys.executable, __file__, "--child", case, "--level", level], capture_output=True,
-                             text=True, check=True, env=os.environ.copy())
-        row = json.loads(out.stdout.strip().splitlines()[-1])
-        rows.append(row)
-        print(f"{case:28s} {row['modes']:4d} modes  {row['wall_s']:6.1f} s wall  {row['cpu_s']:6.1f} s CPU  "
-              f"peak {row['peak_rss_gb']:.2f} GB", flush=True)
+    runs = [(ROOT, "current", CASES)] + ([(baseline, "baseline", BASELINE_CASES)] if baseline else [])
+    for root, label, cases in runs:
+        for case in cases:
+            row = {"code": label, **_child_json(["--child", case, "--level", level], root)}
+            rows.append(row)
+            print(f"{label:8s} {case:14s} {row['modes']:4d} modes  {row['wall_s']:6.1f} s wall  "
+                  f"{row['cpu_s']:6.1f} s CPU  peak {row['peak_rss_gb']:.2f} GB", flush=True)
+    return rows
+
+
+def child_run(variant_file: str, t_end: float | None, save: str) -> None:
+    """Run ``variant_file`` in this process; save its result to ``save``; print one JSON line."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+    from flexgear.mbs.run import run_variant
+    from flexgear.results import save_result
+    from flexgear.spec import load_variant
+
+    variant = load_variant(variant_file)
+    mbs = exu.SystemContainer().AddSystem()
+    build_star_gearbox(mbs, variant)
+    mbs.Assemble()
+    size = {"ode2_coordinates": len(mbs.systemData.GetODE2Coordinates()),
+            "constraint_rows": len(mbs.systemData.GetAECoordinates())}
+    result = run_variant(variant, t_end)
+    save_result(result, save)
+    print(json.dumps({**size, **{k: result.meta.get(k) for k in ("status", "reason", "wall_time_s", "cpu_time_s",
+                                                                  "t_end_s", "newton_iterations", "jacobians")}}))
+
+
+def mbs_section(baseline: Path, variants: list[int], t_end: float | None, window: float) -> list[dict]:
+    import tempfile
+
+    from flexgear.results import load_result
+    from flexgear.study.agreement import signal_agreement
+
+    rows = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for m in variants:
+            runs = {}
+            for root, label in ((ROOT, "current"), (baseline, "baseline")):
+                save = Path(tmp) / f"{label}-model{m}"
+                args = ["--child-run", f"model_variants/model{m}.toml", "--save", str(save)]
+                runs[label] = {"save": save, **_child_json(args + (["--t-end", str(t_end)] if t_end else []), root)}
+            row = {"variant": f"model{m}", **{f"{k}_{lb}": r.get(k) for lb, r in runs.items()
+                                              for k in ("ode2_coordinates", "constraint_rows", "wall_time_s",
+                                                        "cpu_time_s", "status")}}
+            if all(r.get("status") == "ok" for r in runs.values()):
+                ref, new = load_result(runs["baseline"]["save"]), load_result(runs["current"]["save"])
+                end = float(runs["current"]["t_end_s"])
+                agreement = signal_agreement(ref, new, (end - window, end), ref.meta["theory"]["mesh_frequency_hz"])
+                table = agreement.table
+                mesh = table[table.index.str.contains("mesh_force")]
+                accel = table[table.index.str.contains("accel")]
+                row.update(worst_mean=agreement.worst_mean, worst_mean_signal=str(table["mean_diff"].abs().idxmax()),
+                           worst_amp_1x=agreement.worst_amplitude,
+                           worst_amp_signal=str(table["amp_diff"].abs().idxmax()),
+                           mesh_force_mean=float(mesh["mean_diff"].abs().max()),
+                           mesh_force_amp_1x=float(mesh["amp_diff"].abs().max()),
+                           bearing_accel_amp_1x=float(accel["amp_diff"].abs().max()))
+            rows.append(row)
+            print(json.dumps(row), flush=True)
+    by = {r["variant"]: r for r in rows}
+    if "model7" in by and by["model7"].get("wall_time_s_baseline"):
+        seven = by["model7"]
+        new, old = seven["wall_time_s_current"], seven["wall_time_s_baseline"]
+        print(f"model 7: {new:.1f} s against the baseline's {old:.1f} s ({new / old:.2f}x)")
+        if "model1" in by:
+            print(f"model 7 / model 1: {seven['wall_time_s_current'] / by['model1']['wall_time_s_current']:.1f}x "
+                  f"(baseline {seven['wall_time_s_baseline'] / by['model1']['wall_time_s_baseline']:.1f}x)")
     return rows
 
 
 def checks_section(level: str, bolted: bool) -> dict:
     import numpy as np
-    import scipy.linalg as la
 
     import flexgear as fg
     from flexgear.fe.cms import _rbe3_rows, full_free_modes, rbe3_weights
     from flexgear.fe.compliance import free_body_solver
     from flexgear.fe.fem import rigid_body_modes
-    from flexgear.fe.joined import body_matrices, joint_rows
-    from flexgear.fe.reduced import component_contacts, component_load_circles, component_reduced_body
-    from flexgear.fe.ring_shaft import pair_fe_models, rigid_partner_body, ring_seat, tied_pair, tied_pair_body
+    from flexgear.fe.reduced import component_contacts, component_load_circles
+    from flexgear.fe.ring_shaft import pair_fe_models, ring_seat, tied_pair, tied_pair_body
     from flexgear.spec import load_gearbox
 
     spec = load_gearbox(ROOT / "model_variants" / "gearbox.toml")
@@ -142,40 +205,38 @@ def checks_section(level: str, bolted: bool) -> dict:
     print(f"  compliance at the ring's contacts: largest error {100 * out['contact_compliance_error']:.4f} % of the "
           f"largest entry; bearing seat (6 RBE3 diagonals): {100 * out['seat_compliance_error_max']:.4f} %")
 
-    def held_hz(b, names):
-        mass, stiffness = body_matrices(b)
-        g = np.vstack([joint_rows(b, n, b.interface(n).point) for n in names])
-        basis = la.null_space(g)
-        lam = la.eigh(basis.T @ stiffness @ basis, basis.T @ mass @ basis, eigvals_only=True)
-        return np.sqrt(lam[:10]) / (2 * np.pi)
-
-    for component in ("ring", "output_shaft"):
-        today = component_reduced_body(spec, component, level)
-        patches = [i.name for i in today.interfaces if i.name.startswith("bolt_")]
-        one = rigid_partner_body(spec, component, level)
-        f_today, f_one = held_hz(today, patches), held_hz(one, ["bolt_patches"])
-        out[f"{component}_held_today_hz"], out[f"{component}_held_one_interface_hz"] = f_today.tolist(), f_one.tolist()
-        print(f"{component} held at its bolts: {len(patches)} patches ({today.n_modes} modes) vs one rigid interface "
-              f"({one.n_modes} modes): largest difference {np.abs(f_one / f_today - 1).max():.2e}")
     return out
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", default="coarse")
-    parser.add_argument("--sections", nargs="+", default=["build", "checks"], choices=["build", "checks"])
+    parser.add_argument("--sections", nargs="+", default=["build", "checks"], choices=["build", "checks", "mbs"])
     parser.add_argument("--bolted", action="store_true", help="also run flexgear.fe.bolted's own full-FE modes")
+    parser.add_argument("--baseline", type=Path, help="a checkout of the code to compare with (build, mbs)")
+    parser.add_argument("--variants", type=int, nargs="+", default=[1, 3, 4, 5, 6, 7])
+    parser.add_argument("--t-end", type=float, default=None, help="mbs: simulated time [s] (default: load case's)")
+    parser.add_argument("--window", type=float, default=0.1, help="mbs: agreement over the last WINDOW s")
     parser.add_argument("--out", type=Path, help="write the results here as JSON")
     parser.add_argument("--child", choices=CASES, help=argparse.SUPPRESS)
+    parser.add_argument("--child-run", help=argparse.SUPPRESS)
+    parser.add_argument("--save", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.child:
         child(args.child, args.level)
         return
+    if args.child_run:
+        child_run(args.child_run, args.t_end, args.save)
+        return
     results: dict = {"level": args.level}
     if "build" in args.sections:
-        results["build"] = build_section(args.level)
+        results["build"] = build_section(args.level, args.baseline)
     if "checks" in args.sections:
         results["checks"] = checks_section(args.level, args.bolted)
+    if "mbs" in args.sections:
+        if args.baseline is None:
+            parser.error("--sections mbs needs --baseline DIR")
+        results["mbs"] = mbs_section(args.baseline.resolve(), args.variants, args.t_end, args.window)
     if args.out:
         from flexgear.cache import atomic_write_bytes
 

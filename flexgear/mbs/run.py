@@ -337,6 +337,9 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
         states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()
         build_s = time.perf_counter() - wall0
+        # the system's size: second-order coordinates and algebraic ones (a constraint row's multiplier each)
+        meta.update(ode2_coordinates=len(mbs.systemData.GetODE2Coordinates()),
+                    constraint_rows=len(mbs.systemData.GetAECoordinates()))
         guard = RunGuard(model, variant, t_end, budget - build_s, progress)
         log = SensorLog(mbs, {**sensors, **{f"state/{k}": v for k, v in states.items()}})
         counts = _solve_chunk(mbs, variant, 0.0, t_end, guard, log, {})
