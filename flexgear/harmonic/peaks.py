@@ -215,9 +215,9 @@ def peak_crossings(spec: Any, speeds_rpm: Sequence[float], indicators: Sequence[
     (:func:`response_peaks`), the multiplet that carries the response at the grid speed of each peak
     (:func:`mode_contributions`' largest), that multiplet's Campbell lines on the same grid and their crossings
     with order h, the one nearest the peak. A harmonic the planets' phasing cancels (:data:`CANCELLED`) is left
-    out. Columns: indicator, harmonic, peak_rpm, amplitude, frequency_hz and
-    kind of the carrying multiplet, share (its |contribution| over the indicator's response part), crossing_rpm,
-    difference (peak_rpm / crossing_rpm - 1; nan where the lines do not cross order h in the grid).
+    out. Columns: indicator, harmonic, peak_rpm, amplitude, frequency_hz, damping_ratio and kind of the carrying
+    multiplet, share (its |contribution| over the indicator's response part), crossing_rpm, difference
+    (peak_rpm / crossing_rpm - 1; nan where the lines do not cross order h in the grid).
     """
     speeds = np.sort(np.asarray(speeds_rpm, float))
     lin = lumped_linear(spec, harmonics)
@@ -239,6 +239,7 @@ def peak_crossings(spec: Any, speeds_rpm: Sequence[float], indicators: Sequence[
                 near = crossings[(crossings.order == h) & crossings["mode"].isin(numbers)]
                 row = {"indicator": indicator, "harmonic": h, "peak_rpm": float(peak.speed_rpm),
                        "amplitude": float(peak.amplitude), "frequency_hz": float(top.frequency_hz),
+                       "damping_ratio": float(top.damping_ratio),
                        "kind": kinds.get((float(speeds[i]), numbers[0]), "") if numbers else "",
                        "share": float(top.share), "crossing_rpm": math.nan, "difference": math.nan}
                 if len(near):
@@ -246,5 +247,5 @@ def peak_crossings(spec: Any, speeds_rpm: Sequence[float], indicators: Sequence[
                     row["crossing_rpm"] = float(best.speed_rpm)
                     row["difference"] = float(peak.speed_rpm / best.speed_rpm - 1.0)
                 rows.append(row)
-    return pd.DataFrame(rows, columns=["indicator", "harmonic", "peak_rpm", "amplitude", "frequency_hz", "kind",
-                                       "share", "crossing_rpm", "difference"])
+    return pd.DataFrame(rows, columns=["indicator", "harmonic", "peak_rpm", "amplitude", "frequency_hz",
+                                       "damping_ratio", "kind", "share", "crossing_rpm", "difference"])
