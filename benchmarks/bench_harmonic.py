@@ -3,6 +3,7 @@ run of model 7, and does the frequency domain match settled time integration of 
 
 Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 200] [--harmonics 10]
      nice -n 5 python benchmarks/bench_harmonic.py checks [model_variants/model1.toml model_variants/model7.toml]
+                                                           [--lumped-only | --no-lumped] [--gearbox FILE]
 
 - ``speed``: caches warmed first (a linearisation loads the reduced bodies, a 1e-4 s run compiles the time model);
   then per round, interleaved, flexgear.harmonic.harmonic_response of model 7 over ``--speeds`` speeds from 500 to
@@ -19,6 +20,12 @@ Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 
   the four bearing accelerations, and K_v (peak over mean mesh force, flexgear.study.indicators), against the
   frequency domain at the same speed: relative differences, goal 10 %. An amplitude the planets' phasing cancels
   (below :data:`CANCELLED` of its family's largest at that speed in the frequency domain) is shown but not judged.
+  Then the lumped model of ``--gearbox`` under the same law against its own settled time integration
+  (flexgear.study.harmonic_check: the same rule for the first strong peak, its crossing read off the lumped model's
+  Campbell diagram through the mode that carries the peak, the three speeds n_c x BESIDE, runs to settle_max_time_s
+  with the settling test, the same amplitudes and K_v; "moved": the time value's change from the window before the
+  last), and its peaks of the 1x and 2x curves on a :data:`PEAK_STEP_RPM` grid against the Campbell crossings of
+  the modes that carry them (flexgear.harmonic.peaks.peak_crossings), goal 1 %.
 """
 
 from __future__ import annotations
@@ -50,14 +57,21 @@ RAMP_S, END_S, WINDOW_S = 0.05, 0.25, 0.05
 """Time runs: ramps of speed and load [s], the load case's end before the settling test [s], the analysed window."""
 CANCELLED = 0.01
 """Amplitudes below this fraction of their family's largest (frequency domain, same speed) are not judged."""
+PEAK_STEP_RPM = 5.0
+"""Step of the lumped model's peak grid [rpm]: a grid point within 0.2 % of its lowest crossing's speed."""
+PEAK_INDICATORS = ("outer_mesh_force_1_n", "inner_mesh_force_1_n", "input_bearing_accel_x_m_per_s2",
+                   "output_bearing_accel_x_m_per_s2")
 COLUMNS = ("outer_mesh_force_1_n", "inner_mesh_force_1_n", "input_bearing_accel_x_m_per_s2",
            "input_bearing_accel_y_m_per_s2", "output_bearing_accel_x_m_per_s2", "output_bearing_accel_y_m_per_s2")
 
 
+def _iso_spec(spec):
+    spec = spec.with_fields("contact", law="iso6336", friction_coefficient=0.0)
+    return spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
+
+
 def _iso(variant):
-    spec = variant.gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.0)
-    spec = spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
-    return dataclasses.replace(variant, gearbox=spec)
+    return dataclasses.replace(variant, gearbox=_iso_spec(variant.gearbox))
 
 
 def speed(a: argparse.Namespace) -> None:
@@ -126,7 +140,7 @@ def checks(a: argparse.Namespace) -> None:
 
     print(load_average())
     worst = 0.0
-    for path in a.variants:
+    for path in [] if a.lumped_only else a.variants:
         variant = _iso(load_variant(path))
         spec = variant.gearbox
         harmonics = spec.contact_assumed.stiffness_harmonics
@@ -175,8 +189,49 @@ def checks(a: argparse.Namespace) -> None:
             rel = (kv_f - 1.0) / (kv_t - 1.0) - 1.0
             worst = max(worst, abs(rel))
             print(f"    K_v - 1: freq {kv_f - 1:.4g} time {kv_t - 1:.4g} ({100 * rel:+.1f} %)")
-    print(f"\nlargest judged difference: {100 * worst:.1f} % (goal 10 %)")
+    if not a.lumped_only:
+        print(f"\nlargest judged difference: {100 * worst:.1f} % (goal 10 %)")
+    if not a.no_lumped:
+        lumped_checks(a.gearbox)
     print(load_average())
+
+
+def lumped_checks(path: str) -> None:
+    """The lumped model's checks (module docstring)."""
+    from flexgear.harmonic.peaks import peak_crossings
+    from flexgear.spec import load_gearbox
+    from flexgear.study.harmonic_check import check_speeds, compare_lumped
+
+    spec = _iso_spec(load_gearbox(path))
+    t0 = time.perf_counter()
+    cs = check_speeds(spec, beside=BESIDE, strong=STRONG)
+    print(f"\nlumped model ({Path(path).name}): first strong peak of K_v at {cs.peak_rpm:g} rpm (K_v {cs.kv:.4f}), "
+          f"set by {cs.mesh} at {cs.order}x, carried by the mode at {cs.frequency_hz:.1f} Hz (damping ratio "
+          f"{cs.damping_ratio:.3f}, share {cs.share:.2f}); its Campbell crossing with {cs.order}x at "
+          f"{cs.crossing_rpm:.1f} rpm ({time.perf_counter() - t0:.1f} s)")
+    worst = 0.0
+    for factor, n in zip(BESIDE, cs.speeds_rpm, strict=True):
+        check = compare_lumped(spec, n)
+        worst = max(worst, check.worst)
+        print(f"  {n:g} rpm ({factor:g} x): time run {check.wall_time_s:.1f} s; {check.settling.reason}; window "
+              f"{check.window_s[0]:.4f}-{check.window_s[1]:.4f} s")
+        for _, r in check.table.iterrows():
+            what = "K_v - 1" if r.harmonic == 0 else f"{r.quantity} {r.harmonic}x"
+            print(f"    {what}: freq {r.frequency:.4g} time {r.time:.4g} ({100 * r.difference:+.1f} %"
+                  f"{'' if r.judged else ', cancelled: not judged'}); moved {100 * r.moved:+.1e} %")
+    print(f"  lumped model, largest judged difference: {100 * worst:.1f} % (goal 10 %)")
+    t0 = time.perf_counter()
+    grid = np.arange(500.0, 7000.0 + 0.5 * PEAK_STEP_RPM, PEAK_STEP_RPM)
+    peaks = peak_crossings(spec, grid, PEAK_INDICATORS, orders=(1, 2),
+                           harmonics=spec.contact_assumed.stiffness_harmonics)
+    print(f"\nlumped model: peaks of the 1x and 2x curves over {grid.size} speeds against the Campbell crossings of "
+          f"the modes that carry them ({time.perf_counter() - t0:.1f} s):")
+    for _, p in peaks.iterrows():
+        print(f"  {p.indicator} {p.harmonic}x: peak {p.peak_rpm:.1f} rpm, mode {p.frequency_hz:.1f} Hz {p.kind} "
+              f"(damping ratio {p.damping_ratio:.3f}, share {p.share:.2f}), crossing {p.crossing_rpm:.1f} rpm: "
+              f"{100 * p.difference:+.2f} %")
+    print(f"  largest |difference| {100 * peaks.difference.abs().max():.2f} % (goal 1 %); within 1 %: "
+          f"{int((peaks.difference.abs() <= 0.01).sum())} of {len(peaks)}")
 
 
 def main() -> None:
@@ -188,6 +243,11 @@ def main() -> None:
     s.add_argument("--harmonics", type=int, default=10)
     c = sub.add_parser("checks")
     c.add_argument("variants", nargs="*", default=[str(ROOT / "model_variants" / f"model{i}.toml") for i in (1, 7)])
+    only = c.add_mutually_exclusive_group()
+    only.add_argument("--lumped-only", action="store_true", help="the lumped model's checks only")
+    only.add_argument("--no-lumped", action="store_true", help="without the lumped model's checks")
+    c.add_argument("--gearbox", default=str(ROOT / "model_variants" / "gearbox.toml"),
+                   help="gearbox file of the lumped model's checks")
     a = ap.parse_args()
     os.environ.setdefault("OMP_NUM_THREADS", "1")
     {"speed": speed, "checks": checks}[a.section](a)

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -24,11 +25,38 @@ from flexgear.harmonic.base import (
     mesh_frequency_hz,
 )
 
-__all__ = ["lumped_harmonic_response"]
+__all__ = ["lumped_harmonic_response", "LumpedLinear", "lumped_linear"]
+
+
+@dataclass(frozen=True)
+class LumpedLinear:
+    """The lumped model linearised about its static equilibrium under the load (:func:`lumped_linear`).
+
+    ``operating(speed_rpm)``: the linear problem at that input speed [rpm] (flexgear.harmonic.base._Operating: M,
+    D + G, K over the free coordinates, contact rows, excitation, outputs); ``labels``: the free coordinates'
+    names (flexgear.lumped.model.LumpedSystem.labels); ``free``: their indices among all coordinates;
+    ``system``: the assembled flexgear.lumped.model.LumpedSystem; ``per_rpm``: f_mesh per input rpm [Hz/rpm];
+    ``name``: the model's name in a :class:`~flexgear.harmonic.base.Response`.
+    """
+
+    operating: Callable[[float], _Operating]
+    labels: tuple[str, ...]
+    free: np.ndarray
+    system: Any
+    per_rpm: float
+    name: str
 
 
 def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS) -> Response:
-    """Harmonic response of the lumped model of ``spec`` (a flexgear.spec.GearboxSpec) at ``speeds_rpm`` [rpm].
+    """Harmonic response of the lumped model of ``spec`` (a flexgear.spec.GearboxSpec) at ``speeds_rpm`` [rpm]
+    (the linearisation: :func:`lumped_linear`)."""
+    t0 = time.perf_counter()
+    lin = lumped_linear(spec, harmonics)
+    return _sweep(lin.operating, speeds_rpm, harmonics, lin.name, lin.per_rpm, t0)
+
+
+def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear:
+    """The lumped model of ``spec`` (a flexgear.spec.GearboxSpec) linearised, with ``harmonics`` stiffness harmonics.
 
     The time model's equations (flexgear.lumped.run) linearised about the static equilibrium under the load
     torque: input spin held (the prescribed drive), mean mesh stiffness, friction left out. The contact law is the
@@ -51,7 +79,6 @@ def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: 
     )
     from flexgear.theory import theory
 
-    t0 = time.perf_counter()
     spec = _excited(spec, harmonics)
     model = build_lumped_model(spec)
     s = model.system
@@ -139,8 +166,5 @@ def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: 
         return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
                           omega_mesh)
 
-    per_rpm = mesh_frequency_hz(spec, 1.0)
-    return _sweep(operating, speeds_rpm, harmonics, f"lumped ({Path(str(spec.source)).stem})", per_rpm, t0)
-
-
-# --------------------------------------------------------------------------- multibody model
+    return LumpedLinear(operating, tuple(s.labels[j] for j in free), free, s, mesh_frequency_hz(spec, 1.0),
+                        f"lumped ({Path(str(spec.source)).stem})")

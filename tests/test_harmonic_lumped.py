@@ -1,0 +1,106 @@
+"""The lumped model's harmonic response (flexgear.harmonic.lumped) against its own physics, at speeds read off its own
+Campbell diagram (flexgear.harmonic.peaks, flexgear.study.harmonic_check).
+
+(1) Below the first strong crossing (flexgear.study.harmonic_check.check_speeds), the 1x and 2x amplitudes of the mesh
+    forces and bearing accelerations and K_v - 1 of a settled time run (flexgear.lumped.run) within 10 %: the
+    first-order excitation F_0 (s - 1) leaves out the parametric terms, of relative order c_h (c_1, c_2 ~ 0.05-0.1).
+(2) Lightly damped (mesh damping ratio and bearing damping x 0.1: every mode's damping ratio below 1.5 %), each
+    resonance peak of the 1x and 2x curves lies within 1 % of the Campbell crossing of the mode that carries it:
+    a lightly damped peak lies at h f_mesh = f_n up to a shift of order zeta^2 (2e-4). The carrying modes are those
+    the planets' phasing lets each harmonic excite (Parker 2004; z_s = 44, N = 5): translational at 1x
+    ((h z_s +- 1) / N an integer), planet modes at 2x (neither h z_s / N nor (h z_s +- 1) / N).
+(3) At the study's damping, the peaks of the modes whose damping shift zeta^2 is at most a quarter of the 1 %
+    (damping ratio <= :data:`LIGHT`) within 1 % of their crossings.
+"""
+
+import dataclasses
+
+import numpy as np
+import pytest
+
+from flexgear.harmonic.peaks import lumped_campbell, peak_crossings
+from flexgear.study.harmonic_check import CANCELLED, COLUMNS, check_speeds, compare_lumped
+
+TOLERANCE = 0.10  # the time-domain comparison
+PEAK_TOLERANCE = 0.01  # peak speeds against crossings
+LIGHT = 0.05  # damping ratio whose peak shift zeta^2 is a quarter of PEAK_TOLERANCE
+GRID = np.arange(500.0, 7000.0 + 5.0, 5.0)  # 5 rpm: a grid point within 0.2 % of the lowest crossing's speed
+INDICATORS = ("outer_mesh_force_1_n", "inner_mesh_force_1_n", "input_bearing_accel_x_m_per_s2",
+              "output_bearing_accel_x_m_per_s2")
+
+
+@pytest.fixture(scope="module")
+def iso_spec(gearbox):
+    """The ISO 6336 law with the contact-line stiffness variation and no friction (the linearisation's scope)."""
+    spec = gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.0)
+    return spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
+
+
+def _lightly_damped(spec, factor: float = 0.1):
+    spec = spec.with_fields("contact_assumed", mesh_damping_ratio=factor * spec.contact_assumed.mesh_damping_ratio)
+    b = spec.bearings
+    return spec.with_fields("bearings", **{
+        f.name: dataclasses.replace(getattr(b, f.name), damping_per_stiffness_s=factor * getattr(
+            b, f.name).damping_per_stiffness_s) for f in dataclasses.fields(b)})
+
+
+def test_frequency_domain_matches_settled_time_run_below_the_first_strong_crossing(iso_spec):
+    speeds = check_speeds(iso_spec)
+    assert speeds.order in (1, 2)  # the strong peaks of the study's gearbox: the 1x and 2x crossings
+    check = compare_lumped(iso_spec, speeds.speeds_rpm[0])
+    assert check.settling.settled
+    table = check.table
+    moved = table[table.judged].moved.abs().max()
+    assert moved < 0.01  # the last two windows agree: settled
+    judged = table[table.judged]
+    # phasing: 2x moves no central member (the bearings' 2x is cancelled), everything else is judged
+    assert set(judged.quantity) == set(COLUMNS) | {"dynamic_factor - 1"}
+    assert (table[~table.judged].harmonic == 2).all() and table[~table.judged].quantity.str.contains("accel").all()
+    assert (table[~table.judged].frequency < CANCELLED * table.frequency.max()).all()
+    bad = judged[judged.difference.abs() > TOLERANCE]
+    assert bad.empty, bad.to_string()
+
+
+def test_campbell_of_a_star_gearbox_is_flat_and_crossings_follow_the_mesh_orders(iso_spec):
+    """Carrier fixed: no gyroscopic or centripetal terms, the natural frequencies do not depend on the speed, and each
+    crossing of order k lies at f_n / (k f_mesh per rpm)."""
+    diagram = lumped_campbell(iso_spec, [500.0, 3000.0, 7000.0], orders=(1, 2))
+    spread = diagram.table.groupby("mode").frequency_hz.agg(lambda f: f.max() / f.min() - 1.0)
+    assert spread.max() < 1e-9
+    c = diagram.crossings
+    np.testing.assert_allclose(c.speed_rpm, c.frequency_hz / (c.order * diagram.mesh_hz_per_rpm), rtol=1e-9)
+
+
+def test_lightly_damped_peaks_lie_at_the_crossings_of_their_modes(iso_spec):
+    peaks = peak_crossings(_lightly_damped(iso_spec), GRID, INDICATORS, orders=(1, 2),
+                           harmonics=iso_spec.contact_assumed.stiffness_harmonics)
+    assert len(peaks) >= len(INDICATORS)
+    assert peaks.difference.notna().all(), peaks.to_string()
+    assert (peaks.difference.abs() <= PEAK_TOLERANCE).all(), peaks.to_string()
+    assert (peaks[peaks.harmonic == 1].kind == "translational").all()
+    assert (peaks[peaks.harmonic == 2].kind == "planet").all()
+
+
+def test_peaks_of_lightly_damped_modes_at_the_study_damping(iso_spec):
+    peaks = peak_crossings(iso_spec, GRID, INDICATORS, orders=(1, 2),
+                           harmonics=iso_spec.contact_assumed.stiffness_harmonics)
+    light = peaks[peaks.damping_ratio <= LIGHT]
+    assert len(light) >= 2, peaks.to_string()
+    assert (light.difference.abs() <= PEAK_TOLERANCE).all(), light.to_string()
+
+
+def test_modal_contributions_add_up_to_the_response(iso_spec):
+    """X = sum_j psi_j eta_j over all roots: with no root left out (none overdamped), the multiplets' contributions
+    add up to the mesh force's response part F - F_0 C_h of the direct solve."""
+    from flexgear.harmonic import lumped_harmonic_response
+    from flexgear.harmonic.lumped import lumped_linear
+    from flexgear.harmonic.peaks import mode_contributions
+
+    speed, h, mesh = 2000.0, 2, "outer_mesh_force_1_n"
+    lin = lumped_linear(iso_spec, 3)
+    parts = mode_contributions(lin, speed, mesh, h)
+    assert parts.multiplicity.sum() == lin.free.size  # every root pair kept
+    op = lin.operating(speed)
+    force = lumped_harmonic_response(iso_spec, [speed], 3).complex(mesh).loc[speed, h]
+    response_part = force - op.f0[0] * op.coef[0, h - 1]
+    assert parts.contribution.sum() == pytest.approx(response_part, rel=1e-8)
