@@ -4,7 +4,8 @@ Sun and planet: bore to reference radius; ring: reference radius to root + 8 mm.
 meshes (a few hundred nodes, about a second each) with the bore as the RBE3 interface "bore"; the ring's
 interface "bolt_patches" as the gearbox's joint expects (flexgear.fe.reduced.gear_shaft_joints): one patch per
 bolt on its outer surface, centred at the bolt's angle, as wide as its clamped disc, all patches one rigid
-interface. Flexible shafts (and so the tied ring and output shaft) have no stand-in.
+interface. The shafts' stand-ins serve rigid shafts (their mass properties): a flexible shaft, and so the tied
+ring and output shaft, has none.
 They exercise the flexible-gear machinery; the real components come from
 flexgear.fe.reduced.component_reduced_body.
 """
@@ -42,7 +43,8 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
 
 
 def annulus_source(spec, component: str, level: str):
-    """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox: sun, planet and ring."""
+    """A ``reduced_source`` for flexgear.mbs.gearbox.build_star_gearbox: sun, planet and ring; the shafts for
+    their mass properties."""
     from flexgear.fe.reduced import BOLT_PATCHES
 
     geo = gear_set_geometry(spec)
@@ -56,7 +58,14 @@ def annulus_source(spec, component: str, level: str):
         gear = geo.sun if component == "sun" else geo.planet
         bore = getattr(spec.components_assumed, f"{component}_bore_diameter_mm") * 0.5e-3
         return _annulus(bore, gear.reference_radius, width, False, spec.material_assumed, modes, "bore", 0, half)
-    raise ValueError(f"annulus_source: no stand-in for {component!r} (sun, planet and ring have one)")
+    # shafts: their mass properties for the rigid shafts (a flexible shaft would also need its bearing seat)
+    c = spec.components_assumed
+    outer = getattr(c, f"{component}_outer_diameter_mm") * 0.5e-3
+    inner = getattr(c, f"{component}_inner_diameter_mm") * 0.5e-3
+    length = getattr(c, f"{component}_length_mm") * 1e-3
+    if component == "input_shaft":
+        return _annulus(inner, outer, length, False, spec.material_assumed, modes, "sun_seat", 0, half)
+    return _annulus(inner, outer, length, False, spec.material_assumed, modes, BOLT_PATCHES, c.ring_bolt_count, half)
 
 
 STANDIN_ASYMMETRY_TOLERANCE = 3e-3
