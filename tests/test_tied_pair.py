@@ -62,3 +62,25 @@ def test_tied_body_compliance_at_contact_bands_and_bearing_seat_within_2_percent
     full_seat = interface_compliance(fe, seat, ring_side)
     reduced_seat = interface_compliance(body, seat, body.interface("ring_seat"))
     assert np.diag(reduced_seat) == pytest.approx(np.diag(full_seat), rel=0.02)
+
+
+def test_part_shares_of_the_tied_body_add_up_from_each_parts_own_fe(gearbox):
+    """Each part's share of a mode's energy (flexgear.fe.ring_shaft.tied_part_matrices: the ring's from its own
+    nodes, the shaft's the rest) equals the shaft's energy computed from its own FE matrices on its nodes' motion
+    through the tie, u_s = T_s u (the tie conserves energy: K = T^T blockdiag(K_r, K_s) T): within 1e-8 of the
+    largest entry; both parts' shares are positive semi-definite."""
+    import scipy.sparse as sp
+
+    from flexgear.fe.ring_shaft import pair_fe_models, tied_pair, tied_pair_body, tied_part_matrices
+
+    ring, shaft = pair_fe_models(gearbox, "coarse")
+    tied = tied_pair(ring, shaft, gearbox)
+    body = tied_pair_body(gearbox, "coarse")
+    parts = tied_part_matrices(gearbox, "coarse")
+    rows = tied.scalar_tie[tied.offsets[1]:tied.offsets[2]]
+    u_s = sp.kron(rows, sp.identity(3), format="csr") @ body.modes
+    for k, (fe_matrix, own) in enumerate(((shaft.M, parts["output_shaft"][0]), (shaft.K, parts["output_shaft"][1]))):
+        direct = u_s.T @ (fe_matrix @ u_s)
+        assert np.abs(direct - own).max() < 1e-8 * np.abs(own).max(), k
+    for m_p, k_p in parts.values():
+        assert np.linalg.eigvalsh(m_p).min() > -1e-10 and np.linalg.eigvalsh(k_p).min() > -1e-10 * body.stiffness.max()

@@ -49,7 +49,7 @@ from flexgear.progress import say
 from flexgear.spec import GearboxSpec
 
 __all__ = ["PAIR", "TIED_PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
-           "tied_pair_body", "tied_pair_mass_properties", "reduced_body"]
+           "tied_pair_body", "tied_pair_mass_properties", "reduced_body", "tied_part_matrices"]
 
 PAIR = ("ring", "output_shaft")
 """The bolted pair's parts, in the order of the tied model (the ring first: its nodes keep their indices)."""
@@ -140,6 +140,47 @@ def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress
 
     props = _read_cached(_tied_key(spec, level), read)
     return props if props is not None else tied_pair_body(spec, level, progress).props
+
+
+def tied_part_matrices(spec: GearboxSpec, level: str = "coarse", progress: bool = False
+                       ) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each part's share of the tied body's modal mass and stiffness: {part: (M_p, K_p)}, (m, m) over the body's
+    modal coordinates q, with M_ring + M_shaft = I and K_ring + K_shaft = diag(omega^2).
+
+    The ring's nodes are the tied model's first ones, untouched by the tie (flexgear.fe.tied), so its part is exact:
+    M_ring = Phi_r^T M_r Phi_r, K_ring = Phi_r^T K_r Phi_r with Phi_r the modes' rows of the ring's nodes and M_r,
+    K_r the ring's own FE matrices; the shaft's is the rest. A mode's kinetic (strain) energy splits as
+    q^T M_p q (q^T K_p q) between the parts. Cached beside the body.
+    """
+    from flexgear.cache import atomic_write_bytes, cache_dir, load_or_build, read_entry
+
+    path = cache_dir() / f"tied-parts-{_tied_key(spec, level)}.npz"
+
+    def read(file) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        with np.load(file, allow_pickle=False) as z:
+            m_r, k_r = z["mass_ring"], z["stiffness_ring"]
+        body = tied_pair_body(spec, level, progress)
+        return {"ring": (m_r, k_r), "output_shaft": (np.eye(body.n_modes) - m_r, np.diag(body.stiffness) - k_r)}
+
+    def load():
+        return read_entry(path, read) if path.exists() else None
+
+    def build():
+        import io
+
+        body = tied_pair_body(spec, level, progress)
+        ring = part_fe_model(spec, "ring", level, progress)
+        n = ring.n_nodes
+        if not np.allclose(body.nodes[:n], ring.nodes, rtol=0.0, atol=1e-12):
+            raise ValueError("tied_part_matrices: the tied body's first nodes are not the ring's")
+        phi = body.modes[:3 * n]
+        m_r, k_r = phi.T @ (ring.M @ phi), phi.T @ (ring.K @ phi)
+        buf = io.BytesIO()
+        np.savez(buf, mass_ring=0.5 * (m_r + m_r.T), stiffness_ring=0.5 * (k_r + k_r.T))
+        atomic_write_bytes(path, buf.getvalue())
+        return read(path)
+
+    return load_or_build(path, load, build)
 
 
 def reduced_body(spec: GearboxSpec, component: str, level: str = "coarse", progress: bool = False) -> ReducedBody:

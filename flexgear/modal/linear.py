@@ -77,7 +77,11 @@ class LinearModel:
     N s/m, N/m and their rotational counterparts]; ``coordinates``: the label of each z (a subset of the system's
     coordinates). ``full_*``: the same over all ODE2 coordinates q (for energies: the contact springs act on the
     deflection coordinates, which z leaves out). ``parts``: {frame node's first coordinate: [(component, 6x6 mass
-    matrix)]} where one rigid frame carries two components (a rigid gear and its rigid shaft as one body).
+    matrix)]} where one frame carries two components (a rigid gear and its rigid shaft as one body, or the tied
+    ring and output shaft). ``elastic_parts``: {component: (indices in ``full_coordinates`` of its body's elastic
+    coordinates q~, [(part, M_p, K_p)])} where one flexible body is two components (the tied ring and output
+    shaft, flexgear.fe.ring_shaft.tied_part_matrices): each part's share of the body's modal mass and stiffness
+    on q~, to split a mode's elastic energy between the parts.
     """
 
     variant: Variant
@@ -99,6 +103,8 @@ class LinearModel:
     # acts on delta - e where a flexible gear's dropped modes return as residual compliance); absent: none
     contact_residuals: dict[str, int] = field(default_factory=dict)
     static_residuals: dict[str, float] = field(default_factory=dict)  # contact name -> e_0 [m] at the operating point
+    elastic_parts: dict[str, tuple[np.ndarray, list[tuple[str, np.ndarray, np.ndarray]]]] = field(
+        default_factory=dict)
 
     @property
     def n(self) -> int:
@@ -214,7 +220,7 @@ def _mass_parts(variant: Variant, model, mbs) -> dict[int, list[tuple[str, np.nd
     spec = variant.gearbox
     out = {}
     for gear, end in (("sun", model.input_body), ("ring", model.output_body)):
-        if end != gear or model.bodies[gear].flexible:
+        if end != gear or (model.bodies[gear].flexible and not _tied(model.bodies[gear])):
             continue
         shaft = "input_shaft" if gear == "sun" else "output_shaft"
         if variant.rigid_mass_properties == "exact":
@@ -228,6 +234,31 @@ def _mass_parts(variant: Variant, model, mbs) -> dict[int, list[tuple[str, np.nd
         out[mbs.GetNodeODE2Index(model.bodies[gear].node)] = [
             (c, axisymmetric_frame_mass(p.mass, p.com, inertia_about_point(p), math.inf, c)[0])
             for c, p in props.items()]
+    return out
+
+
+def _tied(body) -> bool:
+    """Whether ``body`` is the tied ring and output shaft (flexgear.fe.ring_shaft: its "ring_seat" interface)."""
+    from flexgear.fe.reduced import RING_SEAT
+
+    return bool(body.flexible) and any(i.name == RING_SEAT for i in body.reduced.interfaces)
+
+
+def _elastic_parts(variant: Variant, model, mbs) -> dict[str, tuple[np.ndarray, list]]:
+    """The tied body's parts' shares of its modal mass and stiffness on its coordinates q~ (LinearModel)."""
+    from flexgear.fe.ring_shaft import tied_part_matrices
+
+    out = {}
+    for name, body in model.bodies.items():
+        if not _tied(body):
+            continue
+        nodes = getattr(body, "modal_nodes", ()) or (body.modal_node,)
+        index = np.concatenate([mbs.GetNodeODE2Index(nd) + np.arange(len(mbs.GetNode(nd)["referenceCoordinates"]))
+                                for nd in nodes])
+        t = np.eye(body.reduced.n_modes) if body.basis is None else body.basis  # q = T q~
+        parts = tied_part_matrices(variant.gearbox, variant.mesh_level)
+        out[_component_name(name)] = (index, [(part, t.T @ m_p @ t, t.T @ k_p @ t)
+                                              for part, (m_p, k_p) in parts.items()])
     return out
 
 
@@ -356,6 +387,7 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
             residuals = {model.contacts[int(r)].name: first + k for k, r in enumerate(model.residual.rows)}
         static_residuals = {name: float(q[i]) for name, i in residuals.items()}
         parts = _mass_parts(built, model, mbs)
+        elastic_parts = _elastic_parts(built, model, mbs)
     finally:
         sc.Reset()
     c = c.T if c.size else np.zeros((0, n))  # (constraints, coordinates)
@@ -366,10 +398,11 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     coords = [labels[i] for i in ind[keep]]  # z_j is the system coordinate ind[keep[j]]
     mr, kr, dr = (basis.T @ a @ basis for a in (m, k, dx))
     flexible = tuple(_component_name(nm) for nm, b in model.bodies.items() if b.flexible)
+    flexible += tuple(part for _, split in elastic_parts.values() for part, _, _ in split if part not in flexible)
     components = _components(spec.gears.planet_count)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
                        basis, tuple(labels), m, k, components, flexible, parts, static, residuals,
-                       static_residuals)
+                       static_residuals, elastic_parts)
 
 
 def _components(planets: int) -> tuple[str, ...]:

@@ -139,7 +139,10 @@ def _groups(model: LinearModel) -> dict[str, np.ndarray]:
 
 def _shares(model: LinearModel, q: np.ndarray, matrix: np.ndarray, groups: dict[str, np.ndarray],
             parts: bool) -> dict[str, np.ndarray]:
-    """Energy share of each group in each mode (module docstring); ``parts``: split joined rigid frames."""
+    """Energy share of each group in each mode (module docstring); ``parts``: split joined frames by their parts'
+    masses (kinetic energy; else the frame's energy goes to the shaft, which carries the bearing). A flexible body
+    of two components (LinearModel.elastic_parts) splits its elastic energy by its parts' shares of its modal mass
+    (``parts``) or stiffness."""
     mq = matrix @ q
     per = np.real(q.conj() * mq)  # (n_q, modes): each coordinate's part of q^H A q
     total = per.sum(axis=0)
@@ -149,6 +152,14 @@ def _shares(model: LinearModel, q: np.ndarray, matrix: np.ndarray, groups: dict[
         if not parts:
             joined, shaft = model.full_coordinates[start].component, split[-1][0]
             out[shaft], out[joined] = out[shaft] + out[joined], np.zeros_like(out[joined])
+    for component, (index, split) in model.elastic_parts.items():
+        whole = out[f"{component}_elastic"]
+        raw = [np.real(np.einsum("im,ij,jm->m", q[index].conj(), m_p if parts else k_p, q[index]))
+               for _, m_p, k_p in split]
+        s = np.sum(raw, axis=0)
+        s = np.where(np.abs(s) > 0, s, 1.0)
+        for (name, _, _), r in zip(split, raw, strict=True):
+            out[f"{name}_elastic"] = whole * r / s
     if parts:
         for start, split in model.parts.items():
             frame = q[start:start + 6]
