@@ -380,6 +380,15 @@ class PeriodicSeries:
             out = out + a * np.cos(2 * np.pi * n * phi) + b * np.sin(2 * np.pi * n * phi)
         return out
 
+    def packed(self) -> np.ndarray:
+        """The coefficients as one row (mean, cos_coeffs, sin_coeffs), the layout of the compiled evaluator
+        flexgear.laws.compiled.series_value: (1 + 2 H,), or (n, 1 + 2 H) for n series stacked harmonic-major
+        (means (n,), coefficients (H, n))."""
+        mean = np.asarray(self.mean, dtype=float)
+        rows = np.concatenate([mean[None], np.asarray(self.cos_coeffs, float).reshape(-1, *mean.shape),
+                               np.asarray(self.sin_coeffs, float).reshape(-1, *mean.shape)])
+        return np.ascontiguousarray(rows.T)
+
     @classmethod
     def fit(cls, samples: np.ndarray, harmonics: int) -> PeriodicSeries:
         """Truncated Fourier series of samples taken at phi = k / len(samples)."""
