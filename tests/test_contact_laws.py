@@ -56,7 +56,7 @@ def test_compiled_tooth_friction_is_the_regularised_coulomb_law():
         f_slide, _ = friction_forces(800.0, slip, 1.0, 1.0, 0.02, 1.0, 1.0)
         assert tooth_friction(0.02, 800.0, slip) == pytest.approx(f_slide, rel=1e-15)
     beyond = np.linspace(TANH_SATURATION, 60.0, 20001)
-    assert all(math.tanh(x) == 1.0 for x in beyond)  # the saturation bound is where tanh rounds to 1 in double precision
+    assert all(math.tanh(x) == 1.0 for x in beyond)  # where tanh rounds to 1 in double precision
 
 
 def test_drive_angle_is_step_integral():
