@@ -27,8 +27,8 @@ The teeth start in contact with zero load (delta = 0 on the driving flank). Toot
 mu F_n acts across the line of action with arms tabulated over the mesh cycle
 (:class:`flexgear.lumped.model.FrictionTables`), its direction set by the running direction,
 regularised as tanh(omega_1 p_bt / v_reg). The stiffness series and the friction law are the multibody
-model's compiled ones (flexgear.laws.compiled.series_value, tooth_friction). The input spin follows the STEP speed ramp exactly
-(prescribed); the load torque is the STEP load ramp on the output member (Table 5).
+model's compiled ones (flexgear.laws.compiled.series_value, tooth_friction). The input spin follows the STEP
+speed ramp exactly (prescribed); the load torque is the STEP load ramp on the output member (Table 5).
 
 Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps
 per recorded step), the right-hand side compiled with numba. The highest natural frequency of the
