@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 from flexgear.geometry.involute import PeriodicSeries
-from flexgear.laws.contact import ContactLaw, backlash_linear_force, friction_forces, impact_force, periodic_value
+from flexgear.laws.contact import ContactLaw, backlash_linear_force, friction_forces, impact_force
 from flexgear.laws.ramps import drive_angle, step, step_integral
 
 LAW = ContactLaw(stiffness=1e8, exponent=1.5, damping_max=1e5, penetration_depth=1e-4)
@@ -25,11 +25,18 @@ def test_impact_law_values():
     assert impact_force(1e-6, -1.0, LAW) == 0.0
 
 
-def test_periodic_value_recurrences_equal_direct_fourier_sum():
+def test_compiled_series_value_equals_direct_fourier_sum():
+    """The one compiled series evaluator (angle-addition recurrence) against the direct sum of cosines and sines."""
+    from flexgear.laws.compiled import periodic_values, series_value
+
     series = PeriodicSeries(1.0, np.array([-0.0158, 0.0087, -0.0012, 0.004]), np.array([0.01, -0.002, 0.003, 0.0]))
-    phi = np.linspace(0, 3, 301)
-    assert np.max(np.abs(periodic_value(phi, series) - series(phi))) < 1e-12
-    assert periodic_value(phi, PeriodicSeries(1.0, np.zeros(3), np.zeros(3))) == 1.0
+    phi = np.linspace(-1, 3, 401)
+    row = series.packed()
+    compiled = np.array([series_value(row, math.cos(2 * math.pi * p), math.sin(2 * math.pi * p)) for p in phi])
+    assert np.max(np.abs(compiled - series(phi))) < 1e-13
+    assert np.max(np.abs(periodic_values(phi, np.tile(row, (phi.size, 1))) - series(phi))) < 1e-13
+    assert series_value(PeriodicSeries(1.0, np.zeros(3), np.zeros(3)).packed(), 0.3, 0.9) == 1.0
+    assert series_value(np.array([0.7]), 0.3, 0.9) == 0.7  # no harmonics: the mean
 
 
 def test_friction_law():
@@ -38,6 +45,18 @@ def test_friction_law():
     assert f_slide == pytest.approx(0.02 * 800 * 0.25) and f_spin == pytest.approx(0.02 * 800 * 3e-3)
     assert friction_forces(800.0, -1000.0, 0.25, 3e-3, 0.02, 0.01, 3e-3)[1] == pytest.approx(-f_spin)
     assert friction_forces(800.0, 0.0, 0.25, 3e-3, 0.02, 0.01, 3e-3) == (0.0, 0.0)
+
+
+def test_compiled_tooth_friction_is_the_regularised_coulomb_law():
+    """mu F tanh(v / v_reg), odd in v; where it skips tanh (saturation) it returns the very number tanh gives."""
+    from flexgear.laws.compiled import TANH_SATURATION, tooth_friction
+
+    for slip in (-40.0, -19.2, -3.0, -0.4, 0.0, 1e-3, 0.7, 19.0, 19.2, 25.0, 1e6):
+        assert tooth_friction(0.02, 800.0, slip) == 0.02 * 800.0 * math.tanh(slip)
+        f_slide, _ = friction_forces(800.0, slip, 1.0, 1.0, 0.02, 1.0, 1.0)
+        assert tooth_friction(0.02, 800.0, slip) == pytest.approx(f_slide, rel=1e-15)
+    beyond = np.linspace(TANH_SATURATION, 60.0, 20001)
+    assert all(math.tanh(x) == 1.0 for x in beyond)  # where tanh rounds to 1 in double precision
 
 
 def test_drive_angle_is_step_integral():
@@ -66,13 +85,17 @@ def test_numba_twins_equal_the_laws():
 
 
 def test_compiled_forms_match_numpy():
+    """The symbolic (Exudyn) normal law with a stiffness-factor variable, as the runs use it, equals the numpy law."""
     from exudyn import symbolic as esym
 
-    d, v, t = esym.Real(2.5e-4), esym.Real(3e-3), esym.Real(0.31)
+    d, v = esym.Real(2.5e-4), esym.Real(3e-3)
     c = PeriodicSeries(1.0, np.array([-0.0158, 0.0087, -0.0012]), np.array([0.003, 0.001, -0.002]))
-    f_sym = impact_force(d, v, LAW, periodic_value(drive_angle(t, 0.5, 628.3) * 7.0 - 0.2, c, esym), esym)
-    f_np = impact_force(2.5e-4, 3e-3, LAW, periodic_value(drive_angle(0.31, 0.5, 628.3) * 7.0 - 0.2, c))
+    factor = float(c(drive_angle(0.31, 0.5, 628.3) * 7.0 - 0.2))
+    f_sym = impact_force(d, v, LAW, esym.Real("test_stiffness_factor", factor), esym)
+    f_np = impact_force(2.5e-4, 3e-3, LAW, factor)
     assert f_sym.Evaluate() == pytest.approx(float(f_np), rel=1e-12)
+    t = esym.Real(0.31)
+    assert drive_angle(t, 0.5, 628.3, esym).Evaluate() == pytest.approx(drive_angle(0.31, 0.5, 628.3), rel=1e-12)
 
 
 @pytest.mark.parametrize("law", ["impact", "iso6336"])

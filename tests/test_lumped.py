@@ -11,7 +11,7 @@ import pytest
 
 from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
 from flexgear.lumped.modal import modal_analysis
-from flexgear.lumped.model import LumpedParameters, MemberParameters, mesh_friction_tables
+from flexgear.lumped.model import LumpedParameters, MemberParameters, friction_tables, mesh_friction_tables
 from flexgear.lumped.run import run_lumped, static_mesh_forces
 from flexgear.results import signal_columns
 from flexgear.spec import load_gearbox
@@ -114,6 +114,30 @@ def test_friction_table_length_matches_stiffness_harmonics(spec):
         centre = 0.5 * (eps_a + eps_b)
         shifted = (spec_n * np.exp(2j * np.pi * np.arange(1, 4) * centre)).real
         np.testing.assert_allclose(shifted, c, atol=2e-5)
+
+
+@pytest.mark.parametrize("sign_slope", [1.0, -1.0])
+def test_friction_table_arms_match_sampled_contact_lines(sign_slope):
+    """Friction force and arms per unit mu F_n, (1/L) int sg dl and (1/L) int sg d_j dl over the contact lines, against
+    dense sampling of the lines (load uniform along them, sg = sign_slope sign(s - s_p), d1 = d1_A + p_bt s)."""
+    d1_start, d1_end, d1_pitch, d2_offset, p_bt, eps_b = 0.004, 0.0155, 0.0112, -0.1, 0.0062, 0.95
+    table = friction_tables(d1_start, d1_end, d1_pitch, d2_offset, p_bt, eps_b, sign_slope, 64)
+    eps_a, s_p = (d1_end - d1_start) / p_bt, (d1_pitch - d1_start) / p_bt
+    n_y = 4000
+    y = (np.arange(n_y) + 0.5) / n_y
+    u = table.phase[:, None, None] + np.arange(-2, 6)[None, :, None] - eps_b * y[None, None, :]
+    inside = (u >= 0.0) & (u <= eps_a)
+    sg = sign_slope * np.sign(u - s_p) * inside
+    lines = inside.sum(axis=(1, 2)) / n_y  # total length in lines across the face
+    force = sg.sum(axis=(1, 2)) / n_y / lines
+    arm1 = (sg * (d1_start + p_bt * u)).sum(axis=(1, 2)) / n_y / lines
+    # sampling error: the midpoint rule is wrong only in the cells at a line's <= 3 jumps (field ends, pitch point),
+    # by 1/n_y of a line each; at most ceil(eps_a + eps_b) + 1 = 4 lines: |dS| <= 12 / n_y, |dL| <= 8 / n_y
+    tol = (12 + 8) / (n_y * lines.min())
+    np.testing.assert_allclose(table.force, force, atol=tol)
+    np.testing.assert_allclose(table.arm1, arm1, atol=tol * max(abs(d1_start), abs(d1_end)))
+    np.testing.assert_allclose(table.arm2, arm1 + d2_offset * force, atol=tol * (max(abs(d1_start), abs(d1_end))
+                                                                                  + abs(d2_offset)))
 
 
 def test_static_mesh_force_equals_theory(spec):

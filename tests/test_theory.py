@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.geometry.involute import gear_set_geometry, inv, mesh_stiffness_harmonics
+from flexgear.geometry.involute import contact_line_distribution, gear_set_geometry, inv, mesh_stiffness_harmonics
 from flexgear.laws.ramps import step, step_integral
 from flexgear.theory import theory
 
@@ -82,3 +82,44 @@ def test_mesh_stiffness_harmonics_match_contact_line_length(eps_a, eps_b):
         numeric = 2 * np.mean(length / mean * np.exp(-2j * np.pi * n * phi))
         analytic = 2 * np.mean(model * np.exp(-2j * np.pi * n * phi))
         assert abs(numeric - analytic) < 2e-3
+
+
+def _sampled_contact_lines(phi: np.ndarray, eps_a: float, eps_b: float, x_p: float, n_y: int
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+    """Brute force: length, sliding direction and lever of the contact lines, midpoint rule over n_y face points."""
+    y = (np.arange(n_y) + 0.5) / n_y
+    length, signed, lever = np.zeros_like(phi), np.zeros_like(phi), np.zeros_like(phi)
+    teeth = range(-10, 11)
+    for k in teeth:
+        x = phi[:, None] + k - eps_b * y[None, :]
+        inside = (x >= 0) & (x <= eps_a)
+        length += inside.mean(axis=1)
+        signed += (inside * np.sign(x - x_p)).mean(axis=1)
+        lever += (inside * np.abs(x - x_p)).mean(axis=1)
+    return length, signed / length, lever / length, math.ceil(eps_a + eps_b) + 1
+
+
+@pytest.mark.parametrize(("eps_a", "eps_b", "x_p"), [(1.69, 0.95, 0.83), (2.2, 0.95, 1.3), (1.4, 0.3, 0.25)])
+def test_contact_line_integrals_match_dense_sampling(eps_a, eps_b, x_p):
+    """The closed-form contact-line integrals (both models' friction arms) against dense sampling of the face.
+
+    Sampling error bound: per contact line the midpoint rule is exact but for the cells at its <= 3 jumps (two field
+    ends, the sign change at the pitch point), each wrong by at most 1/n_y of the line times the integrand's bound;
+    with at most n_lines lines in the field, |dL| <= 2 n_lines / n_y, |dS| <= 3 n_lines / n_y,
+    |dLambda| <= 2 n_lines g / n_y (g = max |x - x_p|), and the ratios kappa = S/L, lambda = Lambda/L move by at most
+    (|dS| + |kappa| |dL|) / L and (|dLambda| + lambda |dL|) / L.
+    """
+    phi = np.arange(400) / 400
+    n_y = 20000
+    length, kappa, lever = contact_line_distribution(eps_a, eps_b, x_p, phi)
+    s_len, s_kappa, s_lever, n_lines = _sampled_contact_lines(phi, eps_a, eps_b, x_p, n_y)
+    g = max(x_p, eps_a - x_p)
+    assert np.all(np.abs(length - s_len) <= 2 * n_lines / n_y)
+    assert np.all(np.abs(kappa - s_kappa) <= (3 + 2 * np.abs(kappa)) * n_lines / (n_y * length))
+    assert np.all(np.abs(lever - s_lever) <= (2 * g + 2 * lever) * n_lines / (n_y * length))
+    # mean length over the cycle eps_alpha lines; the phase grid's mean of the piecewise-linear length is off by at
+    # most h^2 / 8 per slope change (at most 4 per line, each of 1/eps_beta)
+    assert abs(np.mean(length) - eps_a) <= 4 * n_lines / eps_b * (phi[1] - phi[0]) ** 2 / 8
+    # periodic in the mesh phase (one base pitch per cycle)
+    np.testing.assert_allclose(np.column_stack(contact_line_distribution(eps_a, eps_b, x_p, phi + 3.0)),
+                               np.column_stack((length, kappa, lever)), rtol=1e-12, atol=1e-12)

@@ -43,6 +43,8 @@ __all__ = [
     "gear_set_geometry",
     "mesh_stiffness_harmonics",
     "PeriodicSeries",
+    "SPUR_OVERLAP_RATIO",
+    "contact_line_integrals",
     "contact_line_distribution",
     "contact_line_series",
 ]
@@ -380,6 +382,15 @@ class PeriodicSeries:
             out = out + a * np.cos(2 * np.pi * n * phi) + b * np.sin(2 * np.pi * n * phi)
         return out
 
+    def packed(self) -> np.ndarray:
+        """The coefficients as one row (mean, cos_coeffs, sin_coeffs), the layout of the compiled evaluator
+        flexgear.laws.compiled.series_value: (1 + 2 H,), or (n, 1 + 2 H) for n series stacked harmonic-major
+        (means (n,), coefficients (H, n))."""
+        mean = np.asarray(self.mean, dtype=float)
+        rows = np.concatenate([mean[None], np.asarray(self.cos_coeffs, float).reshape(-1, *mean.shape),
+                               np.asarray(self.sin_coeffs, float).reshape(-1, *mean.shape)])
+        return np.ascontiguousarray(rows.T)
+
     @classmethod
     def fit(cls, samples: np.ndarray, harmonics: int) -> PeriodicSeries:
         """Truncated Fourier series of samples taken at phi = k / len(samples)."""
@@ -387,33 +398,60 @@ class PeriodicSeries:
         return cls(float(spec[0].real), 2 * spec[1:harmonics + 1].real, -2 * spec[1:harmonics + 1].imag)
 
 
-def contact_line_distribution(eps_alpha: float, eps_beta: float, pitch_position: float, phases: np.ndarray,
-                              face_samples: int = 400) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Contact lines in the field of action of a helical mesh as the mesh phase advances.
+SPUR_OVERLAP_RATIO = 1e-9
+"""Overlap ratio below which a mesh counts as spur: point contacts, one per tooth pair in contact."""
 
-    The field of action is x in [0, eps_alpha] base pitches along the line of action (x = 0 at the
-    start of contact, the pitch point at ``pitch_position``) by y in [0, 1] of the face width; the
-    contact line of tooth k lies on x = phi + k - eps_beta y. For every phase phi (cycles) returns
 
-    - length(phi): total contact-line length in units of one straight line across the face,
-    - kappa(phi) = integral of sign(s) dL / L: net direction of sliding (s = x - pitch_position),
-    - lever(phi) = integral of |s| dL / L: mean distance of the load from the pitch point [base pitches],
+def contact_line_integrals(eps_alpha: float, eps_beta: float, pitch_position: float, phases: np.ndarray
+                           ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Integrals along the contact lines in the field of action of a helical mesh, exact, as the mesh phase advances.
+
+    The field of action is x in [0, eps_alpha] base pitches along the line of action (x = 0 at the start of
+    contact, the pitch point at x_p = ``pitch_position``) by y in [0, 1] of the face width; the contact line of
+    tooth k lies on x = phi + k - eps_beta y, so that it covers [x0, x1] = [phi + k - eps_beta, phi + k] clipped to
+    the field. For every phase phi (cycles) returns, summed over the lines and in base pitches,
+
+        L = sum_k int_x0^x1 dx,   S = sum_k int_x0^x1 sign(x - x_p) dx,   M = sum_k int_x0^x1 sign(x - x_p) x dx,
+
+    each in closed form over the parts of [x0, x1] below and above x_p (per unit face width, a line across the
+    whole face has length eps_beta). For a spur mesh (eps_beta < :data:`SPUR_OVERLAP_RATIO`) every tooth pair in
+    contact (0 <= x < eps_alpha) is a point contact of weight 1. With the load uniform along the lines (as the
+    stiffness model assumes) S / L is the net direction of sliding and (M - x_p S) / L the mean distance of the load
+    from the pitch point: :func:`contact_line_distribution`, and the lumped model's friction arms
+    (flexgear.lumped.model.friction_tables).
+    """
+    phases = np.asarray(phases, dtype=float)
+    teeth = np.arange(-1, int(math.ceil(eps_alpha + eps_beta)) + 2)
+    x = np.mod(phases, 1.0)[..., None] + teeth  # the lines' ends at y = 0 (the integrals have period 1)
+    s_p = pitch_position
+    if eps_beta >= SPUR_OVERLAP_RATIO:
+        x0, x1 = np.clip(x - eps_beta, 0.0, eps_alpha), np.clip(x, 0.0, eps_alpha)
+        b1 = np.maximum(np.minimum(x1, s_p), x0)  # [x0, b1] lies below the pitch point, [a0, x1] above it
+        a0 = np.minimum(np.maximum(x0, s_p), x1)
+        signed = (x1 - a0) - (b1 - x0)
+        moment = 0.5 * ((x1**2 - a0**2) - (b1**2 - x0**2))
+        return (x1 - x0).sum(axis=-1), signed.sum(axis=-1), moment.sum(axis=-1)
+    inside = (x >= 0.0) & (x < eps_alpha)
+    signed = inside * np.sign(x - s_p)
+    return inside.sum(axis=-1).astype(float), signed.sum(axis=-1), (signed * x).sum(axis=-1)
+
+
+def contact_line_distribution(eps_alpha: float, eps_beta: float, pitch_position: float, phases: np.ndarray
+                              ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The contact lines of a helical mesh as the mesh phase advances (:func:`contact_line_integrals`, same
+    arguments). For every phase phi (cycles) returns
+
+    - length(phi) = L / eps_beta: total contact-line length in units of one straight line across the face
+      (spur: the number of tooth pairs in contact),
+    - kappa(phi) = S / L: net direction of sliding (sign(x - x_p) averaged over the load),
+    - lever(phi) = (M - x_p S) / L: mean distance |x - x_p| of the load from the pitch point [base pitches],
 
     with the load taken uniform along the contact lines (as the stiffness model assumes).
     """
-    y = (np.arange(face_samples) + 0.5) / face_samples
-    phases = np.asarray(phases, dtype=float)
-    length = np.zeros_like(phases)
-    signed = np.zeros_like(phases)
-    lever = np.zeros_like(phases)
-    for k in range(-int(eps_beta) - 2, int(eps_alpha) + 3):
-        x = phases[:, None] + k - eps_beta * y[None, :]
-        inside = (x >= 0.0) & (x <= eps_alpha)
-        s = x - pitch_position
-        length += inside.mean(axis=1)
-        signed += (inside * np.sign(s)).mean(axis=1)
-        lever += (inside * np.abs(s)).mean(axis=1)
-    return length, signed / length, lever / length
+    length, signed, moment = contact_line_integrals(eps_alpha, eps_beta, pitch_position, phases)
+    lever = (moment - pitch_position * signed) / length
+    lines = length / eps_beta if eps_beta >= SPUR_OVERLAP_RATIO else length
+    return lines, signed / length, lever
 
 
 def contact_line_series(mesh: GearMesh, face_width: float, harmonics: int, samples: int = 512

@@ -1,7 +1,12 @@
 """Compiled (numba) kernels for per-step work that cannot be an Exudyn symbolic function.
 
-Each kernel re-implements, for speed, laws defined as plain functions elsewhere; tests check that
-both give the same numbers (tests/test_contact_laws.py).
+The home of the per-step laws that both the multibody kernels (:func:`mesh_step`, :func:`mesh_friction_forces`,
+:func:`periodic_values`) and the lumped model's right-hand side (flexgear.lumped.run) evaluate: the normal laws
+(:func:`impact_normal_force`, :func:`linear_normal_force`, :func:`backlash_linear_force`), the mesh-stiffness and
+contact-line Fourier series (:func:`series_value`) and tooth friction (:func:`tooth_friction`). numba compiles a
+call of one njit function from another into the caller, so a kernel pays nothing for calling them. The numpy forms
+in flexgear.laws.contact and flexgear.geometry.involute.PeriodicSeries are the tests' references
+(tests/test_contact_laws.py).
 """
 
 from __future__ import annotations
@@ -11,9 +16,12 @@ import math
 import numpy as np
 from numba import njit
 
-__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "mesh_friction_forces",
-           "periodic_values", "ramp_state", "interpolated_columns", "turn_columns", "mesh_step", "bound_entry",
-           "padded_sparse_rows"]
+__all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "series_value", "tooth_friction",
+           "mesh_friction_forces", "periodic_values", "ramp_state", "interpolated_columns", "turn_columns",
+           "mesh_step", "bound_entry", "padded_sparse_rows"]
+
+TANH_SATURATION = 19.1
+"""|x| beyond which tanh(x) rounds to +-1 in double precision (1 - tanh(19.1) = 5e-17 < 2^-54)."""
 
 
 @njit(cache=True)
@@ -45,53 +53,78 @@ def backlash_linear_force(delta: float, delta_t: float, stiffness: float, dampin
 
 
 @njit(cache=True)
+def series_value(coeffs, cos_x: float, sin_x: float) -> float:  # pragma: no cover - compiled
+    """Value of a truncated Fourier series, f = a_0 + sum_(n=1..H) (a_n cos(n x) + b_n sin(n x)), at the angle x
+    given by its cosine and sine (x = 2 pi phi for the mesh phase phi in cycles).
+
+    ``coeffs`` = (a_0, a_1 .. a_H, b_1 .. b_H) (flexgear.geometry.involute.PeriodicSeries.packed): the
+    mesh-stiffness factor s(phi) of eq. 11-12 and the contact-line friction series kappa(phi), lambda(phi)
+    (flexgear.geometry.involute.contact_line_series).
+    cos(n x), sin(n x) by the angle-addition recurrence from cos x, sin x: no further trigonometric call.
+    """
+    n_h = (coeffs.size - 1) // 2
+    value = coeffs[0]
+    ch, sh = cos_x, sin_x  # cos, sin of h x
+    for h in range(1, n_h + 1):
+        value += coeffs[h] * ch + coeffs[n_h + h] * sh
+        ch, sh = ch * cos_x - sh * sin_x, sh * cos_x + ch * sin_x
+    return value
+
+
+@njit(cache=True)
+def tooth_friction(mu: float, normal: float, slip: float) -> float:  # pragma: no cover - compiled
+    """Regularised Coulomb tooth friction [N]: f = mu F tanh(slip), slip = v_slide / v_reg (the sliding speed
+    over the regularisation speed, signed: the running direction). tanh is not called where it rounds to +-1
+    (|slip| > :data:`TANH_SATURATION`): the same number, cheaper at speed."""
+    if slip > TANH_SATURATION:
+        sign = 1.0
+    elif slip < -TANH_SATURATION:
+        sign = -1.0
+    else:
+        sign = math.tanh(slip)
+    return mu * normal * sign
+
+
+@njit(cache=True)
 def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, damping_max, depth,  # noqa: PLR0913
-                         means, cos_c, sin_c, mu, reg, sliding_rows, spin_rows, linear=False):  # pragma: no cover
+                         series, mu, reg, sliding_rows, spin_rows, linear=False):  # pragma: no cover
     """Generalized friction forces Q = -(A^T f_slide + B^T f_spin) of all contacts.
 
-    Same law as laws.contact.impact_force (``linear``: laws.contact.linear_force; normal force with the
-    stiffness series), laws.contact.periodic_value
-    (series index 0: stiffness factor, 1: sliding direction kappa, 2: lever lambda [m]) and
-    laws.contact.friction_forces (f = mu F tanh(Omega lambda_mean / v_reg) (kappa, lambda)).
+    Per contact i at the mesh phase ``phase[i]`` [cycles]: the normal force :func:`impact_normal_force`
+    (``linear``: :func:`linear_normal_force`) with the stiffness times s(phi), the series ``series[k, i]``
+    (:func:`series_value`; k = 0: stiffness factor s, 1: sliding direction kappa, 2: lever lambda [m]) and the
+    friction f = :func:`tooth_friction` (mu, F, Omega lambda_mean / v_reg) acting as f kappa on the sliding row
+    ``sliding_rows[i]`` and f lambda on the relative-spin row ``spin_rows[i]`` (dense, (n_contacts, n_q)).
     """
-    n_c, n_h, n_q = cos_c.shape[1], cos_c.shape[2], sliding_rows.shape[1]
+    n_c, n_q = phase.shape[0], sliding_rows.shape[1]
     q = np.zeros(n_q)
-    val = np.empty(3)
     for i in range(n_c):  # explicit loops: no temporary arrays per contact (a per-step hot path)
         x = 2.0 * math.pi * phase[i]
         c1, s1 = math.cos(x), math.sin(x)
-        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
-        for k in range(3):
-            val[k] = means[k, i]
-        for h in range(n_h):
-            for k in range(3):
-                val[k] += cos_c[k, i, h] * ch + sin_c[k, i, h] * sh
-            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
+        factor = series_value(series[0, i], c1, s1)
+        sliding, lever = series_value(series[1, i], c1, s1), series_value(series[2, i], c1, s1)
         if linear:
-            normal = linear_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], damping_max[i])
+            normal = linear_normal_force(delta[i], delta_t[i], stiffness[i] * factor, damping_max[i])
         else:
-            normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * val[0], exponent[i], damping_max[i],
+            normal = impact_normal_force(delta[i], delta_t[i], stiffness[i] * factor, exponent[i], damping_max[i],
                                          depth[i])
         spin_rate = 0.0
         for j in range(n_q):
             spin_rate += spin_rows[i, j] * q_t[j]
-        f = mu[i] * normal * math.tanh(spin_rate * means[2, i] / reg[i])
+        f = tooth_friction(mu[i], normal, spin_rate * series[2, i, 0] / reg[i])
         for j in range(n_q):
-            q[j] -= sliding_rows[i, j] * (f * val[1]) + spin_rows[i, j] * (f * val[2])
+            q[j] -= sliding_rows[i, j] * (f * sliding) + spin_rows[i, j] * (f * lever)
     return q
 
 
 @njit(cache=True)
-def periodic_values(phase, means, cos_c, sin_c):  # pragma: no cover - compiled
-    """Fourier series values per contact, as laws.contact.periodic_value: cos_c, sin_c (n_contacts, n_harmonics)."""
-    out = means.copy()
+def periodic_values(phase, series):  # pragma: no cover - compiled
+    """:func:`series_value` of each contact's series ``series[i]`` (flexgear.geometry.involute.PeriodicSeries.packed)
+    at its mesh phase ``phase[i]`` [cycles]."""
+    out = np.empty(phase.shape[0])
     for i in range(phase.shape[0]):
         x = 2.0 * math.pi * phase[i]
-        c1, s1 = math.cos(x), math.sin(x)
-        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence
-        for h in range(cos_c.shape[1]):
-            out[i] += cos_c[i, h] * ch + sin_c[i, h] * sh
-            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
+        out[i] = series_value(series[i], math.cos(x), math.sin(x))
     return out
 
 
@@ -160,11 +193,12 @@ def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, col
 
     Per contact i: phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
     (:func:`ramp_state`); ``law[:, i]``: stiffness, exponent, damping_max, penetration depth, mu, v_reg, rate,
-    offset; ``series[k, i]``: mean, cos and sin coefficients (harmonics 1..n_h) of series k (0: stiffness factor,
-    1: sliding direction kappa, 2: lever lambda [m]). ``q``, ``q_t``: all ODE2 coordinates and rates (read
+    offset; ``series[k, i]``: series k (flexgear.geometry.involute.PeriodicSeries.packed; 0: stiffness factor,
+    1: sliding direction kappa, 2: lever lambda [m]), evaluated by :func:`series_value`; friction by
+    :func:`tooth_friction`. ``q``, ``q_t``: all ODE2 coordinates and rates (read
     only); the contact's tooth deflection is q[index[0, i]] less q[index[1, i]] when index[1, i] >= 0 (its
-    residual deflection, flexgear.mbs.residual). Contact i takes its series values and its friction direction
-    factor tanh(Omega lambda_mean / v_reg) from contact index[2, i] <= i (the first of the contacts that share
+    residual deflection, flexgear.mbs.residual). Contact i takes its series values and its friction slip
+    Omega lambda_mean / v_reg from contact index[2, i] <= i (the first of the contacts that share
     phase, series, spin row and v_reg, such as the helix halves of one mesh), which computes them once.
     ``frames``: the bodies' frame coordinates. The sliding and spin rows of contact i are sparse (each touches
     the 12 frame coordinates of its two gears): ``rows[0, i, k]`` and ``rows[1, i, k]`` are their entries at
@@ -172,8 +206,8 @@ def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, col
     plus :func:`mesh_friction_forces` with the dense rows.
     """
     theta = drive_speed * ramp_state(t, ramp_time)[0]
-    n_c, n_h, n_f = law.shape[1], (series.shape[2] - 1) // 2, frames.size
-    w = n_f + factor_rows.size  # work: v0, v1, v2, tanh of contact i at w + 4 i
+    n_c, n_f = law.shape[1], frames.size
+    w = n_f + factor_rows.size  # work: v0, v1, v2 and the friction slip of contact i at w + 4 i
     for j in range(n_f):
         out[j] = 0.0
     for i in range(n_c):
@@ -181,19 +215,14 @@ def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, col
         if index[2, i] == i:
             x = 2.0 * math.pi * (law[6, i] * theta - law[7, i])
             c1, s1 = math.cos(x), math.sin(x)
-            ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence, shared by the 3 series
-            v0, v1, v2 = series[0, i, 0], series[1, i, 0], series[2, i, 0]
-            for h in range(1, n_h + 1):
-                v0 += series[0, i, h] * ch + series[0, i, n_h + h] * sh
-                v1 += series[1, i, h] * ch + series[1, i, n_h + h] * sh
-                v2 += series[2, i, h] * ch + series[2, i, n_h + h] * sh
-                ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
             spin_rate = 0.0
             for k in range(columns.shape[1]):
                 spin_rate += rows[1, i, k] * q_t[frames[columns[i, k]]]
-            out[lead], out[lead + 1], out[lead + 2] = v0, v1, v2
-            out[lead + 3] = math.tanh(spin_rate * series[2, i, 0] / law[5, i])
-        v0, v1, v2, direction = out[lead], out[lead + 1], out[lead + 2], out[lead + 3]
+            out[lead] = series_value(series[0, i], c1, s1)
+            out[lead + 1] = series_value(series[1, i], c1, s1)
+            out[lead + 2] = series_value(series[2, i], c1, s1)
+            out[lead + 3] = spin_rate * series[2, i, 0] / law[5, i]
+        v0, v1, v2, slip = out[lead], out[lead + 1], out[lead + 2], out[lead + 3]
         d, d_t = q[index[0, i]], q_t[index[0, i]]
         if index[1, i] >= 0:
             d -= q[index[1, i]]
@@ -202,7 +231,7 @@ def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, col
             normal = linear_normal_force(d, d_t, law[0, i] * v0, law[2, i])
         else:
             normal = impact_normal_force(d, d_t, law[0, i] * v0, law[1, i], law[2, i], law[3, i])
-        f = law[4, i] * normal * direction
+        f = tooth_friction(law[4, i], normal, slip)
         for k in range(columns.shape[1]):
             out[columns[i, k]] -= rows[0, i, k] * (f * v1) + rows[1, i, k] * (f * v2)
     for k in range(factor_rows.size):

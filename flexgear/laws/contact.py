@@ -2,8 +2,10 @@
 
 Two normal laws, chosen by ``[contact] law``: the ADAMS impact law of the study (section 2.1,
 "impact") and a linear mesh stiffness from ISO 6336-1 with the damping of eq. 13 ("iso6336",
-:func:`linear_force`, stiffness from :mod:`flexgear.laws.iso6336`); the periodic mesh-stiffness
-series of eq. 11-12 and tooth friction. Their compiled (numba) twins are in :mod:`flexgear.laws.compiled`.
+:func:`linear_force`, stiffness from :mod:`flexgear.laws.iso6336`), and tooth friction. These numpy forms are
+the references the tests hold the per-step kernels to; the kernels of both models (multibody and lumped) evaluate
+the laws, the mesh-stiffness series of eq. 11-12 and tooth friction with the compiled functions of
+:mod:`flexgear.laws.compiled` (the series' numpy reference is flexgear.geometry.involute.PeriodicSeries).
 """
 
 from __future__ import annotations
@@ -14,11 +16,10 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.geometry.involute import PeriodicSeries
 from flexgear.spec import Contact, GearboxSpec
 
-__all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "periodic_value",
-           "friction_forces", "mesh_damping", "mesh_laws"]
+__all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "friction_forces",
+           "mesh_damping", "mesh_laws"]
 
 LAWS = ("impact", "iso6336")
 
@@ -142,28 +143,6 @@ def backlash_linear_force(delta: Any, delta_t: Any, stiffness: Any, damping: Any
     back = stiffness * (delta + backlash) + damping * delta_t
     out = np.where(delta > 0.0, drive, np.where(delta < -backlash, back, 0.0))
     return float(out) if np.ndim(out) == 0 else out
-
-
-def periodic_value(phase_cycles: Any, series: PeriodicSeries, m: Any = np) -> Any:
-    """Value of a Fourier series in the mesh phase (cycles); ``m`` is numpy or ``exudyn.symbolic``.
-
-    Uses one cosine and one sine and the recurrences cos(n x) = 2 cos(x) cos((n-1) x) - cos((n-2) x),
-    sin(n x) = sin(x) U_(n-1)(cos x) with U_n = 2 cos(x) U_(n-1) - U_(n-2): short compiled expressions.
-    """
-    out = series.mean
-    if len(series.cos_coeffs) == 0 or not (np.any(series.cos_coeffs) or np.any(series.sin_coeffs)):
-        return out
-    x = 2.0 * math.pi * phase_cycles
-    c1, s1 = m.cos(x), m.sin(x)
-    t_prev, t_cur = 1.0, c1  # Chebyshev T_(n-1), T_n
-    u_prev, u_cur = 0.0, 1.0  # U_(n-2), U_(n-1)
-    for a, b in zip(series.cos_coeffs, series.sin_coeffs, strict=True):
-        if np.ndim(a) == 0:  # plain numbers (symbolic expressions need Python floats)
-            a, b = float(a), float(b)
-        out = out + a * t_cur + b * s1 * u_cur
-        t_prev, t_cur = t_cur, 2.0 * c1 * t_cur - t_prev
-        u_prev, u_cur = u_cur, 2.0 * c1 * u_cur - u_prev
-    return out
 
 
 def friction_forces(normal_force: Any, relative_spin: Any, sliding: Any, lever: Any, mu: float,

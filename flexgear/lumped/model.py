@@ -33,7 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.geometry.involute import GearSetGeometry, contact_line_integrals, gear_set_geometry
 from flexgear.geometry.massprops import combine_mass_properties
 from flexgear.geometry.supports import condensed_radial_stiffness, gearbox_supports
 from flexgear.laws.contact import mesh_damping, mesh_laws
@@ -369,39 +369,22 @@ class FrictionTables:
 
 def friction_tables(d1_start: float, d1_end: float, d1_pitch: float, d2_offset: float, base_pitch: float,
                     eps_beta: float, sign_slope: float, points: int) -> FrictionTables:
-    """Tabulate :class:`FrictionTables` of one mesh.
+    """Tabulate :class:`FrictionTables` of one mesh from the integrals along its contact lines
+    (flexgear.geometry.involute.contact_line_integrals, the multibody model's friction series too).
 
     ``d1_start``, ``d1_end``, ``d1_pitch``: arm d1 = (C - O_1) . n [m] at the start and end of active
     contact and at the pitch point; ``d2_offset`` = (O_1 - O_2) . n, so d2 = d1 + d2_offset;
-    ``sign_slope`` = +1 if the sliding velocity of gear 1 on gear 2 (forward running) grows with s.
+    ``sign_slope`` = +1 if the sliding velocity of gear 1 on gear 2 (forward running) grows with s. With
+    sg = sign_slope sign(s - s_p), d1 = d1_start + p_bt s and the integrals L, S, M (s in base pitches):
+    force = (1/L) int sg dl = sign_slope S / L, arm1 = (1/L) int sg d1 dl = sign_slope (d1_start S + p_bt M) / L.
     """
-    eps_a = (d1_end - d1_start) / base_pitch
-    s_p = (d1_pitch - d1_start) / base_pitch
     phase = np.arange(points) / points
-    ks = np.arange(-1, int(math.ceil(eps_a + eps_beta)) + 2)
-    u = phase[:, None] + ks[None, :]  # (points, teeth)
-
-    def signed_integrals(s0: np.ndarray, s1: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """int ds, int sg ds, int sg s ds over [s0, s1] (sg = sign(s - s_p) * sign_slope)."""
-        b0, b1 = s0, np.maximum(np.minimum(s1, s_p), s0)  # part below the pitch point
-        a0, a1 = np.minimum(np.maximum(s0, s_p), s1), s1  # part above it
-        i0 = (a1 - a0) - (b1 - b0)
-        i1 = 0.5 * ((a1**2 - a0**2) - (b1**2 - b0**2))
-        return s1 - s0, sign_slope * i0, sign_slope * i1
-
-    if eps_beta > 1e-9:
-        s0 = np.clip(u - eps_beta, 0.0, eps_a)
-        s1 = np.clip(u, 0.0, eps_a)
-        length, i0, i1 = signed_integrals(s0, s1)
-    else:  # spur gears: point contacts, equal load per tooth pair in contact
-        inside = (u >= 0.0) & (u < eps_a)
-        length = inside.astype(float)
-        sg = np.sign(u - s_p) * sign_slope
-        i0, i1 = inside * sg, inside * sg * u
-    L, I0, I1 = length.sum(1), i0.sum(1), i1.sum(1)
-    d1_mean = (d1_start * I0 + base_pitch * I1) / L  # int sg d1 = d1_A int sg + p_bt int sg s
-    force = I0 / L
-    return FrictionTables(phase, L / L.mean(), force, d1_mean, d1_mean + d2_offset * force)
+    length, signed, moment = contact_line_integrals((d1_end - d1_start) / base_pitch, eps_beta,
+                                                    (d1_pitch - d1_start) / base_pitch, phase)
+    i0, i1 = sign_slope * signed, sign_slope * moment
+    arm1 = (d1_start * i0 + base_pitch * i1) / length
+    force = i0 / length
+    return FrictionTables(phase, length / length.mean(), force, arm1, arm1 + d2_offset * force)
 
 
 def mesh_friction_tables(spec_geo: GearSetGeometry, points: int) -> tuple[FrictionTables, FrictionTables]:

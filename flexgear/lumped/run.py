@@ -25,9 +25,10 @@ phi_m is the mesh phase (mesh cycles) from the sun or ring spin, each planet pha
 (sun mesh: z_s (theta_s - psi_i) / 2 pi; ring mesh: -z_r (theta_r - psi_i) / 2 pi + outer-inner phase).
 The teeth start in contact with zero load (delta = 0 on the driving flank). Tooth friction
 mu F_n acts across the line of action with arms tabulated over the mesh cycle
-(:class:`flexgear.lumped.run.model.FrictionTables`), its direction set by the running direction,
-regularised as tanh(omega_1 p_bt / v_reg). The input spin follows the STEP speed ramp exactly
-(prescribed); the load torque is the STEP load ramp on the output member (Table 5).
+(:class:`flexgear.lumped.model.FrictionTables`), its direction set by the running direction,
+regularised as tanh(omega_1 p_bt / v_reg). The stiffness series and the friction law are the multibody
+model's compiled ones (flexgear.laws.compiled.series_value, tooth_friction). The input spin follows the STEP
+speed ramp exactly (prescribed); the load torque is the STEP load ramp on the output member (Table 5).
 
 Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps
 per recorded step), the right-hand side compiled with numba. The highest natural frequency of the
@@ -46,7 +47,14 @@ import numpy as np
 import pandas as pd
 
 from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
-from flexgear.laws.compiled import backlash_linear_force, impact_normal_force, padded_sparse_rows, ramp_state
+from flexgear.laws.compiled import (
+    backlash_linear_force,
+    impact_normal_force,
+    padded_sparse_rows,
+    ramp_state,
+    series_value,
+    tooth_friction,
+)
 from flexgear.laws.contact import mesh_laws
 from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
 from flexgear.progress import Progress
@@ -150,20 +158,6 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
 
 
 # --------------------------------------------------------------------------- compiled kernel
-_TANH_SATURATION = 19.1
-"""|x| beyond which tanh(x) rounds to +-1 in double precision (1 - tanh(19.1) = 5e-17 < 2^-53)."""
-
-
-@numba.njit(cache=True)
-def _tanh(x: float) -> float:  # pragma: no cover - compiled
-    """tanh(x), exact in double precision, without the call where it saturates (the friction direction at speed)."""
-    if x > _TANH_SATURATION:
-        return 1.0
-    if x < -_TANH_SATURATION:
-        return -1.0
-    return math.tanh(x)
-
-
 @numba.njit(cache=True, inline="always")  # inlined into _integrate's RK4 stages (no 35-array call per stage)
 def _evaluate(t, y, model, work):
     """Accelerations ``acc`` (all coordinates, rotating frame), forces and the recorded signals ``out``.
@@ -212,13 +206,8 @@ def _evaluate(t, y, model, work):
             d += gval[m, k] * q[gidx[m, k]]
             dd += gval[m, k] * qd[gidx[m, k]]
         phase = pcoefm[m] * q[pidx[m]] + poff[m]
-        kf = 1.0
         ca, sa = trig[0, group[m]], trig[1, group[m]]  # x = 2 pi (phase - centre) = A_g + B_m
-        c1, s1 = ca * rot_b[0, m] - sa * rot_b[1, m], sa * rot_b[0, m] + ca * rot_b[1, m]
-        ch, sh = c1, s1  # cos, sin of (h + 1) x by the angle-addition recurrence
-        for h in range(harm.shape[1]):
-            kf += harm[m, h] * ch
-            ch, sh = ch * c1 - sh * s1, sh * c1 + ch * s1
+        kf = series_value(harm[m], ca * rot_b[0, m] - sa * rot_b[1, m], sa * rot_b[0, m] + ca * rot_b[1, m])
         if fp[_IMPACT] > 0.0:  # the impact law on the driving flank, mirrored on the back flank
             if d >= 0.0:
                 F = impact_normal_force(d, dd, km[m] * kf, fp[_EXPONENT], cm[m], fp[_DEPTH])
@@ -244,7 +233,7 @@ def _evaluate(t, y, model, work):
             a2 = tables[ty, i0, 2] * (1.0 - wt) + tables[ty, i1, 2] * wt
             b1 = 0 if ty == 0 else 3 + m - km.size // 2
             b2 = 3 + m if ty == 0 else 1
-            ff = mu * F * _tanh(g1[m] * qd[3 * b1 + 2] * fscale[m])
+            ff = tooth_friction(mu, F, g1[m] * qd[3 * b1 + 2] * fscale[m])
             f[3 * b2] += ff * fa * tau[m, 0]
             f[3 * b2 + 1] += ff * fa * tau[m, 1]
             f[3 * b1] -= ff * fa * tau[m, 0]
@@ -335,11 +324,18 @@ def _phase_groups(model: LumpedModel) -> tuple[np.ndarray, np.ndarray, np.ndarra
     return group, np.ascontiguousarray(index), rate, np.ascontiguousarray(np.stack([np.cos(b), np.sin(b)]))
 
 
+def _stiffness_series(model: LumpedModel) -> np.ndarray:
+    """Each mesh's stiffness factor k(t)/k_mean as a series in x = 2 pi (phi - centre) (eq. 11-12: mean 1, cosine
+    coefficients c_n, no sine terms), in the layout of flexgear.laws.compiled.series_value."""
+    c = model.harmonics
+    return np.ascontiguousarray(np.hstack([np.ones((c.shape[0], 1)), c, np.zeros_like(c)]))
+
+
 def _kernel_args(model: LumpedModel) -> tuple:
     s = model.system
     return (model.fp, model.ip, s.mass, *_sparse_rows(s.support_stiffness, s.support_damping),
             *padded_sparse_rows(s.mesh_G), model.mesh_k,
-            model.mesh_c, model.free, model.presc, model.presc_coef, model.harmonics, model.phase_centre,
+            model.mesh_c, model.free, model.presc, model.presc_coef, _stiffness_series(model), model.phase_centre,
             model.phase_index, model.phase_coef, model.phase_offset, model.backlash, model.tables, model.mesh_type,
             model.tau, model.g1, model.friction_scale, model.ground_damping, model.spin_support,
             s.nominal_position, s.free & (s.mass > 0.0), *_phase_groups(model))

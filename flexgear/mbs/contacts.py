@@ -29,7 +29,7 @@ import numpy as np
 
 from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_series, tooth_normal_local
 from flexgear.geometry.pair import _EZ, helix_halves
-from flexgear.laws.contact import ContactLaw, friction_forces, normal_force, periodic_value
+from flexgear.laws.contact import ContactLaw, friction_forces, normal_force
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body, normal_lever, resting_node
 from flexgear.mbs.elements import _keep_alive
@@ -202,19 +202,20 @@ class StiffnessSchedule:
         self._cos = np.ascontiguousarray(np.atleast_2d(self.series.cos_coeffs).T)
         self._sin = np.ascontiguousarray(np.atleast_2d(self.series.sin_coeffs).T)
         self._means = np.asarray(self.series.mean, float) * np.ones(len(variables))
+        self._packed = self.series.packed()
         self(None, 0.0)
 
     def values(self, t: float) -> np.ndarray:
-        """Factors at time t (reference implementation, numpy)."""
+        """Factors at time t (reference implementation, numpy: the series' direct Fourier sum)."""
         phase = self.rate * float(drive_angle(t, self.ramp_time, self.drive_speed)) - self.offsets
-        return np.asarray(periodic_value(phase, self.series), float) * np.ones(len(self.variables))
+        return np.asarray(self.series(phase), float) * np.ones(len(self.variables))
 
     def fast_values(self, t: float) -> np.ndarray:
         """Same as :meth:`values`, compiled (flexgear.laws.compiled.periodic_values)."""
         from flexgear.laws.compiled import periodic_values, ramp_state
 
         phase = self.rate * (self.drive_speed * ramp_state(float(t), self.ramp_time)[0]) - self.offsets
-        return periodic_values(phase, self._means, self._cos, self._sin)
+        return periodic_values(phase, self._packed)
 
     def __call__(self, mbs, t: float) -> bool:
         for var, value in zip(self.variables, self.fast_values(t).tolist(), strict=True):
@@ -268,13 +269,14 @@ class MeshFriction:
         self._sin = np.ascontiguousarray([np.atleast_2d(self.series[k].sin_coeffs).T
                                           for k in ("stiffness", "sliding", "lever")])
         self._means = np.array([self.series[k].mean for k in ("stiffness", "sliding", "lever")])
+        self._packed = np.ascontiguousarray([self.series[k].packed() for k in ("stiffness", "sliding", "lever")])
         self._index: tuple[np.ndarray, np.ndarray] | None = None
         self._force: np.ndarray | None = None
 
     def forces(self, t: float, delta: np.ndarray, delta_t: np.ndarray, q_t: np.ndarray) -> np.ndarray:
         """Generalized friction forces on the frame coordinates (reference implementation, numpy)."""
         phase = self.phase_rate * drive_angle(t, self.ramp_time, self.drive_speed) - self.offsets
-        value = {name: periodic_value(phase, series) for name, series in self.series.items()}
+        value = {name: series(phase) for name, series in self.series.items()}
         normal = normal_force(delta, delta_t, self.law, value["stiffness"])
         f_slide, f_spin = friction_forces(normal, self.spin_rows @ q_t, value["sliding"], value["lever"],
                                           self.mu, self.reg, self.series["lever"].mean)
@@ -288,7 +290,7 @@ class MeshFriction:
         law = self.law
         return mesh_friction_forces(
             phase, delta, delta_t, q_t, law.stiffness, law.exponent, law.damping_max, law.penetration_depth,
-            self._means, self._cos, self._sin, self.mu, self.reg, self.sliding_rows, self.spin_rows,
+            self._packed, self.mu, self.reg, self.sliding_rows, self.spin_rows,
             law.kind == "iso6336")
 
     def deflection_indices(self, mbs) -> np.ndarray:
