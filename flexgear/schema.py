@@ -298,8 +298,11 @@ REMOVED_FIELDS: dict[str, str] = {
     "reduction_assumed.modal_coordinates": "linear joints and seats always have interface coordinates (production)",
     "reduction_assumed.residual_seat_loads": "a gear's dropped modes answer its seat's own load (production)",
     "supports_assumed": "bearings, drive and load act at the bearing seats, the only placement",
-    "joints_assumed.ring_output_shaft": "the ring and the output shaft are joined per bolt (section 2.1)",
-    "joints_assumed.bolt_patch": "each bolt patch is a rigid clamped disc",
+    "joints_assumed.ring_output_shaft": ("the ring and the output shaft are tied over the bolts' clamped discs "
+                                          "(section 2.1): one body when both are flexible, one rigid bolt-patch "
+                                          "interface and one joint otherwise"),
+    "joints_assumed.bolt_patch": ("the clamped discs move with the rigid partner, or are tied node to face when both "
+                                  "parts are flexible"),
     "joints_assumed.joint_equations": f"{_REFERENCE} ObjectJointGeneric",
     "joints_assumed.joint_axes": "a joint is written in body axes where its shaft is flexible, else in ground axes",
 }
