@@ -4,7 +4,7 @@ Every body, rigid or flexible, has its reference frame on one ``NodeRigidBodyRxy
 at the gear centre with the z axis along the rotation axis. Coordinates of that node are
 (u_x, u_y, u_z, phi_x, phi_y, phi_z); phi_z is the unwrapped spin angle and, for small tilts,
 phi_x and phi_y are the tilt angles in the ground frame (R = R_x(phi_x) R_y(phi_y) R_z(phi_z)).
-Bushings, drives and gear contacts act on these frame coordinates, whatever the body's form.
+Bearings on frames, drives and gear contacts act on these frame coordinates, whatever the body's form.
 
 The frame's inertia is, in the production formulation, :func:`add_linear_frame`: the same body to first order
 in the tilts about its prescribed spin Omega,
