@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.geometry.elements import lever_rows
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
 __all__ = ["Body", "LinearFrame", "add_frame_inertia", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass",
@@ -133,11 +134,9 @@ def add_linear_frame(mbs, name: str, node: int, mass: float, com, inertia, spin_
 
 def frame_rows(point: np.ndarray) -> np.ndarray:
     """(6, 6): translation at ``point`` [m] and rotation of a body per frame translation and small rotation
-    (u, phi), [I, -p~; 0, I] (u + phi x p, phi)."""
-    x, y, z = (float(v) for v in point)
-    out = np.eye(6)
-    out[:3, 3:] = -np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return out
+    (u, phi), [I, -p~; 0, I] (u + phi x p, phi): the rigid lever from the frame origin to ``point``
+    (flexgear.geometry.elements.lever_rows)."""
+    return lever_rows(point)
 
 
 def normal_lever(point: np.ndarray, normal: np.ndarray, about: np.ndarray) -> np.ndarray:
