@@ -59,8 +59,8 @@ def build(mbs, spec):
     contact = dataclasses.replace(spec.contact, damping_fraction_of_stiffness=DAMPING_FRACTION)
     contacts = fg.pair_contacts("mesh", "pinion", "wheel", mesh, np.zeros(3), centre2, contact,
                                 spec.contact_assumed, hand=1, drive_sign=1.0)
-    bushings = [fg.Bushing(name, RADIAL_N_PER_M, AXIAL_N_PER_M, TILT_NM_PER_RAD, DAMPING_PER_STIFFNESS_S)
-                for name in ("pinion", "wheel")]
+    bushings = [fg.BearingElement.axisymmetric(name, RADIAL_N_PER_M, AXIAL_N_PER_M, TILT_NM_PER_RAD,
+                                               DAMPING_PER_STIFFNESS_S) for name in ("pinion", "wheel")]
     train = fg.add_gear_train(mbs, [pinion, wheel], bushings, contacts, RAMP_S, w_in, extra_pre_steps=[spin],
                               contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                               radial_band=MODULE_M)

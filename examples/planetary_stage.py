@@ -60,13 +60,14 @@ def build(mbs, spec):
         contacts += fg.pair_contacts(f"planet_ring{i + 1}", f"planet{i + 1}", "ring", planet_ring, c, np.zeros(3),
                                      hand=-1, drive_sign=-1.0, spins=(w_planet, 0.0), phase_offset=phase, **common)
     b = spec.bearings
-    bushings = [fg.Bushing.from_bearing("sun", b.input_shaft), fg.Bushing.from_bearing("ring", b.output_shaft),
-                fg.Bushing.from_bearing("carrier", b.output_shaft)]
+    bushings = [fg.BearingElement.from_bearing(bearing, body) for bearing, body in
+                ((b.input_shaft, "sun"), (b.output_shaft, "ring"), (b.output_shaft, "carrier"))]
     w_in = INPUT_SPEED_RPM * 2 * math.pi / 60
     train = fg.add_gear_train(mbs, bodies, bushings, contacts, RAMP_S, w_in,
                               carrier=fg.Carrier("carrier", ratio))
     for i in range(N_PLANETS):
-        fg.add_planet_bearing(mbs, by["carrier"], by[f"planet{i + 1}"], b.planet)
+        fg.add_planet_bearing(mbs, by["carrier"], by[f"planet{i + 1}"],
+                              fg.BearingElement.from_bearing(b.planet, f"planet{i + 1}", other="carrier"))
     fg.add_fixed_joint(mbs, by["ring"], coordinates=(5,))  # ring held against spinning
     drive = fg.add_speed_drive(mbs, by["sun"], RAMP_S, w_in)
     fg.add_load_torque(mbs, by["carrier"], -LOAD_TORQUE_NM, RAMP_S)

@@ -3,7 +3,8 @@
 The public API (``__all__``) builds any gearbox in a few lines: gear geometry (``gear_pair_geometry``),
 bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``; parts bolted or
 bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``), bearings
-(``Bushing``, ``add_planet_bearing``), fixed joints (``add_fixed_joint``, ``add_interface_joint``), gear
+(``BearingElement``: a 6x6 stiffness and damping about a point on an axis, ``Bushing`` on a body frame,
+``add_planet_bearing``), fixed joints (``FixedJointElement``, ``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
 on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
 (``Recorder``, ``solve``). The GTF star gearbox of the reference study is built from the same parts
@@ -26,6 +27,7 @@ _LAZY = {
     "HelixHalf": "geometry.pair", "helix_halves": "geometry.pair", "gear_pair_geometry": "geometry.pair",
     "annulus_mass_properties": "geometry.massprops",
     "MassProperties": "geometry.massprops", "combine_mass_properties": "geometry.massprops",
+    "BearingElement": "geometry.elements", "FixedJointElement": "geometry.elements",
     # FE and reduction
     "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.tied",
     "Tie": "fe.tied", "TiedFE": "fe.tied", "tie_parts": "fe.tied",

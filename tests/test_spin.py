@@ -138,17 +138,27 @@ def test_production_keeps_the_reference_signals(case):
 
 
 def test_seat_bearing_matrix_is_the_three_springs(gearbox):
-    """The linear seat's 6x6 stiffness equals the three springs' (flexgear.geometry.supports): radial k_r, axial
-    k_a, tilt k_t about the centre (two rows of k_r/2 at +-sqrt(k_t/k_r)), no translation-tilt coupling."""
+    """The linear seat's 6x6 stiffness (the bearing element's, flexgear.geometry.elements) equals the three
+    springs' sum the reference formulation puts on the axis: radial k_r, axial k_a, tilt k_t about the centre (two
+    rows of k_r/2 at +-sqrt(k_t/k_r)), no translation-tilt coupling; damping the springs' dampers summed."""
     from flexgear.geometry.supports import gearbox_supports
-    from flexgear.mbs.joints import seat_matrices
+    from flexgear.mbs.bodies import frame_rows
 
     sup = gearbox_supports(gearbox)["output_shaft"]
-    k6, d6 = seat_matrices(sup)
-    expected = np.diag([sup.radial_stiffness, sup.radial_stiffness, sup.axial_stiffness,
-                        sup.tilt_stiffness, sup.tilt_stiffness, 0.0])
-    assert np.allclose(k6, expected, rtol=1e-12, atol=1e-9 * sup.radial_stiffness)
-    assert np.allclose(d6, sup.damping_per_stiffness * k6)
+    k6, d6 = sup.stiffness, sup.damping
+    springs, dampers = np.zeros((6, 6)), np.zeros((6, 6))
+    for spring in sup.axis_springs():
+        b = frame_rows(spring.point - sup.centre)[:3]
+        springs += b.T @ np.diag(spring.stiffness) @ b
+        dampers += b.T @ np.diag(spring.damping) @ b
+    table = gearbox.bearings.output_shaft
+    expected = np.diag([table.radial_stiffness_n_per_m, table.radial_stiffness_n_per_m,
+                        table.axial_stiffness_n_per_m, table.tilt_stiffness_nm_per_rad,
+                        table.tilt_stiffness_nm_per_rad, 0.0])
+    assert np.allclose(k6, expected, rtol=1e-12, atol=1e-9 * table.radial_stiffness_n_per_m)
+    assert np.allclose(springs, k6, rtol=1e-12, atol=1e-9 * table.radial_stiffness_n_per_m)
+    assert np.allclose(d6, table.damping_per_stiffness_s * k6)
+    assert np.allclose(dampers, d6, rtol=1e-12, atol=1e-9 * np.abs(d6).max())
 
 
 def test_turning_blocks_kernel_equals_the_rotation():

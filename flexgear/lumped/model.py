@@ -35,7 +35,7 @@ import numpy as np
 
 from flexgear.geometry.involute import GearSetGeometry, contact_line_integrals, gear_set_geometry
 from flexgear.geometry.massprops import combine_mass_properties
-from flexgear.geometry.supports import condensed_radial_stiffness, gearbox_supports
+from flexgear.geometry.supports import gearbox_supports
 from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
@@ -139,7 +139,7 @@ class LumpedParameters:
           shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*)
         - bearing stiffness: the Table 2 bearing at its seat (flexgear.geometry.supports)
           condensed to the gear centre, 1/k = 1/k_r + L^2/k_t (L: gear to bearing centre; the tilt statically
-          condensed); damping c = k * damping_per_stiffness_s
+          condensed); damping condensed likewise (c = k * damping_per_stiffness_s)
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width
         - mesh damping: eq. 13, c = 2 xi sqrt(k_m m_1 m_2 / (m_1 + m_2)) with the gear masses
           (the study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m)
@@ -160,9 +160,9 @@ class LumpedParameters:
             if held:
                 return MemberParameters.from_inertia(max(mass, 0.0), inertia, radius, math.inf)
             # the bearing at its seat condensed to the gear centre (flexgear.geometry.supports)
-            k = condensed_radial_stiffness(supports[bearing])
+            k = supports[bearing].condensed_radial_stiffness()
             return MemberParameters.from_inertia(mass, inertia, radius, k,
-                                                 bearing_damping_n_s_per_m=k * supports[bearing].damping_per_stiffness)
+                                                 bearing_damping_n_s_per_m=supports[bearing].condensed_radial_damping())
 
         def mi(*names: str) -> tuple[float, float]:
             """Apparent in-plane mass at the gear centre and spin inertia of the rigidly joined parts.

@@ -4,7 +4,7 @@ Every body, rigid or flexible, has its reference frame on one ``NodeRigidBodyRxy
 at the gear centre with the z axis along the rotation axis. Coordinates of that node are
 (u_x, u_y, u_z, phi_x, phi_y, phi_z); phi_z is the unwrapped spin angle and, for small tilts,
 phi_x and phi_y are the tilt angles in the ground frame (R = R_x(phi_x) R_y(phi_y) R_z(phi_z)).
-Bushings, drives and gear contacts act on these frame coordinates, whatever the body's form.
+Bearings on frames, drives and gear contacts act on these frame coordinates, whatever the body's form.
 
 The frame's inertia is, in the production formulation, :func:`add_linear_frame`: the same body to first order
 in the tilts about its prescribed spin Omega,
@@ -27,6 +27,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.geometry.elements import lever_rows
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
 __all__ = ["Body", "LinearFrame", "add_frame_inertia", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass",
@@ -133,11 +134,9 @@ def add_linear_frame(mbs, name: str, node: int, mass: float, com, inertia, spin_
 
 def frame_rows(point: np.ndarray) -> np.ndarray:
     """(6, 6): translation at ``point`` [m] and rotation of a body per frame translation and small rotation
-    (u, phi), [I, -p~; 0, I] (u + phi x p, phi)."""
-    x, y, z = (float(v) for v in point)
-    out = np.eye(6)
-    out[:3, 3:] = -np.array([[0.0, -z, y], [z, 0.0, -x], [-y, x, 0.0]])
-    return out
+    (u, phi), [I, -p~; 0, I] (u + phi x p, phi): the rigid lever from the frame origin to ``point``
+    (flexgear.geometry.elements.lever_rows)."""
+    return lever_rows(point)
 
 
 def normal_lever(point: np.ndarray, normal: np.ndarray, about: np.ndarray) -> np.ndarray:

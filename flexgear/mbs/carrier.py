@@ -1,10 +1,11 @@
 """A rotating carrier: planet bearings on the carrier and the contacts' geometry turning with it.
 
-Planet bearing: an ``ObjectConnectorCartesianSpringDamper`` from a ``MarkerBodyPosition`` at the pin
-on the carrier to the planet's frame node (radial stiffness in x, y, axial in z: the bearing is
-isotropic about the axis, so the carrier's spin does not matter), plus tilt springs between the
-planet's and the carrier's tilt coordinates (both ground-frame tilts for small tilts); the planet's
-spin relative to the carrier stays free.
+Planet bearing: the planet's bearing element (flexgear.geometry.elements.BearingElement, the carrier on its
+other side) at the planet's frame origin, realised as an ``ObjectConnectorCartesianSpringDamper`` from a
+``MarkerBodyPosition`` at the pin on the carrier to the planet's frame node (radial stiffness in x, y, axial in
+z: the bearing is isotropic about the axis, so the carrier's spin does not matter), plus tilt springs between
+the planet's and the carrier's tilt coordinates (both ground-frame tilts for small tilts); the planet's spin
+relative to the carrier stays free.
 
 Contacts (flexgear.mbs.contacts.GearContact) are linearised at the reference configuration, carrier
 angle 0. With the carrier at angle theta every contact's pitch point, normal and planet centre are
@@ -31,9 +32,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.geometry.elements import BearingElement
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body
-from flexgear.spec import Bearing
 
 __all__ = ["Carrier", "CarrierKinematics", "add_planet_bearing"]
 
@@ -109,13 +110,17 @@ class CarrierKinematics:
         return True
 
 
-def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: Bearing, name: str | None = None) -> list[int]:
-    """Bearing of ``planet`` on its pin of ``carrier`` (Table 2 style stiffnesses, spin free).
+def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: BearingElement, name: str | None = None
+                       ) -> list[int]:
+    """The ``bearing`` of ``planet`` on its pin of ``carrier`` (its DOF map: body ``planet.name``, other
+    ``carrier.name``), the spin free.
 
-    Translation: ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) between the pin
-    (the planet's reference centre, fixed in the carrier) and the planet's frame node; tilt: a
-    coordinate spring k_t between the planet's and the carrier's tilt coordinates about x and y.
-    Damping c = k * damping_per_stiffness. Returns the connectors.
+    Moved to the planet's frame origin (:meth:`BearingElement.at`), where it must be diag(k_r, k_r, k_a, k_t, k_t, 0)
+    (a bearing centred on the planet's frame; ValueError otherwise). Translation: an
+    ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries between
+    the pin (the planet's reference centre, fixed in the carrier) and the planet's frame node; tilt: a coordinate
+    spring-damper k_t between the planet's and the carrier's tilt coordinates about x and y. Returns the
+    connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
@@ -125,20 +130,22 @@ def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: Bearing, name:
         ObjectConnectorCoordinateSpringDamper,
     )
 
+    if (bearing.body, bearing.other) != (planet.name, carrier.name):
+        raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed as {planet.name!r} on "
+                         f"{carrier.name!r}")
+    at_frame = bearing.at(np.zeros(3))
+    k_r, k_a, k_t = at_frame.axisymmetric_entries()
+    d_r, d_a, d_t = at_frame.axisymmetric_entries(at_frame.damping)
     label = name or f"bearing_{planet.name}"
-    k = np.array([bearing.radial_stiffness_n_per_m, bearing.radial_stiffness_n_per_m, bearing.axial_stiffness_n_per_m])
-    c = bearing.damping_per_stiffness_s
     pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
                                            localPosition=list(planet.position - carrier.position)))
     out = [mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         name=label, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=planet.node))],
-        stiffness=list(k), damping=list(c * k)))]
-    kt = bearing.tilt_stiffness_nm_per_rad
+        stiffness=[k_r, k_r, k_a], damping=[d_r, d_r, d_a]))]
     for axis in (3, 4):
         out.append(mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=f"{label}_tilt{axis - 2}",
             markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=carrier.node, coordinate=axis)),
                            mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=planet.node, coordinate=axis))],
-            stiffness=kt, damping=c * kt)))
+            stiffness=k_t, damping=d_t)))
     return out
-

@@ -1,56 +1,31 @@
-"""Linear elements and supports: bushings, bearings at their seats, fixed joints, speed drive, load torque.
+"""Linear elements and supports on bodies: bearings, fixed joints, speed drive, load torque.
 
-Element contract (as ROSS's): every linear frame element gives a 6x6 stiffness and damping matrix on the
-frame coordinates (u_x, u_y, u_z, phi_x, phi_y, phi_z) of one body; all of them are summed into one
-``ObjectGenericODE2`` over the frame nodes. Bearings where they are (:func:`add_support`), the drive and
+Element contract (flexgear.geometry.elements): a bearing is a 6x6 stiffness and damping matrix about a point on
+a body's axis with its DOF map (:class:`BearingElement`). Bearings on body frames are moved to the frame origin
+(:meth:`BearingElement.at`) and summed into one ``ObjectGenericODE2`` over the frame nodes
+(:func:`add_linear_elements`); a fixed joint (:class:`FixedJointElement`) holds two interfaces together
+(:func:`add_interface_joint`). Bearings where they are (:func:`add_support`), the drive and
 the load at an interface (:func:`interface_spin_marker`) act through the interface's exact virtual-node
 motion for a flexible body (flexgear.mbs.flexible) and at the same point of a rigid body.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
-
 import numpy as np
 
-from flexgear.geometry.supports import Support
+from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.ramps import drive_angle, ramp_fraction
 from flexgear.mbs.bodies import Body, matrix_container, resting_node, zero_user_jacobian
-from flexgear.spec import Bearing
+
+Bushing = BearingElement.axisymmetric
+"""The public API's name of a bearing on a body frame: ``Bushing(body, k_r, k_a, k_t, damping_per_stiffness)``
+[N/m, N/m, N m/rad, s] is :meth:`BearingElement.axisymmetric` at the frame origin."""
 
 
-@dataclass(frozen=True)
-class Bushing:
-    """A bearing as a 6-DOF linear spring-damper from a body frame to ground (spin left free).
-
-    Stiffness diag(k_r, k_r, k_a, k_t, k_t, 0) on (u_x, u_y, u_z, phi_x, phi_y, phi_z) [N/m, N·m/rad];
-    damping c = k * damping_per_stiffness [s] (stiffness-proportional).
-    """
-
-    body: str
-    radial_stiffness: float
-    axial_stiffness: float
-    tilt_stiffness: float
-    damping_per_stiffness: float
-
-    @classmethod
-    def from_bearing(cls, body: str, bearing: Bearing) -> Bushing:
-        """Bushing of a Table 2 bearing."""
-        return cls(body, bearing.radial_stiffness_n_per_m, bearing.axial_stiffness_n_per_m,
-                   bearing.tilt_stiffness_nm_per_rad, bearing.damping_per_stiffness_s)
-
-    def stiffness_matrix(self) -> np.ndarray:
-        k = [self.radial_stiffness, self.radial_stiffness, self.axial_stiffness,
-             self.tilt_stiffness, self.tilt_stiffness, 0.0]
-        return np.diag(k)
-
-    def damping_matrix(self) -> np.ndarray:
-        return self.damping_per_stiffness * self.stiffness_matrix()
-
-
-def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_nodes: list[int] | None = None,
+def add_linear_elements(mbs, bodies: list[Body], elements: list[BearingElement], extra_nodes: list[int] | None = None,
                         extra_size: int = 0) -> tuple[int, int]:
-    """Sum the elements' matrices into one ``ObjectGenericODE2`` over the bodies' frame nodes.
+    """Sum the bearings' matrices, each moved to its body's frame origin (:meth:`BearingElement.at`), into one
+    ``ObjectGenericODE2`` over the bodies' frame nodes (each bearing to ground, on the body frame: no interface).
 
     ``extra_nodes`` (e.g. the modal nodes of flexible bodies, ``extra_size`` coordinates in all) are
     appended to the object with zero matrices so that its marker spans them too.
@@ -64,10 +39,14 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_
     stiffness, damping = np.zeros((n, n)), np.zeros((n, n))
     for e in elements:
         if e.body not in index:
-            raise KeyError(f"bushing on unknown body {e.body!r}; bodies: {sorted(index)}")
+            raise KeyError(f"bearing on unknown body {e.body!r}; bodies: {sorted(index)}")
+        if e.other is not None or e.interface is not None:
+            raise ValueError(f"bearing on {e.body!r}: frame elements act between a body frame and ground "
+                             f"(other={e.other!r}, interface={e.interface!r}); use add_support or add_planet_bearing")
         s = slice(6 * index[e.body], 6 * index[e.body] + 6)
-        stiffness[s, s] += e.stiffness_matrix()
-        damping[s, s] += e.damping_matrix()
+        at_frame = e.at(np.zeros(3))
+        stiffness[s, s] += at_frame.stiffness
+        damping[s, s] += at_frame.damping
     obj = mbs.AddObject(ObjectGenericODE2(
         name="frame_elements", nodeNumbers=[b.node for b in bodies] + list(extra_nodes or []),
         stiffnessMatrix=matrix_container(stiffness), dampingMatrix=matrix_container(damping), forceVector=np.zeros(n),
@@ -77,17 +56,16 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[Bushing], extra_
     return obj, marker
 
 
-def add_support(mbs, body: Body, support: Support) -> list[int]:
-    """A Table 2 bearing at its place (flexgear.geometry.supports): three spring-dampers from ground to the axis.
+def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
+    """The bearing ``bearing`` (acting on ``body``, ground on the other side) where it is.
 
-    Springs (``Support.spring_points``) at points on the body's axis at ``support.centre_z`` (+- a) of its
-    frame: ``ObjectConnectorCartesianSpringDamper`` with stiffness k and damping k * damping_per_stiffness,
-    to a ``MarkerSuperElementPosition`` on a virtual node moving rigidly with the interface
-    ``support.interface`` of a flexible body (``FlexibleBody.point_markers``, placed at the same points) or a
-    body-fixed marker of a rigid body (a rigid body on a linear frame, flexgear.mbs.bodies.add_linear_frame: the
-    three springs' sum as one 6 x 6 bearing on its frame coordinates, flexgear.mbs.joints.add_frame_bearing).
-    Points on the axis: the spin does not move them, so the bearing leaves the spin free and damps only
-    translation and tilt. Returns the connectors.
+    Rigid body on a linear frame (flexgear.mbs.bodies.add_linear_frame): the 6 x 6 bearing on its frame
+    coordinates (flexgear.mbs.joints.add_frame_bearing). Otherwise the bearing realised as its three spring-dampers
+    on the axis (:meth:`BearingElement.axis_springs`): ``ObjectConnectorCartesianSpringDamper`` from ground to a
+    ``MarkerSuperElementPosition`` on a virtual node moving rigidly with the interface ``bearing.interface`` of a
+    flexible body (``FlexibleBody.point_markers``, placed at the same points, :func:`support_points`) or a
+    body-fixed marker of a rigid body. Points on the axis: the spin does not move them, so the bearing leaves the
+    spin free and damps only translation and tilt. Returns the connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
@@ -97,34 +75,36 @@ def add_support(mbs, body: Body, support: Support) -> list[int]:
         VObjectConnectorCartesianSpringDamper,
     )
 
-    springs = support.spring_points()
+    if bearing.body != body.name or bearing.other is not None:
+        raise ValueError(f"bearing on {bearing.body!r} (other side {bearing.other!r}) placed on body {body.name!r} "
+                         "to ground (BearingElement.on moves it)")
     if body.frame is not None and not body.flexible:  # a linear frame: one linear bearing on its coordinates
         from flexgear.mbs.joints import add_frame_bearing
 
-        return [add_frame_bearing(mbs, body, support)]
+        return [add_frame_bearing(mbs, body, bearing)]
+    springs = bearing.axis_springs()
     if body.flexible:
-        markers = body.point_markers.get(support.interface, [])
+        markers = body.point_markers.get(bearing.interface, [])
         if len(markers) != len(springs):
             raise KeyError(f"flexible body {body.name!r} needs {len(springs)} point markers on interface "
-                           f"{support.interface!r} (add_flexible_body point_markers); has {len(markers)}")
+                           f"{bearing.interface!r} (add_flexible_body point_markers); has {len(markers)}")
     else:
-        markers = [mbs.AddMarker(MarkerBodyPosition(bodyNumber=body.obj, localPosition=[0.0, 0.0, float(z)]))
-                   for z, _ in springs]
+        markers = [mbs.AddMarker(MarkerBodyPosition(bodyNumber=body.obj, localPosition=[float(v) for v in sp.point]))
+                   for sp in springs]
     out = []
-    for k, ((z, stiffness), marker) in enumerate(zip(springs, markers, strict=True)):
-        ground = mbs.AddNode(NodePointGround(referenceCoordinates=list(map(float, body.position + [0.0, 0.0, z]))))
+    for k, (spring, marker) in enumerate(zip(springs, markers, strict=True)):
+        ground = mbs.AddNode(NodePointGround(referenceCoordinates=list(map(float, body.position + spring.point))))
         out.append(mbs.AddObject(ObjectConnectorCartesianSpringDamper(
             name=f"bearing_{body.name}_{k}", markerNumbers=[mbs.AddMarker(MarkerNodePosition(nodeNumber=ground)),
                                                             marker],
-            stiffness=[float(s) for s in stiffness],
-            damping=[float(support.damping_per_stiffness * s) for s in stiffness],
+            stiffness=[float(v) for v in spring.stiffness], damping=[float(v) for v in spring.damping],
             visualization=VObjectConnectorCartesianSpringDamper(show=False))))
     return out
 
 
-def support_points(support: Support) -> list[np.ndarray]:
-    """Points [m, component frame] of the bearing's springs: the ``point_markers`` a flexible body needs."""
-    return [np.array([0.0, 0.0, z]) for z, _ in support.spring_points()]
+def support_points(bearing: BearingElement) -> list[np.ndarray]:
+    """Points [m, body frame] of the bearing's axis springs: the ``point_markers`` a flexible body needs."""
+    return [np.array(sp.point) for sp in bearing.axis_springs()]
 
 
 def interface_spin_marker(mbs, body: Body, interface: str | None) -> tuple[int, int, int]:
@@ -235,29 +215,37 @@ def add_fixed_joint(mbs, body: Body, other: Body | None = None, coordinates: tup
         for k in coordinates]
 
 
-def add_interface_joint(mbs, body: Body, other: Body, interfaces: tuple[str, str], point, name: str = "") -> int:
-    """Fixed joint of two bodies at their interfaces, at ``point`` [m, ground frame, reference configuration].
+def add_interface_joint(mbs, body: Body, other: Body, joint: FixedJointElement, name: str = "") -> int:
+    """The fixed joint ``joint`` of ``body`` and ``other`` at their interfaces, at ``joint.point`` [m, ground frame,
+    reference configuration].
 
     A flexible body joins through the ``MarkerSuperElementRigid`` of its interface (the RBE3 motion
     of the interface node set, see flexgear.mbs.flexible.add_flexible_body, which must have placed that
-    marker at ``point``); a rigid body through a body-fixed marker at ``point``. All six relative
+    marker at the point); a rigid body through a body-fixed marker at the point. All six relative
     motions are constrained (``ObjectJointGeneric``); its ``Force``/``Torque`` outputs are the
     forces [N] and moments [N·m] the joint transmits. Returns the joint.
     """
     from exudyn.itemInterface import MarkerBodyRigid, ObjectJointGeneric, VObjectJointGeneric
 
+    check_joint_bodies(joint, body, other)
     markers = []
-    for b, itf in zip((body, other), interfaces, strict=True):
+    for b, itf in zip((body, other), joint.interfaces, strict=True):
         if b.flexible:
             if itf not in b.interface_markers:
                 raise KeyError(f"flexible body {b.name!r} has no marker on interface {itf!r}; "
                                f"have {sorted(b.interface_markers)}")
             markers.append(b.interface_markers[itf])
         else:
-            local = np.asarray(point, float) - b.position
+            local = joint.point - b.position
             markers.append(mbs.AddMarker(MarkerBodyRigid(bodyNumber=b.obj, localPosition=list(map(float, local)))))
     return mbs.AddObject(ObjectJointGeneric(name=name or f"joint_{body.name}_{other.name}", markerNumbers=markers,
                                             constrainedAxes=[1] * 6, visualization=VObjectJointGeneric(show=False)))
+
+
+def check_joint_bodies(joint: FixedJointElement, body: Body, other: Body) -> None:
+    """Raise ValueError unless ``joint``'s DOF map names ``body`` and ``other``, in that order."""
+    if (joint.body, joint.other) != (body.name, other.name):
+        raise ValueError(f"joint of {joint.body!r} and {joint.other!r} placed on {body.name!r} and {other.name!r}")
 
 
 def _keep_alive(mbs, functions: list) -> None:

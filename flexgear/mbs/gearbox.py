@@ -20,10 +20,11 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.fe.ring_shaft import TIED_PAIR
+from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
-from flexgear.geometry.supports import Support, gearbox_supports
+from flexgear.geometry.supports import gearbox_supports
 from flexgear.laws.contact import mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
@@ -206,7 +207,7 @@ def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
 
 def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
-                   joints: dict[str, np.ndarray] | None = None, support: Support | None = None,
+                   joints: dict[str, np.ndarray] | None = None, support: BearingElement | None = None,
                    cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
                    superelement: bool = True, contacts: list[GearContact] = (), source: str | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
@@ -322,12 +323,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                          contacts=contacts, source=TIED_PAIR))
             ends[gear] = gear
         else:
-            joints = gear_shaft_joints(spec, gear)
+            joints = [FixedJointElement.gear_shaft(gear, shaft, j) for j in gear_shaft_joints(spec, gear)]
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  {a: p for a, _, p in joints}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin,
-                                  superelement=superelements, contacts=contacts)
+                                  {j.interface: j.point for j in joints}, cutoff_hz=cutoff, dropped=dropped,
+                                  spin_rad_s=spin, superelement=superelements, contacts=contacts)
             other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   {b: p for _, b, p in joints}, supports[shaft], spin_rad_s=spin,
+                                   {j.other_interface: j.point for j in joints}, supports[shaft], spin_rad_s=spin,
                                    superelement=superelements)
             bodies += [lead, other]
             pairs.append((lead, other, joints, spin / th.input_speed))  # spin per drive angle
@@ -349,20 +350,20 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
             carried = (_seat_loads_carried(lead) and len(found) == 1
-                       and _is_gear_seat(lead, found[0][0]))
+                       and _is_gear_seat(lead, found[0].interface))
             axes = _joint_axes(other)
-            made = [LinearInterfaceJoint(mbs, lead, other, (a, b), p, ratio, label + (f"_{k}" if k else ""),
-                                         residual=carried, axes=axes) for k, (a, b, p) in enumerate(found)]
+            made = [LinearInterfaceJoint(mbs, lead, other, j, ratio, label + (f"_{k}" if k else ""),
+                                         residual=carried, axes=axes) for k, j in enumerate(found)]
             if axes == "body":
                 body_axes.append(lead.name)
             if carried:
                 seat_residuals[lead.name] = (made[0].residual_node, made[0].centre)
             linear_gears.append(lead.name)
             turning += [e for j in made for e in j.turning()]
-            joints[lead.name] = [(j.obj, p) for j, (_, _, p) in zip(made, found, strict=True)]
+            joints[lead.name] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
             continue
-        joints[lead.name] = [(add_interface_joint(mbs, lead, other, (a, b), p, label + (f"_{k}" if k else "")), p)
-                             for k, (a, b, p) in enumerate(found)]
+        joints[lead.name] = [(add_interface_joint(mbs, lead, other, j, label + (f"_{k}" if k else "")),
+                              np.array(j.point)) for k, j in enumerate(found)]
     planets = [f"planet{i + 1}" for i in range(geo.planet_count)]
     placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
     for body, key in placed:  # bearings at their seats (flexgear.geometry.supports)
@@ -371,12 +372,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
 
             spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
             carried = _seat_loads_carried(by_body[body])
-            seat = LinearSeat(mbs, by_body[body], supports[key], spin, residual=carried)
+            seat = LinearSeat(mbs, by_body[body], supports[key].on(body), spin, residual=carried)
             turning += seat.turning()
             if carried:
                 seat_residuals[body] = (seat.residual_node, seat.centre)
             continue
-        add_support(mbs, by_body[body], supports[key])
+        add_support(mbs, by_body[body], supports[key].on(body))
     if turning:
         from flexgear.mbs.joints import TurningBlocks
 

@@ -32,18 +32,21 @@ counts them per step), with a rigid
 shaft more Jacobians; so a joint takes body axes where its shaft is flexible, ground axes where it is rigid.
 The multipliers are then the force and moment in the gear's body axes.
 
-A bearing at a flexible body's seat (flexgear.geometry.supports: three springs on the axis) acts on the seat
-interface's motion s = (translation at the bearing centre, rotation) in ground, the same first-order
-expression: an auxiliary coordinate vector s tied by s = J_f (frame - reference) + R_n Psi q (one linear
-constraint, its modal block rewritten each step) carries the bearing's constant 6 x 6 stiffness and damping
-(:class:`LinearSeat`): the three springs' sum, exact to first order, in place of three spring-dampers on the
-body's virtual nodes, which Exudyn evaluates and differentiates numerically through the whole mode basis.
+A bearing at a flexible body's seat (flexgear.geometry.elements.BearingElement, at its place by
+flexgear.geometry.supports) acts on the seat interface's motion s = (translation at the bearing centre, rotation)
+in ground, the same first-order expression: an auxiliary coordinate vector s tied by
+s = J_f (frame - reference) + R_n Psi q (one linear constraint, its modal block rewritten each step) carries the
+bearing's constant 6 x 6 stiffness and damping (:class:`LinearSeat`), in place of the reference formulation's
+three spring-dampers on the body's virtual nodes (the same element realised on the axis,
+flexgear.mbs.elements.add_support), which Exudyn evaluates and differentiates numerically through the whole mode
+basis.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.compiled import ramp_state, turn_columns
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
@@ -51,7 +54,7 @@ _ON_AXIS_M = 1e-9
 """A joint point within this distance [m] of the spin axis lies on it (the exact geometry places it there)."""
 
 __all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "add_frame_bearing", "body_axes_form", "frame_form",
-           "interface_rows", "linear_bearing", "seat_matrices", "turning_form"]
+           "interface_rows", "linear_bearing", "turning_form"]
 
 
 def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.ndarray:
@@ -102,17 +105,6 @@ def body_axes_form(form: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.
             swap @ const + keep_z @ sin_part)
 
 
-def seat_matrices(support) -> tuple[np.ndarray, np.ndarray]:
-    """The bearing's (flexgear.geometry.supports.Support) stiffness and damping on its centre's ground translation
-    and rotation (6, 6): sum over its springs at z_k of B_k^T diag(k) B_k, B_k = [I, d_k (e_y, -e_x, 0) columns],
-    d_k = z_k - centre_z; damping = damping_per_stiffness x stiffness."""
-    k6 = np.zeros((6, 6))
-    for z, stiffness in support.spring_points():
-        b = frame_rows(np.array([0.0, 0.0, z - support.centre_z]))[:3]
-        k6 += b.T @ np.diag(stiffness) @ b
-    return k6, support.damping_per_stiffness * k6
-
-
 def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np.ndarray,
                    series_node: int | None = None) -> int:
     """A constant 6 x 6 ``stiffness`` and ``damping`` on the six coordinates of ``node`` to ground (one
@@ -128,18 +120,19 @@ def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np
                                            jacobianUserFunction=zero_user_jacobian(6 * len(nodes))))
 
 
-def add_frame_bearing(mbs, body: Body, support) -> int:
-    """The bearing ``support`` of a rigid ``body`` on its frame coordinates: :func:`seat_matrices` at the bearing
-    centre through [I, -p~; 0, I] (the three springs' sum, exact to first order in the tilts)."""
-    rows = frame_rows(np.array([0.0, 0.0, support.centre_z]))
-    k6, d6 = (rows.T @ a @ rows for a in seat_matrices(support))
-    return linear_bearing(mbs, f"bearing_{body.name}", body.node, k6, d6)
+def add_frame_bearing(mbs, body: Body, bearing: BearingElement) -> int:
+    """The ``bearing`` of a rigid ``body`` on its frame coordinates: its matrices moved from the bearing centre to
+    the frame origin (:meth:`BearingElement.at`, T^T K T with T = [I, -p~; 0, I], exact to first order in the
+    tilts)."""
+    at_frame = bearing.at(np.zeros(3))
+    return linear_bearing(mbs, f"bearing_{body.name}", body.node, at_frame.stiffness, at_frame.damping)
 
 
 class LinearInterfaceJoint:
-    """A fixed joint of ``body`` (interface ``interfaces[0]``) and ``other`` (``interfaces[1]``) at ``point``.
+    """The fixed joint ``joint`` of ``body`` (its interface ``joint.interface``) and ``other``
+    (``joint.other_interface``) at ``joint.point``.
 
-    ``point`` [m, ground frame at the reference]: on the bodies' common axis, where their frame columns are
+    ``joint.point`` [m, ground frame at the reference]: on the bodies' common axis, where their frame columns are
     constant (:func:`frame_form`). ``spin_per_drive_angle`` the bodies'
     nominal spin per prescribed drive angle (both turn together). ``obj`` is the constraint; :meth:`turning`
     gives its blocks that a :class:`TurningBlocks` pre-step function turns with the spin. ``residual``: the
@@ -148,7 +141,7 @@ class LinearInterfaceJoint:
     ``axes``: "ground" or "body", the axes of its six equations and multipliers (module docstring).
     """
 
-    def __init__(self, mbs, body: Body, other: Body, interfaces: tuple[str, str], point, spin_per_drive_angle: float,
+    def __init__(self, mbs, body: Body, other: Body, joint: FixedJointElement, spin_per_drive_angle: float,
                  name: str = "", residual: bool = False, axes: str = "ground"):
         from exudyn.itemInterface import (
             MarkerObjectODE2Coordinates,
@@ -156,12 +149,15 @@ class LinearInterfaceJoint:
             ObjectGenericODE2,
         )
 
-        point = np.asarray(point, float)
+        from flexgear.mbs.elements import check_joint_bodies
+
+        check_joint_bodies(joint, body, other)
+        point = np.array(joint.point)
         self.spin = float(spin_per_drive_angle)
         self.centre = point - body.position  # the gear's interface point, its body frame at the reference
         self.residual_node = -1
         forms, q_ref, markers = [], [], []
-        for b, itf, sign in ((body, interfaces[0], -1.0), (other, interfaces[1], 1.0)):
+        for b, itf, sign in ((body, joint.interface, -1.0), (other, joint.other_interface, 1.0)):
             nodes = [b.node]
             local = point - b.position
             q_ref.append(np.concatenate([b.position, np.zeros(3)]))
@@ -214,14 +210,15 @@ class LinearInterfaceJoint:
 
 
 class LinearSeat:
-    """The bearing ``support`` (flexgear.geometry.supports.Support) at the seat of the flexible ``body`` (module
-    docstring). ``spin_per_drive_angle``: the body's nominal spin per prescribed drive angle; ``node``: the six
+    """The ``bearing`` (flexgear.geometry.elements.BearingElement, ground on its other side) at its interface, the
+    seat of the flexible ``body`` (module docstring): its 6 x 6 stiffness and damping about its centre on the seat
+    coordinates. ``spin_per_drive_angle``: the body's nominal spin per prescribed drive angle; ``node``: the six
     seat coordinates; :meth:`turning` gives the block that a :class:`TurningBlocks` pre-step function turns.
     ``residual``: the seat coordinates are the kept motion plus six more, ``residual_node``, the dropped modes'
     seat motion e_s (flexgear.mbs.residual: the bearing acts on the seat in series with it).
     """
 
-    def __init__(self, mbs, body: Body, support, spin_per_drive_angle: float, residual: bool = False):
+    def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
@@ -229,16 +226,19 @@ class LinearSeat:
             ObjectGenericODE2,
         )
 
+        if bearing.body != body.name or bearing.other is not None:
+            raise ValueError(f"bearing on {bearing.body!r} (other side {bearing.other!r}) placed on body "
+                             f"{body.name!r} to ground")
         self.spin = float(spin_per_drive_angle)
-        centre = np.array([0.0, 0.0, support.centre_z])
-        modal_nodes, self.rows = body.span(interface_rows(body, support.interface, centre))
+        centre = np.array(bearing.centre)
+        modal_nodes, self.rows = body.span(interface_rows(body, bearing.interface, centre))
         frame = frame_rows(centre)
         self.node = resting_node(mbs, f"{body.name}_seat", 6)
         self.centre = centre
         self.residual_node = -1
         if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
             self.residual_node = resting_node(mbs, f"{body.name}_seat_residual", 6)
-        linear_bearing(mbs, f"bearing_{body.name}", self.node, *seat_matrices(support),
+        linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
                        series_node=self.residual_node if residual else None)
         span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],
                                                jacobianUserFunction=zero_user_jacobian(12)))

@@ -2,9 +2,9 @@
 
 :func:`add_gear_train` is the one assembly step every gearbox shares (the GTF star gearbox of
 flexgear.mbs.gearbox and the examples alike). Given the bodies (rigid or flexible, each on its frame
-node), the linear frame elements (bushings) and the gear contacts, it adds
+node), the bearings on body frames (flexgear.geometry.elements.BearingElement) and the gear contacts, it adds
 
-- one ``ObjectGenericODE2`` with all bushing matrices over the frame coordinates,
+- one ``ObjectGenericODE2`` with all bearing matrices over the frame coordinates,
 - the contacts (flexgear.mbs.contacts.add_gear_contacts): one auxiliary deflection coordinate each,
   their linear kinematics (one constraint per gear pair), one compiled impact law each,
 - for flexible gears, the per-step modal columns of the constraint (flexgear.mbs.contact_kinematics),
@@ -39,7 +39,7 @@ class GearTrain:
     springs: list[int]  # per contact: spring-damper whose Force output is the normal force [N]
     aux_nodes: list[int]  # nodes of the contacts' deflection coordinates, one per gear pair, consecutive
     constraint: MeshConstraint  # the linear mesh kinematics (one Exudyn constraint per gear pair)
-    frame_elements: int  # ObjectGenericODE2 of the bushings
+    frame_elements: int  # ObjectGenericODE2 of the bearings on body frames
     coordinates_marker: int
     kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics (flexible gears)
     carrier: CarrierKinematics | None = None
@@ -96,7 +96,8 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
                    carrier: Carrier | None = None, contact_fourier_order: int = 8,
                    radial_band: float | None = None, extra_pre_steps: list | None = None,
                    seat_residuals: dict[str, tuple[int, np.ndarray]] | None = None) -> GearTrain:
-    """Add the bushings ``elements``, the gear ``contacts`` and their per-step updates for ``bodies``.
+    """Add the bearings ``elements`` (flexgear.geometry.elements.BearingElement, on body frames), the gear
+    ``contacts`` and their per-step updates for ``bodies``.
 
     ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
     (flexgear.mbs.contacts.drive_angle) drives the mesh phase. ``friction``: add tooth friction for
