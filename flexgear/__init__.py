@@ -3,7 +3,7 @@
 The public API (``__all__``) builds any gearbox in a few lines: gear geometry (``gear_pair_geometry``),
 bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``; parts bolted or
 bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``), bearings
-(``BearingElement``: a 6x6 stiffness and damping about a point on an axis, ``Bushing`` on a body frame,
+(``BearingElement``: a 6x6 stiffness and damping about a point on an axis, on a body frame or an interface,
 ``add_planet_bearing``), fixed joints (``FixedJointElement``, ``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
 on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
@@ -37,7 +37,7 @@ _LAZY = {
     # multibody: bodies, elements, contacts
     "Body": "mbs.bodies", "add_rigid_body": "mbs.bodies", "LinearFrame": "mbs.bodies", "add_linear_frame": "mbs.bodies",
     "FlexibleBody": "mbs.flexible", "add_flexible_body": "mbs.flexible", "SpinSchedule": "mbs.spin",
-    "Bushing": "mbs.elements", "add_fixed_joint": "mbs.elements", "add_interface_joint": "mbs.elements",
+    "add_fixed_joint": "mbs.elements", "add_interface_joint": "mbs.elements",
     "add_speed_drive": "mbs.elements", "add_load_torque": "mbs.elements",
     "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts",
     "Carrier": "mbs.carrier", "add_planet_bearing": "mbs.carrier",

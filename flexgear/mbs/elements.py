@@ -17,10 +17,6 @@ from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.ramps import drive_angle, ramp_fraction
 from flexgear.mbs.bodies import Body, matrix_container, resting_node, zero_user_jacobian
 
-Bushing = BearingElement.axisymmetric
-"""The public API's name of a bearing on a body frame: ``Bushing(body, k_r, k_a, k_t, damping_per_stiffness)``
-[N/m, N/m, N m/rad, s] is :meth:`BearingElement.axisymmetric` at the frame origin."""
-
 
 def add_linear_elements(mbs, bodies: list[Body], elements: list[BearingElement], extra_nodes: list[int] | None = None,
                         extra_size: int = 0) -> tuple[int, int]:
