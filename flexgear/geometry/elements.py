@@ -195,3 +195,8 @@ class FixedJointElement:
     def interfaces(self) -> tuple[str, str]:
         """(``interface``, ``other_interface``)."""
         return self.interface, self.other_interface
+
+    def check_bodies(self, body: str, other: str) -> None:
+        """Raise ValueError unless the joint's DOF map names ``body`` and ``other``, in that order."""
+        if (self.body, self.other) != (body, other):
+            raise ValueError(f"joint of {self.body!r} and {self.other!r} placed on {body!r} and {other!r}")

@@ -223,7 +223,7 @@ def add_interface_joint(mbs, body: Body, other: Body, joint: FixedJointElement, 
     """
     from exudyn.itemInterface import MarkerBodyRigid, ObjectJointGeneric, VObjectJointGeneric
 
-    check_joint_bodies(joint, body, other)
+    joint.check_bodies(body.name, other.name)
     markers = []
     for b, itf in zip((body, other), joint.interfaces, strict=True):
         if b.flexible:
@@ -236,12 +236,6 @@ def add_interface_joint(mbs, body: Body, other: Body, joint: FixedJointElement, 
             markers.append(mbs.AddMarker(MarkerBodyRigid(bodyNumber=b.obj, localPosition=list(map(float, local)))))
     return mbs.AddObject(ObjectJointGeneric(name=name or f"joint_{body.name}_{other.name}", markerNumbers=markers,
                                             constrainedAxes=[1] * 6, visualization=VObjectJointGeneric(show=False)))
-
-
-def check_joint_bodies(joint: FixedJointElement, body: Body, other: Body) -> None:
-    """Raise ValueError unless ``joint``'s DOF map names ``body`` and ``other``, in that order."""
-    if (joint.body, joint.other) != (body.name, other.name):
-        raise ValueError(f"joint of {joint.body!r} and {joint.other!r} placed on {body.name!r} and {other.name!r}")
 
 
 def _keep_alive(mbs, functions: list) -> None:

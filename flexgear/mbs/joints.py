@@ -149,9 +149,7 @@ class LinearInterfaceJoint:
             ObjectGenericODE2,
         )
 
-        from flexgear.mbs.elements import check_joint_bodies
-
-        check_joint_bodies(joint, body, other)
+        joint.check_bodies(body.name, other.name)
         point = np.array(joint.point)
         self.spin = float(spin_per_drive_angle)
         self.centre = point - body.position  # the gear's interface point, its body frame at the reference
