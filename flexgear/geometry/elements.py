@@ -146,6 +146,11 @@ class BearingElement:
                 AxisSpring(self.centre + a * axis, (half_k, half_k, 0.0), (half_d, half_d, 0.0)),
                 AxisSpring(self.centre.copy(), (0.0, 0.0, k_a), (0.0, 0.0, d_a))]
 
+    def check_to_ground(self, body: str) -> None:
+        """Raise ValueError unless the element acts between ``body`` and ground (:meth:`on` moves it to a body)."""
+        if self.body != body or self.other is not None:
+            raise ValueError(f"bearing on {self.body!r} (other side {self.other!r}) placed on body {body!r} to ground")
+
     def condensed_radial_stiffness(self, gear_z: float = 0.0) -> float:
         """In-plane stiffness [N/m] at the point (0, 0, ``gear_z``) [m] of a rigid shaft on this bearing: a force F
         there, no moment; the bearing takes F and the moment F L (L = gear_z - z_c), so the point moves

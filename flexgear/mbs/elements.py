@@ -71,9 +71,7 @@ def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
         VObjectConnectorCartesianSpringDamper,
     )
 
-    if bearing.body != body.name or bearing.other is not None:
-        raise ValueError(f"bearing on {bearing.body!r} (other side {bearing.other!r}) placed on body {body.name!r} "
-                         "to ground (BearingElement.on moves it)")
+    bearing.check_to_ground(body.name)
     if body.frame is not None and not body.flexible:  # a linear frame: one linear bearing on its coordinates
         from flexgear.mbs.joints import add_frame_bearing
 

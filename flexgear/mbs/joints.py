@@ -224,9 +224,7 @@ class LinearSeat:
             ObjectGenericODE2,
         )
 
-        if bearing.body != body.name or bearing.other is not None:
-            raise ValueError(f"bearing on {bearing.body!r} (other side {bearing.other!r}) placed on body "
-                             f"{body.name!r} to ground")
+        bearing.check_to_ground(body.name)
         self.spin = float(spin_per_drive_angle)
         centre = np.array(bearing.centre)
         modal_nodes, self.rows = body.span(interface_rows(body, bearing.interface, centre))
