@@ -12,7 +12,11 @@
     accelerations at h = 2, 3, 5.
 (4) The multibody model 1 (rigid) against its own time integration (flexgear.mbs.run.run_variant), as (1); and
     against the lumped model at 2x mesh, which excites planet modes only (3): for them the lumped model is the
-    multibody model's in-plane part (tests/test_modal.py).
+    multibody model's in-plane part (tests/test_modal.py). Its gears are bodies of revolution, so the gearbox is
+    cyclically symmetric and the phasing of (3) holds in the time domain too, with the parametric and nonlinear
+    terms the frequency domain leaves out: the central members' 2x mesh acceleration vanishes in both domains.
+(5) The diagnostics of the checks (flexgear.study.harmonic_check): a line at exactly one frequency told from a
+    sideband; K_v of a signal's mesh-periodic part, without a slow tone added to it.
 """
 
 import dataclasses
@@ -23,6 +27,7 @@ import pytest
 
 from flexgear.harmonic import harmonic_response, lumped_harmonic_response, mesh_frequency_hz
 from flexgear.modal.cli import speeds_rpm as parse_speeds
+from flexgear.study.harmonic_check import line_amplitude, periodic_peak_factor
 
 RAMP_S, END_S = 0.05, 0.25  # short load case: the ramps, then 0.2 s (the slowest decay time is about 33 ms)
 WINDOW_S = 0.1  # analysed: the last 0.1 s, a whole number of mesh cycles
@@ -166,3 +171,31 @@ def test_model1_frequency_domain_matches_time_integration(model1, iso_spec, spee
         if column.startswith("input_bearing"):
             freq, timed = freq[:1], timed[:1]
         np.testing.assert_allclose(freq, timed, rtol=0.10, err_msg=f"{column} at {speed_rpm} rpm")
+    for column in ("input_bearing_accel_x_m_per_s2", "output_bearing_accel_y_m_per_s2"):  # (4): 2x cancelled
+        x = result.signals[column].to_numpy()[-n:]
+        first, second = line_amplitude(x, dt, f_mesh), line_amplitude(x, dt, 2.0 * f_mesh)
+        freq = response.amplitudes(column).iloc[0].to_numpy()
+        assert freq[1] < 1e-6 * freq[0], column
+        assert second < 1e-3 * first, (column, second / first)  # zero, but for what the ramps leave 0.12 s on
+
+
+def test_line_amplitude_tells_a_mesh_harmonic_from_a_sideband():
+    dt, f_mesh, f_side = 1e-5, 1595.0, 12 * 11.73  # a sideband 2 f_mesh + 12 f_ring, no line at 2 f_mesh
+    t = np.arange(int(round(0.2 * f_mesh)) * int(round(1.0 / (f_mesh * dt)))) * dt
+    x = 0.7 * np.sin(2 * np.pi * f_mesh * t) + 0.035 * np.cos(2 * np.pi * (2 * f_mesh + f_side) * t + 0.3)
+    assert line_amplitude(x, dt, f_mesh) == pytest.approx(0.7, rel=1e-3)
+    assert line_amplitude(x, dt, 2 * f_mesh + f_side) == pytest.approx(0.035, rel=1e-3)
+    assert line_amplitude(x, dt, 2 * f_mesh) < 1e-4 * 0.035  # 28 resolution widths away: Hann leakage only
+
+
+def test_periodic_peak_factor_leaves_out_a_slow_tone():
+    dt, f_mesh, mean = 1e-5, 1196.2, 800.0
+    t = np.arange(int(round(60 / (f_mesh * dt)))) * dt  # 60 mesh cycles, to the nearest step
+    wave = 0.76 * np.cos(2 * np.pi * f_mesh * t + 0.4) + 4.0 * np.cos(4 * np.pi * f_mesh * t - 1.1)
+    slow = 0.46 * np.cos(2 * np.pi * 106.9 * t)
+    phi = np.linspace(0.0, 2 * np.pi, 200001)  # the periodic part's peak on a fine grid of one mesh cycle
+    peak = (mean + 0.76 * np.cos(phi + 0.4) + 4.0 * np.cos(2 * phi - 1.1)).max() / mean
+    forces = np.stack([mean + wave, mean + wave + slow], axis=1)
+    kv = periodic_peak_factor(forces, dt, f_mesh, harmonics=3)
+    assert kv - 1.0 == pytest.approx(peak - 1.0, rel=2e-3)
+    assert forces[:, 1].max() / forces[:, 1].mean() - 1.0 > kv - 1.0 + 0.5 * 0.46 / mean  # the raw peak has the tone

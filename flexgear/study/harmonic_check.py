@@ -15,6 +15,12 @@ cycles at the recorded step, 1x and 2x by flexgear.study.compare.harmonic_amplit
 largest over planets and both meshes of a planet's peak mesh force over its mean in the window
 (flexgear.study.indicators). The same over the window before the last shows how much the run still moves.
 
+Diagnostics of a settled run: :func:`line_amplitude`, the amplitude at exactly one frequency over a long window,
+which tells a mesh harmonic from the sidebands h f_mesh +- p f_rot that a rotating asymmetric member (flexible
+gears' meshes, the ring's bolt pattern) adds and that the analysed window's resolution 1 / WINDOW_S merges with
+it; :func:`periodic_peak_factor`, K_v of the window's mesh-periodic part alone (what the frequency domain
+computes).
+
 Comparison (:func:`compare_lumped`): frequency domain over time domain minus 1 for each amplitude, and
 (K_v,f - 1) / (K_v,t - 1) - 1. An amplitude the planets' phasing cancels (below :data:`CANCELLED` of its family's
 largest at that speed in the frequency domain: mesh forces, bearing accelerations) is listed but not judged.
@@ -35,7 +41,8 @@ from flexgear.study.compare import harmonic_amplitudes
 from flexgear.study.indicators import _kv
 
 __all__ = ["CheckSpeeds", "LumpedCheck", "check_speeds", "settled_lumped_run", "window_amplitudes",
-           "compare_lumped", "STRONG", "BESIDE", "WINDOW_S", "RAMP_S", "CANCELLED", "COLUMNS", "SWEEP_RPM"]
+           "compare_lumped", "line_amplitude", "periodic_peak_factor",
+           "STRONG", "BESIDE", "WINDOW_S", "RAMP_S", "CANCELLED", "COLUMNS", "SWEEP_RPM"]
 
 STRONG = 0.5
 """A peak of K_v - 1 at least this fraction of the highest counts as a strong crossing."""
@@ -182,3 +189,31 @@ def compare_lumped(spec: Any, speed_rpm: float, ramp_s: float = RAMP_S, window_s
                  "difference": (kv_f - 1.0) / (kv_t - 1.0) - 1.0, "judged": True,
                  "moved": (kv_t - 1.0) / (kv_b - 1.0) - 1.0})
     return LumpedCheck(float(speed_rpm), pd.DataFrame(rows), test, window, float(result.meta.get("wall_time_s", 0.0)))
+
+
+def line_amplitude(signal: np.ndarray, dt: float, frequency_hz: float) -> float:
+    """Amplitude of the sinusoid at exactly ``frequency_hz`` [Hz] in ``signal`` sampled at ``dt`` [s]: the
+    Hann-windowed DTFT A = 2 |sum_n w_n (x_n - mean x) e^{-i 2 pi f n dt}| / sum_n w_n. A line at another frequency
+    f' leaks into it by the window's transform at f' - f: about 3e-4 of its amplitude at |f' - f| = 10 / (n dt),
+    4e-5 at 20 / (n dt)."""
+    x = np.asarray(signal, float)
+    x = x - x.mean()
+    w = np.hanning(x.size)
+    t = np.arange(x.size) * dt
+    return float(2.0 * abs(np.exp(-2j * math.pi * frequency_hz * t) @ (w * x)) / w.sum())
+
+
+def periodic_peak_factor(forces: np.ndarray, dt: float, mesh_frequency_hz: float, harmonics: int) -> float:
+    """K_v of the mesh-periodic part of ``forces`` (n, m): m mesh-force signals sampled at ``dt`` [s] over a whole
+    number of mesh cycles. Each column x has the mean F and the Fourier coefficients X_h = (2 / n) sum_k x_k
+    e^{-i 2 pi h f_mesh k dt} (exact for whole cycles), h = 1..``harmonics``; its peak factor is
+    max_phi (F + Re sum_h X_h e^{i h phi}) / F (flexgear.harmonic.base.waveform_peak), K_v the largest over the
+    columns. Content at other frequencies (sidebands, slow load-sharing changes) does not enter it."""
+    from flexgear.harmonic.base import waveform_peak
+
+    f = np.atleast_2d(np.asarray(forces, float).T).T
+    t = np.arange(f.shape[0]) * dt
+    h = np.arange(1, harmonics + 1)
+    mean = f.mean(axis=0)
+    coef = 2.0 * (np.exp(-2j * math.pi * mesh_frequency_hz * np.outer(h, t)) @ (f - mean)) / f.shape[0]  # (H, m)
+    return max(waveform_peak(coef[:, j], mean[j]) / mean[j] for j in range(f.shape[1]))
