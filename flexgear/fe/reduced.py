@@ -71,7 +71,7 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
     if component == "ring":
-        return [patch_union(fe, spec, BOLT_PATCHES)]
+        return [patch_union(fe, d, BOLT_PATCHES)]
     tube = [p for p in d.layout(component).prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
@@ -81,12 +81,12 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
         joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
-        joints = [patch_union(fe, spec, BOLT_PATCHES)]
+        joints = [patch_union(fe, d, BOLT_PATCHES)]
         far = (z > tube.z1 - seat - _TOL)
     return [*joints, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
-def patch_union(fe, spec: GearboxSpec, name: str) -> Interface:
+def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
     """The clamped discs of ``fe`` (the ring's flange face or the output shaft's web face,
     flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in ascending order, each disc's
     nodes weighted equally and each disc in all 1 / (number of bolts), the point their weighted centroid (on the
@@ -265,7 +265,7 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
                 "on the first-order mesh topology)")
         # first-order mesh topology; fe_model raises the order itself (a second-order Netgen mesh loaded
         # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
-        mesh = component_mesh(spec, name, level, order=1, progress=progress)
+        mesh = component_mesh(d, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         itfs = component_interfaces(fe, d, name)
         return reduce(fe, itfs, red.fixed_interface_modes, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
