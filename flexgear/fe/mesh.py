@@ -136,9 +136,8 @@ def _private_temporary(path: Path, suffix: str) -> Path:
 
 
 def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = False) -> Path:
-    """Path of the cached OCC solid (``.brep``) of ``component``, checked against its digest; built on a cache
-    miss or when the file does not match its digest. ``spec``: a spec or its design (flexgear.design), as in every
-    function here that takes one."""
+    """Path of the cached OCC solid (``.brep``) of ``component`` (``spec``: a spec or its design, flexgear.design),
+    checked against its digest; built on a cache miss or when the file does not match its digest."""
     d = as_design(spec)
     path = cache_dir() / f"solid-{component}-{geometry_hash(d.spec, component)}.brep"
 
@@ -223,10 +222,8 @@ def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return nodes, elements, surface
 
 
-def region_nodes(spec: GearboxSpec | Design, component: str, nodes: np.ndarray,
-                 boundary: np.ndarray) -> dict[str, np.ndarray]:
-    """Named boundary node sets of ``component`` (indices into ``nodes``, among ``boundary``)."""
-    d = as_design(spec)
+def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
+    """Named boundary node sets of ``component`` of design ``d`` (indices into ``nodes``, among ``boundary``)."""
     spec, layout = d.spec, d.layout(component)
     p = nodes[boundary]
     r = np.hypot(p[:, 0], p[:, 1])
@@ -279,8 +276,7 @@ def _paths(spec: GearboxSpec, component: str, level: str, order: int) -> dict[st
 def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coarse", order: int | None = None,
                    progress: bool = False) -> ComponentMesh:
     """The (cached) tetrahedral mesh of ``component`` at mesh ``level``; ``order`` overrides the level's."""
-    d = as_design(spec)
-    spec = d.spec
+    spec = (d := as_design(spec)).spec
     if component not in GEOMETRY_COMPONENTS:
         raise ValueError(f"unknown component {component!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
     if level not in spec.meshing_assumed:
