@@ -15,14 +15,10 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from flexgear.geometry.involute import gear_set_geometry
+from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.spec import GearboxSpec
 
-__all__ = [ "Theory", "theory"]
-
-
-
-
+__all__ = ["Theory", "theory", "gear_set_theory"]
 
 
 @dataclass(frozen=True)
@@ -49,8 +45,12 @@ class Theory:
 
 def theory(spec: GearboxSpec) -> Theory:
     """Theoretical values for the spec's load case at full speed and load (after the ramps)."""
+    return gear_set_theory(spec, gear_set_geometry(spec))
+
+
+def gear_set_theory(spec: GearboxSpec, geo: GearSetGeometry) -> Theory:
+    """:func:`theory` of ``spec`` with its gear set ``geo`` (flexgear.geometry.involute.gear_set_geometry) given."""
     g = spec.gears
-    geo = gear_set_geometry(spec)
     w_in = spec.load_case.input_speed_rad_s
     zs, zp, zr = g.sun_teeth, g.planet_teeth, g.ring_teeth
     if g.arrangement == "star":

@@ -8,7 +8,8 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def test_import_layers_contract_is_kept(monkeypatch):
-    """spec -> cache -> results -> geometry -> theory -> fe -> laws -> mbs | lumped -> study -> report -> cli."""
+    """spec -> cache -> results -> geometry -> theory -> design -> fe -> laws -> mbs | lumped -> study -> report
+    -> cli."""
     cli = pytest.importorskip("importlinter.cli")
     monkeypatch.chdir(ROOT)
     assert cli.lint_imports(config_filename=str(ROOT / "pyproject.toml"), no_cache=True, no_logo=True) == 0

@@ -27,8 +27,8 @@ import scipy.sparse as sp
 import scipy.sparse.linalg as sla
 from threadpoolctl import threadpool_limits
 
+from flexgear.design import Design, as_design
 from flexgear.fe.fem import FEModel, rigid_body_modes, surface_faces
-from flexgear.geometry.layout import component_layout
 from flexgear.spec import GearboxSpec
 
 __all__ = ["bolt_axes", "clamped_patches", "tie_matrix", "tied_free_modes", "ring_output_shaft_fe_modes"]
@@ -36,24 +36,25 @@ __all__ = ["bolt_axes", "clamped_patches", "tie_matrix", "tied_free_modes", "rin
 _TOL = 1e-6  # m: nodes on an exact plane or cylinder of the OCC geometry
 
 
-def bolt_axes(spec: GearboxSpec) -> tuple[np.ndarray, float, float]:
+def bolt_axes(spec: GearboxSpec | Design) -> tuple[np.ndarray, float, float]:
     """Bolt axes of the ring-output shaft joint: centres (n, 2) [m], hole radius [m], interface plane z_j [m].
 
     Hole k at polar angle 2 pi k / n on the ring flange's hole circle (flexgear.geometry.layout); z_j is the
-    flange's +z face, where the output shaft's web lies on it.
+    flange's +z face, where the output shaft's web lies on it. ``spec``: a spec or its design (flexgear.design).
     """
-    flange = next(p for p in component_layout(spec, "ring").prisms if p.section.holes)
+    flange = next(p for p in as_design(spec).layout("ring").prisms if p.section.holes)
     return flange.section.hole_centres(), flange.section.hole_radius, flange.z1
 
 
-def clamped_patches(fe: FEModel, spec: GearboxSpec, clamp_radius: float | None = None) -> list[np.ndarray]:
+def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float | None = None) -> list[np.ndarray]:
     """Per bolt, the nodes of ``fe`` on the interface plane z_j within the clamped disc around its axis.
 
     ``clamp_radius`` [m] defaults to half of ``[joints_assumed] bolt_clamp_diameter_mm``; the hole's edge
     (at the hole radius) is included. Works for the ring (flange face) and the output shaft (web face).
     """
-    centres, hole_radius, z_j = bolt_axes(spec)
-    radius = spec.joints_assumed.bolt_clamp_diameter_mm * 1e-3 / 2 if clamp_radius is None else clamp_radius
+    d = as_design(spec)
+    centres, hole_radius, z_j = bolt_axes(d)
+    radius = d.spec.joints_assumed.bolt_clamp_diameter_mm * 1e-3 / 2 if clamp_radius is None else clamp_radius
     on_plane = np.abs(fe.nodes[:, 2] - z_j) < _TOL
     out = []
     for cx, cy in centres:

@@ -45,7 +45,8 @@ from flexgear.cache import (
     read_entry,
     record_digest,
 )
-from flexgear.geometry.layout import component_layout, exact_mass_properties, geometry_hash
+from flexgear.design import Design, as_design
+from flexgear.geometry.layout import exact_mass_properties, geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
@@ -134,10 +135,11 @@ def _private_temporary(path: Path, suffix: str) -> Path:
     return path.with_name(f".{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{suffix}")
 
 
-def component_brep(spec: GearboxSpec, component: str, progress: bool = False) -> Path:
-    """Path of the cached OCC solid (``.brep``) of ``component``, checked against its digest; built on a cache
-    miss or when the file does not match its digest."""
-    path = cache_dir() / f"solid-{component}-{geometry_hash(spec, component)}.brep"
+def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = False) -> Path:
+    """Path of the cached OCC solid (``.brep``) of ``component`` (``spec``: a spec or its design, flexgear.design),
+    checked against its digest; built on a cache miss or when the file does not match its digest."""
+    d = as_design(spec)
+    path = cache_dir() / f"solid-{component}-{geometry_hash(d.spec, component)}.brep"
 
     def load() -> Path | None:
         if not path.exists():
@@ -149,7 +151,7 @@ def component_brep(spec: GearboxSpec, component: str, progress: bool = False) ->
         from flexgear.geometry.solids import component_solid
 
         t0 = time.perf_counter()
-        shape = component_solid(spec, component)
+        shape = component_solid(d.layout(component))
         tmp = _private_temporary(path, ".brep")
         shape.WriteBrep(str(tmp))
         tmp.replace(path)
@@ -165,14 +167,14 @@ def _say(progress: bool, text: str) -> None:
         say(text)
 
 
-def _refine_teeth(geo, spec: GearboxSpec, component: str, size: float, mp) -> None:
+def _refine_teeth(geo, d: Design, component: str, size: float, mp) -> None:
     """Tooth size on tooth faces (inside the tip-root band) and bolt-hole faces, and along their edges.
 
     ``geo.SetFaceMeshsize`` limits the faces; the edges get the same limit through points of
     ``mp.RestrictH`` along them (a face's ``maxh`` property would cover both, but only when set
     before the OCCGeometry is built, which costs a second build of it: 2.5 s for the ring).
     """
-    layout = component_layout(spec, component)
+    layout = d.layout(component)
     bands = []
     if layout.gear is not None:
         g = layout.gear
@@ -195,18 +197,18 @@ def _refine_teeth(geo, spec: GearboxSpec, component: str, size: float, mp) -> No
                     mp.RestrictH(p.x, p.y, p.z, size)
 
 
-def _netgen_mesh(brep: Path, spec: GearboxSpec, component: str, level: str):
+def _netgen_mesh(brep: Path, d: Design, component: str, level: str):
     """The first-order Netgen mesh of the solid, its OCC geometry attached (a second order is raised from it)."""
     import netgen.meshing as nm
     from netgen.occ import OCCGeometry
 
-    settings = spec.meshing_assumed[level]
+    settings = d.spec.meshing_assumed[level]
     geo = OCCGeometry(str(brep))
     mp = nm.MeshingParameters(
         maxh=settings.body_size_mm * 1e-3, curvaturesafety=settings.elements_per_curvature_radius,
         grading=_GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=settings.optimisation_steps,
         optsteps3d=settings.optimisation_steps)
-    _refine_teeth(geo, spec, component, settings.tooth_size_mm * 1e-3, mp)
+    _refine_teeth(geo, d, component, settings.tooth_size_mm * 1e-3, mp)
     return geo.GenerateMesh(mp=mp)
 
 
@@ -220,9 +222,9 @@ def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return nodes, elements, surface
 
 
-def region_nodes(spec: GearboxSpec, component: str, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
-    """Named boundary node sets of ``component`` (indices into ``nodes``, among ``boundary``)."""
-    layout = component_layout(spec, component)
+def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
+    """Named boundary node sets of ``component`` of design ``d`` (indices into ``nodes``, among ``boundary``)."""
+    spec, layout = d.spec, d.layout(component)
     p = nodes[boundary]
     r = np.hypot(p[:, 0], p[:, 1])
     z = p[:, 2]
@@ -257,7 +259,7 @@ def region_nodes(spec: GearboxSpec, component: str, nodes: np.ndarray, boundary:
         outer = on_cylinder(tube.section.outer)
         if component == "input_shaft":
             out["bearing_seat"] = boundary[outer & (z < tube.z0 + width + tol)]
-            sun = component_layout(spec, "sun").z_range
+            sun = d.layout("sun").z_range
             out["gear_seat"] = boundary[outer & (z > sun[0] - tol)]
         else:
             out["bearing_seat"] = boundary[outer & (z > tube.z1 - width - tol)]
@@ -271,25 +273,26 @@ def _paths(spec: GearboxSpec, component: str, level: str, order: int) -> dict[st
     return {"npz": stem.with_suffix(".npz"), "vol": stem.with_suffix(".vol.gz"), "json": stem.with_suffix(".json")}
 
 
-def component_mesh(spec: GearboxSpec, component: str, level: str = "coarse", order: int | None = None,
+def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coarse", order: int | None = None,
                    progress: bool = False) -> ComponentMesh:
     """The (cached) tetrahedral mesh of ``component`` at mesh ``level``; ``order`` overrides the level's."""
+    spec = (d := as_design(spec)).spec
     if component not in GEOMETRY_COMPONENTS:
         raise ValueError(f"unknown component {component!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
     if level not in spec.meshing_assumed:
         raise ValueError(f"unknown mesh level {level!r}; gearbox.toml [meshing_assumed] has "
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
-    return _mesh(spec, component, level, order, progress)
+    return _mesh(d, component, level, order, progress)
 
 
-def _mesh(spec: GearboxSpec, component: str, level: str, order: int, progress: bool) -> ComponentMesh:
+def _mesh(d: Design, component: str, level: str, order: int, progress: bool) -> ComponentMesh:
     """The cached mesh (:func:`_cached_mesh`), or the one built and stored (:func:`_build_mesh`) when it is
     missing or cannot be read, by one process at a time (the lock of its JSON summary)."""
-    paths = _paths(spec, component, level, order)
-    brep = component_brep(spec, component, progress)
+    paths = _paths(d.spec, component, level, order)
+    brep = component_brep(d, component, progress)
     return load_or_build(paths["json"], lambda: _cached_mesh(paths, component, level, order, brep),
-                         lambda: _build_mesh(spec, component, level, order, progress)[0])
+                         lambda: _build_mesh(d, component, level, order, progress)[0])
 
 
 def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int, brep: Path) -> ComponentMesh | None:
@@ -315,21 +318,22 @@ def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int,
                          build_time, paths["vol"], brep)
 
 
-def _build_mesh(spec: GearboxSpec, component: str, level: str, order: int, progress: bool):
+def _build_mesh(d: Design, component: str, level: str, order: int, progress: bool):
     """Mesh ``component`` (cache miss), store it; (ComponentMesh, its Netgen mesh with the OCC geometry).
 
     Netgen meshes once per component and level: a second-order mesh is the first-order mesh (the cached
     one, or meshed and stored here) raised by ``SecondOrder()``, edge nodes on the true surfaces, the same
     topology the reduction's FE model is built on (flexgear.fe.fem raises the order the same way).
     """
+    spec = d.spec
     paths = _paths(spec, component, level, order)
-    brep = component_brep(spec, component, progress)
+    brep = component_brep(d, component, progress)
     paths["json"].unlink(missing_ok=True)  # written last: until then readers find no entry, not a mixed one
     t0 = time.perf_counter()
     if order == 1:
-        ngmesh = _netgen_mesh(brep, spec, component, level)
+        ngmesh = _netgen_mesh(brep, d, component, level)
     else:
-        first = _mesh(spec, component, level, 1, progress)
+        first = _mesh(d, component, level, 1, progress)
         just_built = _JUST_BUILT.get(first.vol_path)
         # the first-order one stays in _JUST_BUILT
         ngmesh = just_built.Copy() if just_built is not None else _load_netgen_mesh(first.vol_path, brep)
@@ -337,7 +341,7 @@ def _build_mesh(spec: GearboxSpec, component: str, level: str, order: int, progr
     nodes, elements, surface = _arrays(ngmesh, order)
     build = time.perf_counter() - t0
     surface = _orient_outward(nodes, surface)
-    regions = region_nodes(spec, component, nodes, np.unique(surface))
+    regions = region_nodes(d, component, nodes, np.unique(surface))
     mesh = ComponentMesh(component, level, order, nodes, elements, surface, regions, build, paths["vol"], brep)
     tmp_vol = _private_temporary(paths["vol"], ".vol.gz")
     ngmesh.Save(str(tmp_vol))

@@ -30,11 +30,12 @@ from pathlib import Path
 import numpy as np
 
 from flexgear.cache import atomic_write_bytes, cache_dir, load_or_build, read_entry
+from flexgear.design import Design, as_design
 from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.bolted import clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
-from flexgear.geometry.involute import gear_set_geometry, helix_halves, tooth_normal_local
-from flexgear.geometry.layout import component_layout, geometry_hash
+from flexgear.geometry.involute import helix_halves, tooth_normal_local
+from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
@@ -58,8 +59,11 @@ _BOLT_PATCH_KIND = "rbe2"  # the bolt patches' union: the clamped discs moving a
 _WHOLE_BASIS = 0  # cache-key term: the whole compressed basis is kept (no truncation)
 
 
-def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interface]:
-    """Interface node sets of ``component`` (see the module docstring), found on the exact surfaces."""
+def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list[Interface]:
+    """Interface node sets of ``component`` (see the module docstring), found on the exact surfaces.
+    ``spec``: a spec or its design (flexgear.design), as in every function here that takes one."""
+    d = as_design(spec)
+    spec = d.spec
     r = np.hypot(fe.nodes[:, 0], fe.nodes[:, 1])
     z = fe.nodes[:, 2]
     c = spec.components_assumed
@@ -67,22 +71,22 @@ def component_interfaces(fe, spec: GearboxSpec, component: str) -> list[Interfac
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
     if component == "ring":
-        return [patch_union(fe, spec, BOLT_PATCHES)]
-    tube = [p for p in component_layout(spec, component).prisms if p.name == "tube"][0]
+        return [patch_union(fe, d, BOLT_PATCHES)]
+    tube = [p for p in d.layout(component).prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
     if component == "input_shaft":
-        sun = component_layout(spec, "sun").prisms
+        sun = d.layout("sun").prisms
         z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
         joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
-        joints = [patch_union(fe, spec, BOLT_PATCHES)]
+        joints = [patch_union(fe, d, BOLT_PATCHES)]
         far = (z > tube.z1 - seat - _TOL)
     return [*joints, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
 
 
-def patch_union(fe, spec: GearboxSpec, name: str) -> Interface:
+def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
     """The clamped discs of ``fe`` (the ring's flange face or the output shaft's web face,
     flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in ascending order, each disc's
     nodes weighted equally and each disc in all 1 / (number of bolts), the point their weighted centroid (on the
@@ -96,7 +100,7 @@ def patch_union(fe, spec: GearboxSpec, name: str) -> Interface:
     return Interface(name, nodes, weights, weights @ fe.nodes[nodes])
 
 
-def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
+def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
     """(load circle of order 0, angles of the contacts on it [rad]) per contact band of a gear.
 
     Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
@@ -105,7 +109,7 @@ def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, 
     """
     if component not in ("sun", "planet", "ring"):
         return []
-    geo = gear_set_geometry(spec)
+    geo, spec = d.gears, d.spec
     sigma = math.copysign(1.0, spec.load_case.input_speed_rad_s)
     planets = np.asarray(geo.planet_angles, float)
     # (mesh, hand of gear 1, drive sign, is this component gear 1, contact angles on this component)
@@ -126,20 +130,20 @@ def _contact_bands(spec: GearboxSpec, component: str) -> list[tuple[LoadCircle, 
     return out
 
 
-def component_load_circles(spec: GearboxSpec, component: str, order: int) -> list[LoadCircle]:
+def component_load_circles(spec: GearboxSpec | Design, component: str, order: int) -> list[LoadCircle]:
     """Load circles of ``order`` on ``component``'s contact bands (module docstring); [] for shafts or order 0."""
     if order == 0:
         return []
-    return [dataclasses.replace(c, order=order) for c, _ in _contact_bands(spec, component)]
+    return [dataclasses.replace(c, order=order) for c, _ in _contact_bands(as_design(spec), component)]
 
 
-def component_contacts(spec: GearboxSpec, component: str) -> tuple[np.ndarray, np.ndarray]:
+def component_contacts(spec: GearboxSpec | Design, component: str) -> tuple[np.ndarray, np.ndarray]:
     """Contact points (p, 3) [m] and tooth normals (p, 3) of a gear in its body frame, per band and angle.
 
     Sun and ring: the five planets' contacts on each helix half; planet: its sun and ring contacts.
     """
     points, normals = [], []
-    for circle, angles in _contact_bands(spec, component):
+    for circle, angles in _contact_bands(as_design(spec), component):
         z = 0.5 * (circle.z_min_m + circle.z_max_m)
         for a in angles:
             e_r, e_t = np.array([math.cos(a), math.sin(a), 0.0]), np.array([-math.sin(a), math.cos(a), 0.0])
@@ -149,13 +153,13 @@ def component_contacts(spec: GearboxSpec, component: str) -> tuple[np.ndarray, n
     return np.array(points).reshape(-1, 3), np.array(normals).reshape(-1, 3)
 
 
-def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
+def joint_point(spec: GearboxSpec | Design, gear: str) -> np.ndarray:
     """Point [m] (component frame = gearbox frame) where ``gear`` ("sun" or "ring") is joined to its shaft.
 
     Sun-input shaft: on the axis, mid-way along the sun. Ring-output shaft: on the axis, in the plane
     where the ring's flange meets the shaft's web.
     """
-    prisms = component_layout(spec, gear).prisms
+    prisms = as_design(spec).layout(gear).prisms
     if gear == "sun":
         return np.array([0.0, 0.0, 0.5 * (min(p.z0 for p in prisms) + max(p.z1 for p in prisms))])
     if gear == "ring":
@@ -163,7 +167,7 @@ def joint_point(spec: GearboxSpec, gear: str) -> np.ndarray:
     raise ValueError(f"joint_point: gear must be 'sun' or 'ring', got {gear!r}")
 
 
-def gear_shaft_joints(spec: GearboxSpec, gear: str) -> list[tuple[str, str, np.ndarray]]:
+def gear_shaft_joints(spec: GearboxSpec | Design, gear: str) -> list[tuple[str, str, np.ndarray]]:
     """The fixed joint of ``gear`` ("sun" or "ring") and its shaft: [(gear interface, shaft interface, point [m])].
 
     Sun-input shaft: at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat". Ring-output
@@ -189,14 +193,14 @@ def gear_seat(body: ReducedBody, gear: str) -> Interface:
     return body.interface(RING_SEAT if RING_SEAT in names else BOLT_PATCHES)
 
 
-def component_reduced_body(spec: GearboxSpec, component: str, level: str = "coarse",
+def component_reduced_body(spec: GearboxSpec | Design, component: str, level: str = "coarse",
                            progress: bool = False) -> ReducedBody:
     """The reduced flexible body of a component (cached): ``component`` as in Table 3 or the geometry."""
     key, build = _component_reduction(spec, component, level, progress)
     return cached_reduced_body(key, build)
 
 
-def component_mass_properties(spec: GearboxSpec, component: str, level: str = "coarse",
+def component_mass_properties(spec: GearboxSpec | Design, component: str, level: str = "coarse",
                               progress: bool = False) -> MassProperties:
     """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
     when the body is there (a rigid twin needs no modes), else from the body built and cached."""
@@ -205,7 +209,8 @@ def component_mass_properties(spec: GearboxSpec, component: str, level: str = "c
     return props if props is not None else cached_reduced_body(key, build).props
 
 
-def cached_component_frequencies(spec: GearboxSpec, component: str, level: str = "coarse") -> np.ndarray | None:
+def cached_component_frequencies(spec: GearboxSpec | Design, component: str,
+                                 level: str = "coarse") -> np.ndarray | None:
     """Free-free frequencies [Hz] of :func:`component_reduced_body`, read alone from the cache; None when the
     body is not cached yet (nothing is built)."""
     return _read_cached(_component_reduction(spec, component, level, False)[0], _load_frequencies)
@@ -236,13 +241,15 @@ def _read_cached(key: str, read: Callable[[Path], object]) -> object | None:
         return None
 
 
-def _component_reduction(spec: GearboxSpec, component: str, level: str,
+def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
                          progress: bool) -> tuple[str, Callable[[], ReducedBody]]:
     """Cache key and build function of a component's reduced body (:func:`component_reduced_body`)."""
+    d = as_design(spec)
+    spec = d.spec
     name = COMPONENT_GEOMETRY[component]
     mesh_settings = spec.meshing_assumed[level]
     red = spec.reduction_assumed
-    circles = component_load_circles(spec, name, red.attachment_order)
+    circles = component_load_circles(d, name, red.attachment_order)
     patches = name in ("ring", "output_shaft")
     # the bolt patches' union, its kind and clamped disc enter the key of the bodies that have it
     extra = [(BOLT_PATCHES, "union", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
@@ -258,9 +265,9 @@ def _component_reduction(spec: GearboxSpec, component: str, level: str,
                 "on the first-order mesh topology)")
         # first-order mesh topology; fe_model raises the order itself (a second-order Netgen mesh loaded
         # as is carries its mid-edge points as unconnected vertices: a singular stiffness matrix)
-        mesh = component_mesh(spec, name, level, order=1, progress=progress)
+        mesh = component_mesh(d, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
-        itfs = component_interfaces(fe, spec, name)
+        itfs = component_interfaces(fe, d, name)
         return reduce(fe, itfs, red.fixed_interface_modes, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
                       rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES))
 

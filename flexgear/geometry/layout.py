@@ -36,6 +36,7 @@ from __future__ import annotations
 
 import json
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from functools import lru_cache
 
@@ -51,11 +52,15 @@ __all__ = [
     "Section",
     "Prism",
     "ComponentLayout",
+    "tooth_profiles",
     "gear_profiles",
     "component_layout",
+    "gear_set_layout",
     "section_integrals",
     "exact_mass_properties",
+    "layout_mass_properties",
     "component_mass_properties",
+    "cached_mass_properties",
     "geometry_hash",
 ]
 
@@ -128,14 +133,15 @@ class ComponentLayout:
 
 
 @lru_cache(maxsize=16)
-def _profiles_cached(gs: GearSetGeometry, fillet_coefficient: float) -> dict[str, ToothProfile]:
+def tooth_profiles(gs: GearSetGeometry, fillet_coefficient: float) -> dict[str, ToothProfile]:
+    """Tooth profiles of the gear set's sun, planet and ring (root fillet radius = ``fillet_coefficient`` * m_n)."""
     return {name: tooth_profile(getattr(gs, name), fillet_coefficient * getattr(gs, name).normal_module)
             for name in GEAR_COMPONENTS}
 
 
 def gear_profiles(spec: GearboxSpec) -> dict[str, ToothProfile]:
     """Tooth profiles of sun, planet and ring (root fillet radius = root_fillet_coefficient * m_n)."""
-    return _profiles_cached(gear_set_geometry(spec), spec.gears_assumed.root_fillet_coefficient)
+    return tooth_profiles(gear_set_geometry(spec), spec.gears_assumed.root_fillet_coefficient)
 
 
 def _gear_half_length(spec: GearboxSpec) -> float:
@@ -162,10 +168,16 @@ def _gear_prisms(spec: GearboxSpec, name: str, gear: Gear, inner: float, outer: 
 
 def component_layout(spec: GearboxSpec, component: str) -> ComponentLayout:
     """The prisms of ``component`` (one of GEOMETRY_COMPONENTS) in its component frame."""
+    return gear_set_layout(spec, gear_set_geometry(spec), component)
+
+
+def gear_set_layout(spec: GearboxSpec, gs: GearSetGeometry, component: str) -> ComponentLayout:
+    """:func:`component_layout` of ``spec`` with its gear set ``gs`` (flexgear.geometry.involute.gear_set_geometry)
+    given."""
     if component not in GEOMETRY_COMPONENTS:
         raise ValueError(f"unknown component {component!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
-    gs, c = gear_set_geometry(spec), spec.components_assumed
-    profiles = gear_profiles(spec)
+    c = spec.components_assumed
+    profiles = tooth_profiles(gs, spec.gears_assumed.root_fillet_coefficient)
     mm = 1e-3
     h = _gear_half_length(spec)
     if component in ("sun", "planet"):
@@ -227,9 +239,14 @@ def section_integrals(section: Section, profiles: dict[str, ToothProfile] | None
 
 def exact_mass_properties(spec: GearboxSpec, component: str) -> MassProperties:
     """Mass properties of ``component`` from the exact section integrals (no cache)."""
-    layout = component_layout(spec, component)
-    rho = spec.material_assumed.density_kg_m3
-    profiles = gear_profiles(spec)
+    return layout_mass_properties(component_layout(spec, component), gear_profiles(spec),
+                                  spec.material_assumed.density_kg_m3)
+
+
+def layout_mass_properties(layout: ComponentLayout, profiles: dict[str, ToothProfile],
+                           rho: float) -> MassProperties:
+    """Mass properties of a component ``layout`` of density ``rho`` [kg/m^3] from the exact section integrals
+    (module docstring), the gear sections' outlines from ``profiles``."""
     mass = first = i_zz = i_xx = 0.0
     for p in layout.prisms:
         area, polar = section_integrals(p.section, profiles)
@@ -248,6 +265,12 @@ def component_mass_properties(spec: GearboxSpec, component: str) -> MassProperti
     ``component``: "sun", "planet", "ring", "input_shaft" or "output_shaft"; frames as in the
     module docstring. The JSON cache ``meshes/massprops-<hash>.json`` is keyed by every input.
     """
+    return cached_mass_properties(spec, component, lambda: exact_mass_properties(spec, component))
+
+
+def cached_mass_properties(spec: GearboxSpec, component: str, compute: Callable[[], MassProperties]) -> MassProperties:
+    """:func:`component_mass_properties` from its JSON cache, else computed by ``compute()`` (the exact section
+    integrals of ``component``'s layout) and stored."""
     path = cache_dir() / f"massprops-{component}-{geometry_hash(spec, component)}.json"
     if path.exists():
         try:
@@ -256,7 +279,7 @@ def component_mass_properties(spec: GearboxSpec, component: str) -> MassProperti
                                   np.array(d["inertia_kg_m2"], float))
         except (ValueError, KeyError):
             pass  # unreadable entry: recompute and overwrite
-    props = exact_mass_properties(spec, component)
+    props = compute()
     payload = {"component": component, "mass_kg": props.mass, "com_m": props.com.tolist(),
                "inertia_kg_m2": props.inertia.tolist(), "method": "exact section integrals"}
     atomic_write_bytes(path, json.dumps(payload, indent=1).encode())

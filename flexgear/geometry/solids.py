@@ -32,9 +32,8 @@ from dataclasses import dataclass
 import netgen.occ as occ
 import numpy as np
 
-from flexgear.geometry.layout import ComponentLayout, Prism, component_layout
+from flexgear.geometry.layout import ComponentLayout, Prism
 from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
-from flexgear.spec import GearboxSpec
 
 __all__ = ["FLANK_POINTS", "section_face", "component_solid", "occ_mass_properties"]
 
@@ -245,14 +244,12 @@ def _holes(solid, prisms: list[Prism]):
     return solid - (occ.Fuse(cutters) if len(cutters) > 1 else cutters[0])
 
 
-def component_solid(spec: GearboxSpec | ComponentLayout, component: str | None = None,
-                    flank_points: int = FLANK_POINTS):
-    """One OCC solid of ``component`` in its component frame (see flexgear.geometry.layout).
+def component_solid(layout: ComponentLayout, flank_points: int = FLANK_POINTS):
+    """One OCC solid of a component's ``layout`` in its component frame (see flexgear.geometry.layout).
 
     The prisms of the layout must stack along z without gaps; consecutive sections must overlap
     radially and their differing boundaries must not cross (ValueError otherwise).
     """
-    layout = spec if isinstance(spec, ComponentLayout) else component_layout(spec, component)
     prisms = sorted(layout.prisms, key=lambda p: p.z0)
     pairs = list(zip(prisms[:-1], prisms[1:], strict=True))
     for a, b in pairs:

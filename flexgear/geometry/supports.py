@@ -15,26 +15,32 @@ Bearing centres (component frames, z along the axis, origin at the gear mid-plan
 from __future__ import annotations
 
 from flexgear.geometry.elements import BearingElement
-from flexgear.geometry.layout import component_layout
+from flexgear.geometry.layout import ComponentLayout, component_layout
 from flexgear.spec import GearboxSpec
 
-__all__ = ["gearbox_supports"]
+__all__ = ["gearbox_supports", "seat_supports"]
 
 
-def _seat_centre(spec: GearboxSpec, shaft: str) -> float:
-    tube = [p for p in component_layout(spec, shaft).prisms if p.name == "tube"][0]
+def _seat_centre(spec: GearboxSpec, layout: ComponentLayout) -> float:
+    tube = [p for p in layout.prisms if p.name == "tube"][0]
     seat = spec.components_assumed.bearing_seat_width_mm * 1e-3
-    return tube.z0 + 0.5 * seat if shaft == "input_shaft" else tube.z1 - 0.5 * seat
+    return tube.z0 + 0.5 * seat if layout.name == "input_shaft" else tube.z1 - 0.5 * seat
 
 
 def gearbox_supports(spec: GearboxSpec) -> dict[str, BearingElement]:
     """The Table 2 bearings of the study's gearbox ("input_shaft", "output_shaft", "planet"), each at its seat on its
     component (the shafts' "bearing_seat", the planet's "bore" interface), ground on the other side."""
+    return seat_supports(spec, component_layout(spec, "input_shaft"), component_layout(spec, "output_shaft"))
+
+
+def seat_supports(spec: GearboxSpec, input_shaft: ComponentLayout,
+                  output_shaft: ComponentLayout) -> dict[str, BearingElement]:
+    """:func:`gearbox_supports` with the shafts' layouts (flexgear.geometry.layout) given."""
     b = spec.bearings
     return {
         "input_shaft": BearingElement.from_bearing(b.input_shaft, "input_shaft", (0.0, 0.0, _seat_centre(
-            spec, "input_shaft")), "bearing_seat"),
+            spec, input_shaft)), "bearing_seat"),
         "output_shaft": BearingElement.from_bearing(b.output_shaft, "output_shaft", (0.0, 0.0, _seat_centre(
-            spec, "output_shaft")), "bearing_seat"),
+            spec, output_shaft)), "bearing_seat"),
         "planet": BearingElement.from_bearing(b.planet, "planet", (0.0, 0.0, 0.0), "bore"),
     }

@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from flexgear.design import Design, as_design
 from flexgear.spec import Contact, GearboxSpec
 
 __all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "friction_forces",
@@ -59,28 +60,28 @@ def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, dam
     return 2.0 * damping_ratio * math.sqrt(stiffness_n_per_m * mass1_kg * mass2_kg / (mass1_kg + mass2_kg))
 
 
-def mesh_laws(spec: GearboxSpec) -> dict[str, ContactLaw]:
+def mesh_laws(spec: GearboxSpec | Design) -> dict[str, ContactLaw]:
     """The whole-face-width law of the sun-planet ("outer") and planet-ring ("inner") meshes.
 
     ``[contact] law = "impact"``: the study's law for both. ``"iso6336"``: k = c_gamma_alpha b / cos^2(beta_b)
     along the tooth normal (flexgear.laws.iso6336, b = total active face width, line load from the
     theoretical input torque shared by the planets, K_A = ``[contact_assumed] application_factor``) and
-    c from eq. 13 with ``[contact_assumed] mesh_damping_ratio`` and the gears' exact masses.
+    c from eq. 13 with ``[contact_assumed] mesh_damping_ratio`` and the gears' exact masses. ``spec``: a spec or
+    its design (flexgear.design).
     """
+    d = as_design(spec)
+    spec = d.spec
     if spec.contact.law == "impact":
         law = ContactLaw.from_contact(spec.contact)
         return {"outer": law, "inner": law}
-    from flexgear.geometry.involute import gear_set_geometry
-    from flexgear.geometry.layout import component_mass_properties
     from flexgear.laws.iso6336 import tooth_stiffness
-    from flexgear.theory import theory
 
-    geo = gear_set_geometry(spec)
+    geo = d.gears
     ga, ca = spec.gears_assumed, spec.contact_assumed
     b = ga.face_width_m
-    f_t = abs(theory(spec).input_torque) / (geo.planet_count * geo.sun.reference_radius)  # either flank
+    f_t = abs(d.theory.input_torque) / (geo.planet_count * geo.sun.reference_radius)  # either flank
     line_load = ca.application_factor * f_t / (b * 1e3)
-    mass = {c: component_mass_properties(spec, c).mass for c in ("sun", "planet", "ring")}
+    mass = {c: d.mass_properties(c).mass for c in ("sun", "planet", "ring")}
     out = {}
     for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"),
                                ("inner", geo.planet_ring, "planet", "ring")):

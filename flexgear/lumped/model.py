@@ -33,9 +33,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexgear.geometry.involute import GearSetGeometry, contact_line_integrals, gear_set_geometry
+from flexgear.design import Design, as_design
+from flexgear.geometry.involute import GearSetGeometry, contact_line_integrals
 from flexgear.geometry.massprops import combine_mass_properties
-from flexgear.geometry.supports import gearbox_supports
 from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
@@ -130,8 +130,9 @@ class LumpedParameters:
         return np.asarray(self.planet_angles_rad, dtype=float)
 
     @classmethod
-    def from_spec(cls, spec: GearboxSpec, hold_input: bool = False) -> LumpedParameters:
-        """Parameters of the spec's gearbox (``hold_input``: also hold the sun's spin, as the prescribed drive does).
+    def from_spec(cls, spec: GearboxSpec | Design, hold_input: bool = False) -> LumpedParameters:
+        """Parameters of the spec's gearbox, from the spec or its design (flexgear.design) (``hold_input``: also hold
+        the sun's spin, as the prescribed drive does).
 
         - masses and spin inertias: flexgear.geometry.layout.component_mass_properties (sun + input shaft,
           the in-plane mass the apparent mass at the gear centre of the joined parts, see ``mi``;
@@ -146,15 +147,13 @@ class LumpedParameters:
         - with ``[contact] law = "iso6336"`` both from flexgear.laws.contact.mesh_laws, the multibody model's law
         - pressure angles: operating transverse pressure angles of the two meshes (flexgear.geometry.involute)
         """
-        from flexgear.geometry.layout import component_mass_properties
-
-        geo = gear_set_geometry(spec)
+        d = as_design(spec)
+        spec, geo = d.spec, d.gears
         la = spec.lumped_assumed
         names = GEOMETRY_COMPONENTS
-        props = {c: component_mass_properties(spec, c) for c in names}
+        props = {c: d.mass_properties(c) for c in names}
         star = spec.gears.arrangement == "star"
-
-        supports = gearbox_supports(spec)
+        supports = d.supports
 
         def member(mass: float, inertia: float, radius: float, bearing, held: bool = False) -> MemberParameters:
             if held:
@@ -193,7 +192,7 @@ class LumpedParameters:
             fixed = (*fixed, "sun")
         m_s, m_p, m_r = props["sun"].mass, props["planet"].mass, props["ring"].mass
         if spec.contact.law == "iso6336":  # the multibody model's law and damping (flexgear.laws.contact.mesh_laws)
-            laws = mesh_laws(spec)
+            laws = mesh_laws(d)
             k_s, k_r = laws["outer"].stiffness, laws["inner"].stiffness
             c_s, c_r = laws["outer"].damping_max, laws["inner"].damping_max
         else:  # the study's lumped model: eq. 10 with an assumed C_gamma, eq. 13

@@ -46,7 +46,8 @@ import numba
 import numpy as np
 import pandas as pd
 
-from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
+from flexgear.design import Design, as_design
+from flexgear.geometry.involute import mesh_stiffness_harmonics
 from flexgear.laws.compiled import (
     backlash_linear_force,
     impact_normal_force,
@@ -60,7 +61,6 @@ from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import GearboxSpec, spec_hash
-from flexgear.theory import theory
 
 __all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces"]
 
@@ -97,12 +97,12 @@ class LumpedModel:
     mesh_c: np.ndarray  # (meshes,) the law's damping: eq. 13 [N s/m], or the impact law's c_max [N s/m]
 
 
-def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
-    """Assemble the time-domain model of the spec (one source of truth: involute, theory, geometry)."""
-    params = LumpedParameters.from_spec(spec, hold_input=True)
+def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
+    """Assemble the time-domain model of the spec or its design (flexgear.design: gear set, theory, geometry)."""
+    d = as_design(spec)
+    spec, geo, th = d.spec, d.gears, d.theory
+    params = LumpedParameters.from_spec(d, hold_input=True)
     sysm = assemble(params)
-    geo = gear_set_geometry(spec)
-    th = theory(spec)
     g, lc = spec.gears, spec.load_case
     star = g.arrangement == "star"
     r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)  # Omega_c / omega_in
@@ -118,7 +118,7 @@ def build_lumped_model(spec: GearboxSpec) -> LumpedModel:
     ip = np.array([2, out_spin, 0, 1 if star else 2], dtype=np.int64)
     mesh_k, mesh_c = sysm.mesh_stiffness, sysm.mesh_damping
     if spec.contact.law == "impact":  # the multibody model's law, whole face width, on every mesh
-        law = mesh_laws(spec)["outer"]
+        law = mesh_laws(d)["outer"]
         fp[_IMPACT], fp[_EXPONENT], fp[_DEPTH] = 1.0, law.exponent, law.penetration_depth
         mesh_k, mesh_c = np.full_like(mesh_k, law.stiffness), np.full_like(mesh_c, law.damping_max)
 
@@ -380,7 +380,8 @@ def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: 
     if t_end <= 0.0:
         raise ValueError(f"t_end_s: expected > 0, got {t_end}")
     wall0, cpu0 = time.perf_counter(), time.process_time()
-    model = build_lumped_model(spec)
+    d = as_design(spec)
+    model = build_lumped_model(d)
     rec = _simulate(model, t_end, lc.step_size_s, spec.lumped_assumed.integration_substeps, progress)
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
     n = model.system.params.planet_count
@@ -391,7 +392,7 @@ def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: 
         ratio = np.where(w_in != 0.0, w_out / w_in, np.nan)
     data = np.column_stack([t, w_in, w_out, ratio, rec[:, 2], rec[:, 3:3 + nm], rec[:, 3 + nm:7 + nm]])
     signals = pd.DataFrame(data, columns=signal_columns(n))
-    meta = run_metadata("lumped", "lumped", spec_hash(spec, "lumped", t_end), t_end, lc, n, {}, theory(spec),
+    meta = run_metadata("lumped", "lumped", spec_hash(spec, "lumped", t_end), t_end, lc, n, {}, d.theory,
                         status="ok", reason="", wall_time_s=wall, cpu_time_s=cpu,
                         integration={"method": "rk4", "substeps": spec.lumped_assumed.integration_substeps})
     return RunResult(meta, signals)

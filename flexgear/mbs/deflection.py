@@ -27,7 +27,6 @@ import math
 import numpy as np
 
 from flexgear.fe.reduced import BOLT_PATCHES, RING_SEAT, gear_seat
-from flexgear.geometry.involute import gear_set_geometry
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import frame_rows, normal_lever
 from flexgear.spec import COMPONENT_GEOMETRY
@@ -40,7 +39,7 @@ def transmission_error(model, time_s: np.ndarray, output_angle: np.ndarray) -> n
     spec, th = model.spec, model.theory
     lc = spec.load_case
     theta_in = np.asarray(drive_angle(np.asarray(time_s), lc.ramp_time_s, lc.input_speed_rad_s), float)
-    geo = gear_set_geometry(spec)
+    geo = model.design.gears
     r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
     sign = math.copysign(1.0, th.output_speed)
     return r_out * (th.ratio * theta_in - np.asarray(output_angle, float)) * sign

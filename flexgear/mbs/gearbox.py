@@ -19,12 +19,12 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from flexgear.design import Design, as_design
 from flexgear.fe.ring_shaft import TIED_PAIR
 from flexgear.geometry.elements import BearingElement, FixedJointElement
-from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
+from flexgear.geometry.involute import GearSetGeometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
-from flexgear.geometry.supports import gearbox_supports
 from flexgear.laws.contact import mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
@@ -38,7 +38,7 @@ from flexgear.mbs.elements import (
 )
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
-from flexgear.theory import Theory, theory
+from flexgear.theory import Theory
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "dynamic_modes", "run_cost"]
 
@@ -47,8 +47,7 @@ __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox"
 class GearboxModel:
     """Handles of an assembled gearbox in an Exudyn system."""
 
-    spec: GearboxSpec
-    theory: Theory
+    design: Design  # the gearbox's spec, gear set and theory (flexgear.design)
     bodies: dict[str, Body]
     outer_contacts: list[list[int]]  # [planet][half] spring-damper objects, sun-planet
     inner_contacts: list[list[int]]  # [planet][half] spring-damper objects, planet-ring
@@ -71,13 +70,21 @@ class GearboxModel:
     body_axes_joints: tuple[str, ...] = ()
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
 
+    @property
+    def spec(self) -> GearboxSpec:
+        return self.design.spec
+
+    @property
+    def theory(self) -> Theory:
+        return self.design.theory
+
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
     """(axial position z_h [m], planet hand H, face-width share) of each helix half."""
     return [(h.z, h.hand, h.share) for h in pair_helix_halves(geo.helix_layout, geo.helix_face_width, geo.half_gap)]
 
 
-def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContact]:
+def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[GearContact]:
     """Gear contacts of every planet, mesh and helix half, in the order (planet, outer/inner, half).
 
     Built with the generic :func:`flexgear.geometry.layout.pair.pair_contacts`. Sun-planet: gear 1 = sun, pushing
@@ -85,16 +92,17 @@ def mesh_contacts(spec: GearboxSpec, drive_sign: float = 1.0) -> list[GearContac
     hands (flexgear.geometry.layout.pair convention, gear 1 in the +z half): sun +1, planet -1, so that the
     planet's axial forces from sun and ring cancel. Mesh phase of planet i:
     phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing), plus the configured
-    outer-inner phase on the planet-ring mesh.
+    outer-inner phase on the planet-ring mesh. ``spec``: a spec or its design (flexgear.design).
     """
-    geo = gear_set_geometry(spec)
+    d = as_design(spec)
+    geo, spec = d.gears, d.spec
     g = spec.gears
     zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
     sigma = 1.0 if drive_sign >= 0 else -1.0
     spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
     common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
                   half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
-    laws = mesh_laws(spec)
+    laws = mesh_laws(d)
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -113,31 +121,26 @@ MassSource = Callable[[GearboxSpec, str], MassProperties]
 ReducedSource = Callable[[GearboxSpec, str, str], object]
 
 
-def _exact_mass_source(spec: GearboxSpec, component: str) -> MassProperties:
-    from flexgear.geometry.layout import component_mass_properties
-
-    return component_mass_properties(spec, component)
-
-
 def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
     from flexgear.fe.ring_shaft import reduced_body
 
     return reduced_body(spec, component, level, progress=True)
 
 
-def _default_mass_source(spec: GearboxSpec, component: str, level: str) -> MassProperties:
+def _default_mass_source(d: Design, component: str, level: str) -> MassProperties:
     from flexgear.fe.reduced import component_mass_properties
 
-    return component_mass_properties(spec, component, level, progress=True)
+    return component_mass_properties(d, component, level, progress=True)
 
 
-def _mass_source(variant: Variant, reduced: ReducedSource, default_bodies: bool) -> MassSource:
-    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's.
-    With the default reduced bodies (``default_bodies``) a rigid twin reads only its body's mass properties."""
+def _mass_source(variant: Variant, d: Design, reduced: ReducedSource, default_bodies: bool) -> MassSource:
+    """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's (of the
+    variant's design ``d``). With the default reduced bodies (``default_bodies``) a rigid twin reads only its body's
+    mass properties."""
     if variant.rigid_mass_properties == "exact":
-        return _exact_mass_source
+        return lambda spec, component: d.mass_properties(component)
     if default_bodies:
-        return lambda spec, component: _default_mass_source(spec, component, variant.mesh_level)
+        return lambda spec, component: _default_mass_source(d, component, variant.mesh_level)
     return lambda spec, component: reduced(spec, component, variant.mesh_level).props
 
 
@@ -162,13 +165,14 @@ def run_cost(variant: Variant) -> float | None:
     feeds grow with it), from the cached reduced bodies' frequencies; None if one of them is not cached yet."""
     from flexgear.fe.reduced import cached_component_frequencies
 
-    spec = variant.gearbox
-    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * theory(spec).mesh_frequency
+    d = as_design(variant.gearbox)
+    spec = d.spec
+    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * d.theory.mesh_frequency
     cost = 0.0
     for component, form in variant.components.items():
         if form != "flexible":
             continue
-        frequencies = cached_component_frequencies(spec, component, variant.mesh_level)
+        frequencies = cached_component_frequencies(d, component, variant.mesh_level)
         if frequencies is None:
             return None
         geometry = COMPONENT_GEOMETRY[component]
@@ -264,7 +268,8 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
-                       reduced_source: ReducedSource | None = None, superelements: bool = False) -> GearboxModel:
+                       reduced_source: ReducedSource | None = None, superelements: bool = False,
+                       design: Design | None = None) -> GearboxModel:
     """Assemble the star gearbox of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards).
 
     Each component is rigid or flexible as the variant says. A shaft and its gear (input shaft-sun,
@@ -284,10 +289,12 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     those of the reduced body at the variant's mesh level (rigid and flexible twins identical), or
     "exact", the exact geometry's; ``mass_source`` overrides both. ``superelements``: every flexible body keeps
     its ``ObjectFFRFreducedOrder`` even when the linear forms need none (for mesh-node sensors: recorded states).
+    ``design``: the design of the variant's gearbox (flexgear.design; made from it when None).
     """
     from flexgear.fe.reduced import gear_shaft_joints
 
-    spec = variant.gearbox
+    d = as_design(variant.gearbox if design is None else design)
+    spec = d.spec
     if spec.gears.arrangement != "star":
         raise ValueError(f"{spec.source}: field 'gears.arrangement': build_star_gearbox needs 'star'")
     source = reduced_source or _default_reduced_source
@@ -298,17 +305,16 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             loaded[component, level] = source(spec, component, level)
         return loaded[component, level]
 
-    props = mass_source or _mass_source(variant, reduced, reduced_source is None)
+    props = mass_source or _mass_source(variant, d, reduced, reduced_source is None)
     form = variant.components
-    th = theory(spec)
-    geo = gear_set_geometry(spec)
+    th, geo = d.theory, d.gears
     level = variant.mesh_level
     reference = spec.solver_assumed.reference
     lc = spec.load_case
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
-    supports = gearbox_supports(spec)
-    contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
+    supports = d.supports
+    contacts = mesh_contacts(d, math.copysign(1.0, lc.input_speed_rad_s))
     bodies: list[Body] = []
     pairs = []
     ends = {}
@@ -323,7 +329,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                          contacts=contacts, source=TIED_PAIR))
             ends[gear] = gear
         else:
-            joints = [FixedJointElement.gear_shaft(gear, shaft, j) for j in gear_shaft_joints(spec, gear)]
+            joints = [FixedJointElement.gear_shaft(gear, shaft, j) for j in gear_shaft_joints(d, gear)]
             lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
                                   {j.interface: j.point for j in joints}, cutoff_hz=cutoff, dropped=dropped,
                                   spin_rad_s=spin, superelement=superelements, contacts=contacts)
@@ -404,7 +410,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(spec, th, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
+    return GearboxModel(d, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
                         tuple(train.aux_nodes), ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
                         train.residual, linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
                         seat_residual_nodes=train.seat_residual_nodes)

@@ -23,6 +23,7 @@ import traceback
 import numpy as np
 import pandas as pd
 
+from flexgear.design import Design, design
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.newton import JacobianEconomy
@@ -114,12 +115,10 @@ def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], signals: pd
     return out
 
 
-def _meta(variant: Variant, t_end: float) -> dict:
-    from flexgear.theory import theory
-
+def _meta(variant: Variant, d: Design, t_end: float) -> dict:
     gb = variant.gearbox
     return run_metadata(variant.name, "exudyn", spec_hash(variant, t_end), t_end, gb.load_case,
-                        gb.gears.planet_count, variant.components, theory(gb),
+                        gb.gears.planet_count, variant.components, d.theory,
                         source=str(variant.source), spec=as_dict(gb))
 
 
@@ -134,9 +133,7 @@ class RunGuard:
 
     def __init__(self, model: GearboxModel, variant: Variant, t_end: float, budget_s: float,
                  progress: bool = False) -> None:
-        from flexgear.theory import theory
-
-        th = theory(variant.gearbox)
+        th = model.theory
         factor = variant.gearbox.solver_assumed.runaway_speed_factor
         self.nodes = {"input": model.bodies[model.input_body].node, "output": model.bodies[model.output_body].node}
         self.limits = {"input": factor * abs(math.radians(th.input_speed_deg_per_s)),
@@ -320,7 +317,8 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
     until_settled = t_end_s == "settled" or (t_end_s is None and lc.end == "settled")
     t_end = lc.end_time_s if (t_end_s is None or until_settled) else float(t_end_s)
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
-    meta = _meta(variant, t_end)
+    d = design(variant.gearbox)
+    meta = _meta(variant, d, t_end)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     extra: dict[str, pd.DataFrame] = {}
     # small BLAS calls only (mode-shape fits, post-processing): threads contend on a shared machine
@@ -332,7 +330,8 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
         sc = exu.SystemContainer()
         mbs = sc.AddSystem()
-        model = build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements=record_states_every > 0)
+        model = build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements=record_states_every > 0,
+                                   design=d)
         sensors = add_gearbox_sensors(mbs, model)
         states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()

@@ -129,8 +129,7 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     from exudyn.itemInterface import LoadCoordinate, MarkerNodeCoordinate, SensorNode
     from threadpoolctl import threadpool_limits
 
-    from flexgear.geometry.involute import gear_set_geometry
-    from flexgear.geometry.supports import gearbox_supports
+    from flexgear.design import design
     from flexgear.mbs.gearbox import build_star_gearbox
     from flexgear.mbs.recording import simulation_settings
     from flexgear.mbs.run import RunGuard
@@ -145,19 +144,20 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     tol = DEFAULT_NEWTON_RELATIVE_TOLERANCE if newton_relative_tolerance is None else float(newton_relative_tolerance)
     t1 = round((lc.ramp_time_s + settle_s) / h) * h
     t2 = t1 + round(window_s / h) * h
-    support = gearbox_supports(spec)["output_shaft"]
+    d = design(spec)
+    support = d.supports["output_shaft"]
     r_seat = 0.5e-3 * spec.components_assumed.output_shaft_outer_diameter_mm
     point = np.array([r_seat, 0.0, support.centre[2]])
     direction = np.ones(3) / math.sqrt(3.0)
     generalized = np.concatenate([direction, np.cross(point, direction)])  # Q per unit force
-    arm = gear_set_geometry(spec).centre_distance
+    arm = d.gears.centre_distance
     pulse = {"on": False}
 
     sc = exu.SystemContainer()
     try:
         mbs = sc.AddSystem()
         with threadpool_limits(limits=1, user_api="blas"):
-            model = build_star_gearbox(mbs, built, mass_source, reduced_source)
+            model = build_star_gearbox(mbs, built, mass_source, reduced_source, design=d)
         out_node = model.bodies[model.output_body].node
         for k, q in enumerate(generalized):
             if q == 0.0:

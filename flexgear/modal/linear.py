@@ -224,9 +224,7 @@ def _mass_parts(variant: Variant, model, mbs) -> dict[int, list[tuple[str, np.nd
             continue
         shaft = "input_shaft" if gear == "sun" else "output_shaft"
         if variant.rigid_mass_properties == "exact":
-            from flexgear.geometry.layout import component_mass_properties
-
-            props = {c: component_mass_properties(spec, c) for c in (gear, shaft)}
+            props = {c: model.design.mass_properties(c) for c in (gear, shaft)}
         else:
             from flexgear.fe.reduced import component_mass_properties as mesh_props
 
@@ -267,10 +265,9 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
     import exudyn as exu
 
     from flexgear.laws.ramps import drive_angle
-    from flexgear.theory import theory
 
     spec = variant.gearbox
-    th, lc = theory(spec), spec.load_case
+    th, lc = model.theory, spec.load_case
     theta = float(drive_angle(t_star, lc.ramp_time_s, lc.input_speed_rad_s))
     q0 = np.array(mbs.systemData.GetODE2Coordinates(exu.ConfigurationType.Initial))
     v0 = np.zeros_like(q0)
