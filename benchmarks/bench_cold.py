@@ -16,7 +16,7 @@ Run: nice -n 5 python benchmarks/bench_cold.py [--repeat 3] [--sections cold mak
   per component and run: tetrahedra, nodes, solid time, mesh time (Netgen, from reading the ``.brep`` to the
   last node), the smallest shape quality of the vertex tetrahedra (mean ratio 12 (3V)^(2/3) / sum of squared
   edge lengths: 1 regular, 0 flat) and the mesh-vs-exact differences of mass and Izz
-  (flexgear.fe.mesh.mass_check); the solid's own OCC mass against the exact section integrals once per component.
+  (flexgear.fe.surface.mass_check); the solid's own OCC mass against the exact section integrals once per component.
 
 CPU time is the sum over the command's processes (user + system; on a busy machine the steadier figure,
 but parallel work counts once per core). Peak memory is the largest maximum resident set size among the
@@ -158,7 +158,8 @@ def mesh_table(a: argparse.Namespace) -> None:
 
     import netgen.occ as occ
 
-    from flexgear.fe.mesh import component_brep, component_mesh, mass_check
+    from flexgear.fe.mesh import component_brep, component_mesh
+    from flexgear.fe.surface import mass_check
     from flexgear.geometry.layout import exact_mass_properties
     from flexgear.spec import load_gearbox
 

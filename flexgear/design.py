@@ -68,7 +68,7 @@ _MAX_DESIGNS = 64
 
 def design(spec: GearboxSpec) -> Design:
     """The design of ``spec``, made once per spec content (its file path aside: the design returned carries
-    ``spec`` itself)."""
+    ``spec`` itself, and is the one returned for that spec object until another of the same content asks)."""
     key = spec_hash(spec)
     made = _DESIGNS.get(key)
     if made is None:
@@ -77,7 +77,9 @@ def design(spec: GearboxSpec) -> Design:
         if len(_DESIGNS) >= _MAX_DESIGNS:
             _DESIGNS.pop(next(iter(_DESIGNS)))
         _DESIGNS[key] = made
-    return made if made.spec is spec else replace(made, spec=spec)
+    if made.spec is not spec:  # the same content from another spec object: its geometry, this spec
+        made = _DESIGNS[key] = replace(made, spec=spec)
+    return made
 
 
 def as_design(spec_or_design: GearboxSpec | Design) -> Design:

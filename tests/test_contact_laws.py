@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.geometry.involute import PeriodicSeries
+from flexgear.geometry.contact_lines import PeriodicSeries
 from flexgear.laws.contact import ContactLaw, backlash_linear_force, friction_forces, impact_force
 from flexgear.laws.ramps import drive_angle, step, step_integral
 

@@ -9,7 +9,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from flexgear.geometry.involute import gear_set_geometry, mesh_stiffness_harmonics
+from flexgear.geometry.contact_lines import mesh_stiffness_harmonics
+from flexgear.geometry.involute import gear_set_geometry
 from flexgear.lumped.modal import modal_analysis
 from flexgear.lumped.model import LumpedParameters, MemberParameters, friction_tables, mesh_friction_tables
 from flexgear.lumped.run import run_lumped, static_mesh_forces

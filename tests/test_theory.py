@@ -5,7 +5,8 @@ import math
 import numpy as np
 import pytest
 
-from flexgear.geometry.involute import contact_line_distribution, gear_set_geometry, inv, mesh_stiffness_harmonics
+from flexgear.geometry.contact_lines import contact_line_distribution, mesh_stiffness_harmonics
+from flexgear.geometry.involute import gear_set_geometry, inv
 from flexgear.laws.ramps import step, step_integral
 from flexgear.theory import theory
 

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import trimesh
 
-from flexgear.fe.mesh import component_mesh, surface_mesh
+from flexgear.fe.mesh import component_mesh
+from flexgear.fe.surface import surface_mesh
 from flexgear.geometry.check import _MM, _section, nominal_placements
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.geometry.layout import component_layout

@@ -5,7 +5,7 @@ The home of the per-step laws that both the multibody kernels (:func:`mesh_step`
 (:func:`impact_normal_force`, :func:`linear_normal_force`, :func:`backlash_linear_force`), the mesh-stiffness and
 contact-line Fourier series (:func:`series_value`) and tooth friction (:func:`tooth_friction`). numba compiles a
 call of one njit function from another into the caller, so a kernel pays nothing for calling them. The numpy forms
-in flexgear.laws.contact and flexgear.geometry.involute.PeriodicSeries are the tests' references
+in flexgear.laws.contact and flexgear.geometry.contact_lines.PeriodicSeries are the tests' references
 (tests/test_contact_laws.py).
 """
 
@@ -57,9 +57,9 @@ def series_value(coeffs, cos_x: float, sin_x: float) -> float:  # pragma: no cov
     """Value of a truncated Fourier series, f = a_0 + sum_(n=1..H) (a_n cos(n x) + b_n sin(n x)), at the angle x
     given by its cosine and sine (x = 2 pi phi for the mesh phase phi in cycles).
 
-    ``coeffs`` = (a_0, a_1 .. a_H, b_1 .. b_H) (flexgear.geometry.involute.PeriodicSeries.packed): the
+    ``coeffs`` = (a_0, a_1 .. a_H, b_1 .. b_H) (flexgear.geometry.contact_lines.PeriodicSeries.packed): the
     mesh-stiffness factor s(phi) of eq. 11-12 and the contact-line friction series kappa(phi), lambda(phi)
-    (flexgear.geometry.involute.contact_line_series).
+    (flexgear.geometry.contact_lines.contact_line_series).
     cos(n x), sin(n x) by the angle-addition recurrence from cos x, sin x: no further trigonometric call.
     """
     n_h = (coeffs.size - 1) // 2
@@ -119,8 +119,8 @@ def mesh_friction_forces(phase, delta, delta_t, q_t, stiffness, exponent, dampin
 
 @njit(cache=True)
 def periodic_values(phase, series):  # pragma: no cover - compiled
-    """:func:`series_value` of each contact's series ``series[i]`` (flexgear.geometry.involute.PeriodicSeries.packed)
-    at its mesh phase ``phase[i]`` [cycles]."""
+    """:func:`series_value` of each contact's series ``series[i]``
+    (flexgear.geometry.contact_lines.PeriodicSeries.packed) at its mesh phase ``phase[i]`` [cycles]."""
     out = np.empty(phase.shape[0])
     for i in range(phase.shape[0]):
         x = 2.0 * math.pi * phase[i]
@@ -193,7 +193,7 @@ def mesh_step(t, ramp_time, drive_speed, q, q_t, index, frames, law, series, col
 
     Per contact i: phi = rate theta(t) - offset with the drive angle theta = drive_speed x integral of STEP
     (:func:`ramp_state`); ``law[:, i]``: stiffness, exponent, damping_max, penetration depth, mu, v_reg, rate,
-    offset; ``series[k, i]``: series k (flexgear.geometry.involute.PeriodicSeries.packed; 0: stiffness factor,
+    offset; ``series[k, i]``: series k (flexgear.geometry.contact_lines.PeriodicSeries.packed; 0: stiffness factor,
     1: sliding direction kappa, 2: lever lambda [m]), evaluated by :func:`series_value`; friction by
     :func:`tooth_friction`. ``q``, ``q_t``: all ODE2 coordinates and rates (read
     only); the contact's tooth deflection is q[index[0, i]] less q[index[1, i]] when index[1, i] >= 0 (its

@@ -5,7 +5,7 @@ Two normal laws, chosen by ``[contact] law``: the ADAMS impact law of the study 
 :func:`linear_force`, stiffness from :mod:`flexgear.laws.iso6336`), and tooth friction. These numpy forms are
 the references the tests hold the per-step kernels to; the kernels of both models (multibody and lumped) evaluate
 the laws, the mesh-stiffness series of eq. 11-12 and tooth friction with the compiled functions of
-:mod:`flexgear.laws.compiled` (the series' numpy reference is flexgear.geometry.involute.PeriodicSeries).
+:mod:`flexgear.laws.compiled` (the series' numpy reference is flexgear.geometry.contact_lines.PeriodicSeries).
 """
 
 from __future__ import annotations

@@ -34,7 +34,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.involute import GearSetGeometry, contact_line_integrals
+from flexgear.geometry.contact_lines import contact_line_integrals
+from flexgear.geometry.involute import GearSetGeometry
 from flexgear.geometry.massprops import combine_mass_properties
 from flexgear.laws.contact import mesh_damping, mesh_laws
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
@@ -346,7 +347,7 @@ def assemble(params: LumpedParameters, translations: bool = True) -> LumpedSyste
 class FrictionTables:
     """Tooth-friction resultants of one mesh per unit normal force, over one mesh cycle.
 
-    Phase phi in [0, 1) (mesh cycles), the convention of flexgear.geometry.involute.mesh_stiffness_harmonics:
+    Phase phi in [0, 1) (mesh cycles), the convention of flexgear.geometry.contact_lines.mesh_stiffness_harmonics:
     a tooth with phase u = phi + k has its contact line from transverse position s = u (one face end)
     to s = u - eps_beta (other end), s in base pitches from the start of active contact A, and is
     in contact on 0 <= s <= eps_alpha. The normal load is spread uniformly over all contact-line
@@ -369,7 +370,7 @@ class FrictionTables:
 def friction_tables(d1_start: float, d1_end: float, d1_pitch: float, d2_offset: float, base_pitch: float,
                     eps_beta: float, sign_slope: float, points: int) -> FrictionTables:
     """Tabulate :class:`FrictionTables` of one mesh from the integrals along its contact lines
-    (flexgear.geometry.involute.contact_line_integrals, the multibody model's friction series too).
+    (flexgear.geometry.contact_lines.contact_line_integrals, the multibody model's friction series too).
 
     ``d1_start``, ``d1_end``, ``d1_pitch``: arm d1 = (C - O_1) . n [m] at the start and end of active
     contact and at the pitch point; ``d2_offset`` = (O_1 - O_2) . n, so d2 = d1 + d2_offset;

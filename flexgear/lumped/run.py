@@ -47,7 +47,7 @@ import numpy as np
 import pandas as pd
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.involute import mesh_stiffness_harmonics
+from flexgear.geometry.contact_lines import mesh_stiffness_harmonics
 from flexgear.laws.compiled import (
     backlash_linear_force,
     impact_normal_force,

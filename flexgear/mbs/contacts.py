@@ -15,7 +15,7 @@ s(phi) = 1 + sum_n c_n cos(2 pi n (phi - phi_0)) the mesh-stiffness variation of
 Deflection, pitch-point sliding and relative spin are three auxiliary coordinates per half, tied
 to the gear coordinates by one linear ``ObjectConnectorCoordinateVector`` constraint; the law is a
 compiled (symbolic) user function of an ``ObjectConnectorCartesianSpringDamper`` on them: no
-Python runs per step. Friction (kappa, lambda: see flexgear.geometry.involute.contact_line_distribution)
+Python runs per step. Friction (kappa, lambda: see flexgear.geometry.contact_lines.contact_line_distribution)
 follows from the contact lines' positions relative to the pitch point.
 """
 
@@ -27,7 +27,8 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.geometry.involute import GearMesh, PeriodicSeries, contact_line_series, tooth_normal_local
+from flexgear.geometry.contact_lines import PeriodicSeries, contact_line_series
+from flexgear.geometry.involute import GearMesh, tooth_normal_local
 from flexgear.geometry.pair import _EZ, helix_halves
 from flexgear.laws.contact import ContactLaw, friction_forces, normal_force
 from flexgear.laws.ramps import drive_angle
