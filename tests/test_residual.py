@@ -183,6 +183,7 @@ def test_model4_with_the_cutoff_keeps_the_whole_basis_means(variant, cutoff_runs
         assert amp_new == pytest.approx(amp_ref, rel=2e-2), col
 
 
+@pytest.mark.slow
 def test_model5_planets_dropped_modes_answer_their_bearing_force():
     """Model 5 (flexible planets and shafts), impact law, a short run: cut-off 8 against every mode dynamic. A
     planet on its Table 2 bearing (about 1.6 kHz) is above resonance at the 4.4 kHz mesh frequency, so its inertia
