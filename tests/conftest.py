@@ -3,9 +3,10 @@
 ``make test`` runs the suite in two pytest-xdist worker processes (``-n 2 --dist loadgroup``). With
 ``--dist loadgroup`` the tests that use a module-scoped fixture of their module (a simulation run, an FE model)
 go to one worker, so that the fixture is built once, and every other test is shared out on its own
-(:func:`pytest_xdist_make_scheduler`). The mesh cache (``meshes/`` or ``$FLEXGEAR_CACHE_DIR``) is shared by the
-workers: a missing mesh or reduced body is built by the first worker that needs it while the other waits for it
-(flexgear.cache.load_or_build).
+(:func:`pytest_xdist_make_scheduler`); the units holding ``slow`` tests are handed out first, so that the long runs
+do not start last and leave one worker running alone at the end. The mesh cache (``meshes/`` or
+``$FLEXGEAR_CACHE_DIR``) is shared by the workers: a missing mesh or reduced body is built by the first worker that
+needs it while the other waits for it (flexgear.cache.load_or_build).
 """
 
 import ast
@@ -59,6 +60,31 @@ def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
     return out
 
 
+def _slow_tests(folder: Path) -> dict[str, set[str]]:
+    """Per test module (its path as in node ids): the names of its test functions marked ``slow``: by their own
+    decorators (a mark on the function or on one of its parameters), by a fixture of the module they request whose
+    decorator carries it (a slow fixture parameter), or by the module's ``pytestmark``."""
+    out: dict[str, set[str]] = {}
+    for path in sorted(folder.rglob("test_*.py")):
+        tree = ast.parse(path.read_text())
+        module_slow = any(isinstance(n, ast.Assign) and any(ast.unparse(t) == "pytestmark" for t in n.targets)
+                          and "mark.slow" in ast.unparse(n.value) for n in tree.body)
+        slow_fixtures: set[str] = set()
+        tests: dict[str, tuple[bool, set[str]]] = {}
+        for node in ast.walk(tree):
+            if isinstance(node, ast.FunctionDef):
+                marked = any("mark.slow" in ast.unparse(d) for d in node.decorator_list)
+                if _fixture_of(node) is not None:
+                    if marked:
+                        slow_fixtures.add(node.name)
+                elif node.name.startswith("test"):
+                    tests[node.name] = marked, {a.arg for a in node.args.args + node.args.kwonlyargs}
+        slow = {t for t, (marked, args) in tests.items() if module_slow or marked or args & slow_fixtures}
+        if slow:
+            out[path.relative_to(ROOT).as_posix()] = slow
+    return out
+
+
 @pytest.hookimpl(optionalhook=True)  # a pytest-xdist hook: without xdist installed, never called
 def pytest_xdist_make_scheduler(config, log):
     """``--dist loadgroup``: the tests of a module that use one of its module-scoped fixtures are one unit of work,
@@ -70,13 +96,26 @@ def pytest_xdist_make_scheduler(config, log):
     from xdist.scheduler import LoadScopeScheduling
 
     users = _module_fixture_users(Path(__file__).resolve().parent)
+    slow = _slow_tests(Path(__file__).resolve().parent)
+
+    def module_and_test(nodeid: str) -> tuple[str, str]:
+        module, _, rest = nodeid.partition("::")
+        return module, rest.split("::")[-1].split("[")[0]
 
     class ModuleFixtureScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
-            module, _, rest = nodeid.partition("::")
-            test = rest.split("::")[-1].split("[")[0]
+            module, test = module_and_test(nodeid)
             grouped = users.get(module, set())
             return module if "*" in grouped or test in grouped else nodeid
+
+        def _assign_work_unit(self, node) -> None:
+            """The pending unit with the most slow tests next (then the one with the most tests, then the first)."""
+            def priority(scope: str) -> tuple[int, int]:
+                unit = self.workqueue[scope]
+                return sum(test in slow.get(module, ()) for module, test in map(module_and_test, unit)), len(unit)
+
+            self.workqueue.move_to_end(max(self.workqueue, key=priority), last=False)
+            super()._assign_work_unit(node)
 
     return ModuleFixtureScheduling(config, log)
 

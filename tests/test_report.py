@@ -18,12 +18,48 @@ from flexgear.spec import load_gearbox, load_variant
 from flexgear.study.matrix import run_matrix
 
 
+def _once(fn):
+    """``fn`` computed once per distinct argument list (its pickled bytes): for pure functions of their inputs."""
+    import functools
+    import pickle
+
+    done: dict[bytes, object] = {}
+
+    @functools.wraps(fn)
+    def once(*args, **kwargs):
+        try:
+            key = pickle.dumps((args, sorted(kwargs.items())))
+        except Exception:  # an input that does not pickle: computed as asked
+            return fn(*args, **kwargs)
+        if key not in done:
+            done[key] = fn(*args, **kwargs)
+        return done[key]
+
+    return once
+
+
+@pytest.fixture(scope="module", autouse=True)
+def modal_analyses_once():
+    """The modal pages' analyses of a variant (linearisation, modes, Campbell diagram, speed responses) computed
+    once for the module's reports, which are built from the same results folder."""
+    import flexgear.harmonic.lumped as lumped
+    import flexgear.harmonic.response as response
+    import flexgear.modal as modal
+
+    with pytest.MonkeyPatch.context() as mp:
+        for module, name in ((modal, "linearize"), (modal, "modes"), (modal, "campbell"),
+                             (response, "harmonic_response"), (lumped, "lumped_harmonic_response")):
+            mp.setattr(module, name, _once(getattr(module, name)))
+        yield
+
+
 @pytest.fixture(scope="module")
 def results(tmp_path_factory) -> Path:
     """A quick matrix: two synthetic variants and a bad file, a real 0.02 s model 1, a full lumped run."""
     root = tmp_path_factory.mktemp("report")
     shutil.copy(GEARBOX, root / "gearbox.toml")
-    body = 'gearbox = "gearbox.toml"\n\n[components]\n'
+    # the coarse bodies (those of the project's variants): the modal pages linearise the selected model3
+    body = 'gearbox = "gearbox.toml"\nmesh_level = "coarse"\n\n[components]\n'
     comps = ("input_shaft", "sun", "planets", "ring", "output_shaft")
     (root / "model3.toml").write_text('name = "model3"\n' + body + "".join(
         f'{c} = "{"flexible" if c.endswith("shaft") else "rigid"}"\n' for c in comps))

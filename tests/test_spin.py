@@ -122,7 +122,8 @@ def _assert_same_mesh_signals(ref, new, f_mesh: float, mean_rel: float, amp_rel:
             assert a_new == pytest.approx(a_ref, rel=amp_rel), col
 
 
-@pytest.mark.parametrize("case", ["model4", pytest.param("model7", marks=pytest.mark.heavy)])
+@pytest.mark.parametrize("case", [pytest.param("model4", marks=pytest.mark.slow),
+                                  pytest.param("model7", marks=pytest.mark.heavy)])
 def test_production_keeps_the_reference_signals(case):
     """The reference formulation (Exudyn's FFRF and rigid bodies, generic joints, seat springs on virtual nodes,
     Exudyn's Newton policy) against the production one (linear floating frames, body frames, joints and seat
