@@ -13,10 +13,10 @@ Campbell diagram (flexgear.harmonic.peaks, flexgear.study.harmonic_check).
     (damping ratio <= :data:`LIGHT`) within 1 % of their crossings.
 """
 
-import dataclasses
 
 import numpy as np
 import pytest
+from test_harmonic import _lightly_damped
 
 from flexgear.harmonic.peaks import lumped_campbell, peak_crossings
 from flexgear.study.harmonic_check import CANCELLED, COLUMNS, check_speeds, compare_lumped
@@ -34,14 +34,6 @@ def iso_spec(gearbox):
     """The ISO 6336 law with the contact-line stiffness variation and no friction (the linearisation's scope)."""
     spec = gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.0)
     return spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
-
-
-def _lightly_damped(spec, factor: float = 0.1):
-    spec = spec.with_fields("contact_assumed", mesh_damping_ratio=factor * spec.contact_assumed.mesh_damping_ratio)
-    b = spec.bearings
-    return spec.with_fields("bearings", **{
-        f.name: dataclasses.replace(getattr(b, f.name), damping_per_stiffness_s=factor * getattr(
-            b, f.name).damping_per_stiffness_s) for f in dataclasses.fields(b)})
 
 
 def test_frequency_domain_matches_settled_time_run_below_the_first_strong_crossing(iso_spec):

@@ -42,7 +42,7 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
            "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
-           "gear_shaft_joints", "gear_seat", "patch_union", "BOLT_PATCHES", "RING_SEAT"]
+           "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT"]
 
 BOLT_PATCHES = "bolt_patches"
 """Name of the ring's and the output shaft's rigid interface over the clamped discs of all bolts."""
@@ -181,6 +181,12 @@ def gear_shaft_joints(spec: GearboxSpec | Design, gear: str) -> list[tuple[str, 
     raise ValueError(f"gear_shaft_joints: gear must be 'sun' or 'ring', got {gear!r}")
 
 
+def is_tied(body: ReducedBody) -> bool:
+    """Whether ``body`` is the ring and the output shaft reduced together (flexgear.fe.ring_shaft): it carries the
+    measuring interface "ring_seat"."""
+    return any(i.name == RING_SEAT for i in body.interfaces)
+
+
 def gear_seat(body: ReducedBody, gear: str) -> Interface:
     """The interface of a gear's reduced body that its deflections are measured from.
 
@@ -189,8 +195,7 @@ def gear_seat(body: ReducedBody, gear: str) -> Interface:
     """
     if gear != "ring":
         return body.interface("bore")
-    names = {i.name for i in body.interfaces}
-    return body.interface(RING_SEAT if RING_SEAT in names else BOLT_PATCHES)
+    return body.interface(RING_SEAT if is_tied(body) else BOLT_PATCHES)
 
 
 def component_reduced_body(spec: GearboxSpec | Design, component: str, level: str = "coarse",

@@ -154,13 +154,11 @@ def tied_part_matrices(spec: GearboxSpec, level: str = "coarse", progress: bool 
     """
     from flexgear.cache import atomic_write_bytes, cache_dir, load_or_build, read_entry
 
-    path = cache_dir() / f"tied-parts-{_tied_key(spec, level)}.npz"
+    path = cache_dir() / f"tied-parts-v2-{_tied_key(spec, level)}.npz"
 
     def read(file) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         with np.load(file, allow_pickle=False) as z:
-            m_r, k_r = z["mass_ring"], z["stiffness_ring"]
-        body = tied_pair_body(spec, level, progress)
-        return {"ring": (m_r, k_r), "output_shaft": (np.eye(body.n_modes) - m_r, np.diag(body.stiffness) - k_r)}
+            return {part: (z[f"mass_{part}"], z[f"stiffness_{part}"]) for part in PAIR}
 
     def load():
         return read_entry(path, read) if path.exists() else None
@@ -175,8 +173,10 @@ def tied_part_matrices(spec: GearboxSpec, level: str = "coarse", progress: bool 
             raise ValueError("tied_part_matrices: the tied body's first nodes are not the ring's")
         phi = body.modes[:3 * n]
         m_r, k_r = phi.T @ (ring.M @ phi), phi.T @ (ring.K @ phi)
+        m_r, k_r = 0.5 * (m_r + m_r.T), 0.5 * (k_r + k_r.T)
         buf = io.BytesIO()
-        np.savez(buf, mass_ring=0.5 * (m_r + m_r.T), stiffness_ring=0.5 * (k_r + k_r.T))
+        np.savez(buf, mass_ring=m_r, stiffness_ring=k_r, mass_output_shaft=np.eye(body.n_modes) - m_r,
+                 stiffness_output_shaft=np.diag(body.stiffness) - k_r)
         atomic_write_bytes(path, buf.getvalue())
         return read(path)
 

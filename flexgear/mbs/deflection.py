@@ -26,7 +26,7 @@ import math
 
 import numpy as np
 
-from flexgear.fe.reduced import BOLT_PATCHES, RING_SEAT, gear_seat
+from flexgear.fe.reduced import BOLT_PATCHES, gear_seat, is_tied
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import frame_rows, normal_lever
 from flexgear.spec import COMPONENT_GEOMETRY
@@ -82,8 +82,7 @@ def held_interfaces(reduced, geometry: str) -> list[str]:
     shaft's bearing seat."""
     if geometry != "ring":
         return ["bore"]
-    names = {i.name for i in reduced.interfaces}
-    return ["bearing_seat"] if RING_SEAT in names else [BOLT_PATCHES]
+    return ["bearing_seat"] if is_tied(reduced) else [BOLT_PATCHES]
 
 
 def _body_geometry(name: str) -> str:

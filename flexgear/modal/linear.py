@@ -237,9 +237,9 @@ def _mass_parts(variant: Variant, model, mbs) -> dict[int, list[tuple[str, np.nd
 
 def _tied(body) -> bool:
     """Whether ``body`` is the tied ring and output shaft (flexgear.fe.ring_shaft: its "ring_seat" interface)."""
-    from flexgear.fe.reduced import RING_SEAT
+    from flexgear.fe.reduced import is_tied
 
-    return bool(body.flexible) and any(i.name == RING_SEAT for i in body.reduced.interfaces)
+    return bool(body.flexible) and is_tied(body.reduced)
 
 
 def _elastic_parts(variant: Variant, model, mbs) -> dict[str, tuple[np.ndarray, list]]:
