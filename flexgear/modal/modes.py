@@ -19,14 +19,22 @@ mbs.residual, where the variant has one). The strain of a frame is that of its b
 
 Kinds (cyclic symmetry of a planetary set with N equally spaced planets: Lin & Parker 1999 for spur gears,
 Eritenel & Parker 2009 for the 6-DOF-per-body helical model), from the kinetic energy of the central members
-(sun, ring and shafts; the carrier is fixed):
+(sun, ring and shafts; the carrier is fixed). With c the central members' frames' share of the mode's kinetic
+energy and a the share of their spin and axial motion (phi_z, u_z) in it:
 
-- ``planet``: central members' frames at rest (share < ``tolerance``), multiplicity N - 3 (N - 1 in the torsional
-  model); an elastic central member may deform in them (Wu & Parker 2008, elastic ring);
-- ``rotational``: central members only spin and move axially (rotational-axial modes, single);
-- ``translational``: central members only translate in-plane and tilt (translational-tilting modes, pairs);
 - ``elastic_<component>``: the elastic strain of one flexible component holds most (> 1/2) of the mode's strain;
+- ``planet``: central members' frames at rest, c < ``planet_share`` (:data:`PLANET_SHARE`), multiplicity N - 3
+  (N - 1 in the torsional model); an elastic central member may deform in them (Wu & Parker 2008, elastic ring);
+- ``rotational``: central members only spin and move axially, (c - a) / c < ``motion_share``
+  (:data:`MOTION_SHARE`; rotational-axial modes, single);
+- ``translational``: central members only translate in-plane and tilt, a / c < ``motion_share``
+  (translational-tilting modes, pairs);
 - ``mixed``: none of these (broken symmetry: unequally spaced planets, a helical set's coupling).
+
+With exact symmetry (rigid members, mean mesh stiffness) the shares that vanish are round-off; a flexible model's
+tetrahedral meshes break the symmetry slightly, so that the central frames move a little in the planet modes and
+the wrong kind of central motion enters a little, orders of magnitude below the motions that define the kinds:
+the thresholds sit between the two. The pair split of a broken symmetry is the multiplet's ``spread_pct``.
 """
 
 from __future__ import annotations
@@ -39,13 +47,18 @@ import pandas as pd
 
 from flexgear.modal.linear import LinearModel
 
-__all__ = ["Modes", "modes", "CENTRAL", "TOLERANCE"]
+__all__ = ["Modes", "modes", "CENTRAL", "PLANET_SHARE", "MOTION_SHARE"]
 
 CENTRAL = ("input_shaft", "sun", "ring", "output_shaft")
 """The central members of the star gearbox (carrier fixed)."""
 
-TOLERANCE = 1e-6
-"""Kinetic-energy share below which a group of coordinates counts as at rest."""
+PLANET_SHARE = 1e-4
+"""Share of a mode's kinetic energy in the central members' frames below which they count as at rest (a planet
+mode; module docstring)."""
+
+MOTION_SHARE = 1e-3
+"""Share of the central members' kinetic energy in the other kind's motion (spin and axial, or translation and
+tilt) below which a mode is rotational or translational (module docstring)."""
 
 _SPIN_AXIAL = ("u_z", "phi_z")
 
@@ -175,18 +188,18 @@ def _shares(model: LinearModel, q: np.ndarray, matrix: np.ndarray, groups: dict[
 
 
 def _kind(model: LinearModel, kinetic: dict[str, np.ndarray], spin_axial: np.ndarray, strain: dict[str, np.ndarray],
-          j: int, tolerance: float) -> str:
+          j: int, planet_share: float, motion_share: float) -> str:
     elastic = {c: strain[f"{c}_elastic"][j] for c in model.flexible}
     if elastic:
         best = max(elastic, key=elastic.get)
         if elastic[best] > 0.5:
             return f"elastic_{best}"
     frame = sum(kinetic[c][j] for c in CENTRAL if c in kinetic)
-    if frame < tolerance:
+    if frame < planet_share:
         return "planet"
-    if frame - spin_axial[j] < tolerance:
+    if frame - spin_axial[j] < motion_share * frame:
         return "rotational"
-    if spin_axial[j] < tolerance:
+    if spin_axial[j] < motion_share * frame:
         return "translational"
     return "mixed"
 
@@ -202,11 +215,11 @@ def _multiplets(freqs: np.ndarray, kinds: tuple[str, ...], rtol: float) -> tuple
     return mult, spread
 
 
-def modes(model: LinearModel, f_max_hz: float | None = None, *, tolerance: float = TOLERANCE,
-          pair_rtol: float = 1e-3) -> Modes:
+def modes(model: LinearModel, f_max_hz: float | None = None, *, planet_share: float = PLANET_SHARE,
+          motion_share: float = MOTION_SHARE, pair_rtol: float = 1e-3) -> Modes:
     """The modes of ``model`` up to ``f_max_hz`` [Hz] (all by default), with kinds and energy shares (module
-    docstring). ``tolerance``: kinetic-energy share of a group at rest; ``pair_rtol``: relative frequency distance
-    within a multiplet."""
+    docstring). ``planet_share``, ``motion_share``: the kinds' thresholds; ``pair_rtol``: relative frequency
+    distance within a multiplet."""
     lam, phi = _eigen(model)
     freqs = np.abs(lam) / (2.0 * math.pi)
     zeta = -lam.real / np.maximum(np.abs(lam), 1e-300)
@@ -223,7 +236,7 @@ def modes(model: LinearModel, f_max_hz: float | None = None, *, tolerance: float
     mq = model.full_mass @ q
     total = np.real(np.einsum("im,im->m", q.conj(), mq))
     spin_axial = np.real(np.einsum("im,im->m", q[axial].conj(), mq[axial])) / np.where(total > 0, total, 1.0)
-    kinds = tuple(_kind(model, kinetic, spin_axial, strain, j, tolerance) for j in range(freqs.size))
+    kinds = tuple(_kind(model, kinetic, spin_axial, strain, j, planet_share, motion_share) for j in range(freqs.size))
     mult, spread = _multiplets(freqs, kinds, pair_rtol)
     columns = {}
     for prefix, shares in (("kinetic", kinetic), ("strain", strain)):
