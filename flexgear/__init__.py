@@ -48,6 +48,7 @@ _LAZY = {
     "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox", "run_variant": "mbs.run",
     # modal analysis at the operating point
     "linearize": "modal.linear", "LinearModel": "modal.linear", "modes": "modal.modes", "Modes": "modal.modes",
+    "period_modes": "modal.period",
 }
 
 __all__ = [

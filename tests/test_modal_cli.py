@@ -20,8 +20,9 @@ def test_modes_command_writes_table(tmp_path, capsys):
                               "--out", str(tmp_path / "out")])
     assert args.func(args) == 0
     table = pd.read_csv(tmp_path / "out" / "model1_exact" / "modes.csv")
-    head = ["mode", "frequency_hz", "damping_ratio", "kind", "multiplicity", "spread_pct"]
-    assert list(table.columns[:6]) == head
+    head = ["mode", "frequency_hz", "damping_ratio", "kind", "spread_pct", "multiplicity", "split_pct"]
+    assert list(table.columns[:7]) == head
+    assert (table.spread_pct == 0.0).all()  # rigid gears: the matrices do not depend on their angles
     components = ["input_shaft", "sun", *(f"planet_{i}" for i in range(1, 6)), "ring", "output_shaft"]
     for family in ("kinetic", "strain"):
         assert all(f"{family}_{c}" in table.columns for c in components)

@@ -2,7 +2,9 @@
 
 :func:`linearize` (flexgear.modal.linear): the multibody model of any variant, rigid or flexible, linearised at its
 static equilibrium under the load torque at the input speed; :func:`modes` (flexgear.modal.modes): its natural
-frequencies, damping ratios, mode shapes, cyclic-symmetry kinds and energy shares per component; :func:`campbell`
+frequencies, damping ratios, mode shapes, cyclic-symmetry kinds and energy shares per component;
+:func:`period_modes` (flexgear.modal.period): the same over one revolution of the flexible gears, each frequency's
+mean and spread; :func:`campbell`
 (flexgear.modal.campbell): the Campbell diagram over input speed with the mesh-order crossings; :func:`modal_screening`
 (flexgear.modal.screening): which components must be flexible, from the all-flexible variant's modes. The names are
 imported on first use (PEP 562), so that the command line's parser (flexgear.modal.cli) stays light.
@@ -12,10 +14,10 @@ from importlib import import_module
 
 _LAZY = {"Coordinate": "linear", "LinearModel": "linear", "linearize": "linear", "Modes": "modes", "modes": "modes",
          "Campbell": "campbell", "campbell": "campbell", "mesh_frequency_hz": "campbell", "resonant": "campbell",
-         "ModalScreening": "screening", "modal_screening": "screening"}
+         "ModalScreening": "screening", "modal_screening": "screening", "period_modes": "period"}
 
 __all__ = ["Campbell", "Coordinate", "LinearModel", "ModalScreening", "Modes", "campbell", "linearize",
-           "mesh_frequency_hz", "modal_screening", "modes", "resonant"]
+           "mesh_frequency_hz", "modal_screening", "modes", "period_modes", "resonant"]
 
 
 def __getattr__(name: str):

@@ -1,10 +1,10 @@
 """Command lines ``flexgear modes``, ``flexgear campbell`` and ``flexgear modal-screening``.
 
-``flexgear modes VARIANT [--speed-rpm R] [--f-max-hz F] [--out DIR]`` linearises the variant at its operating
-point (flexgear.modal.linear), prints one line per mode (frequency, damping ratio, kind, multiplet spread, the
-components holding most kinetic and strain energy) and writes
-DIR/<variant>/modes.csv (flexgear.modal.modes.Modes.table: mode, frequency_hz, damping_ratio, kind, multiplicity,
-spread_pct, kinetic_<component>, strain_<component>).
+``flexgear modes VARIANT [--speed-rpm R] [--f-max-hz F] [--samples J] [--out DIR]`` linearises the variant at its
+operating point over one revolution of its flexible gears (flexgear.modal.period), prints one line per mode
+(mean frequency, damping ratio, kind, spread over the revolution, multiplet and its split, the components holding
+most kinetic and strain energy) and writes DIR/<variant>/modes.csv (flexgear.modal.modes.Modes.table: mode,
+frequency_hz, damping_ratio, kind, spread_pct, multiplicity, split_pct, kinetic_<component>, strain_<component>).
 
 ``flexgear campbell VARIANT [--speeds-rpm 0:6000:500] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell) writes
 DIR/<variant>/campbell.csv (speed_rpm, mode, frequency_hz, damping_ratio, kind), crossings.csv (speed_rpm, order,
@@ -33,17 +33,21 @@ def args_modes(p: argparse.ArgumentParser) -> None:
     p.add_argument("--speed-rpm", type=float, default=None, metavar="R",
                    help="input speed in rpm (default: the load case's; 0: at rest)")
     p.add_argument("--f-max-hz", type=float, default=None, metavar="F", help="highest frequency in Hz (default: all)")
+    p.add_argument("--samples", type=int, default=None, metavar="J",
+                   help="operating points over one revolution of the slowest flexible gear (default: "
+                        "flexgear.modal.period.DEFAULT_SAMPLES)")
     p.add_argument("--out", default="results", metavar="DIR",
                    help="results folder; the table goes to OUT/<variant name>/modes.csv (default: %(default)s)")
 
 
 def cmd_modes(a: argparse.Namespace) -> int:
     """Run ``flexgear modes``; returns the exit code."""
-    from flexgear.modal import linearize, modes
+    from flexgear.modal.period import DEFAULT_SAMPLES, period_modes
     from flexgear.spec import load_variant
 
     variant = load_variant(a.variant)
-    result = modes(linearize(variant, speed_rpm=a.speed_rpm), a.f_max_hz)
+    result = period_modes(variant, a.speed_rpm, a.f_max_hz,
+                          samples=DEFAULT_SAMPLES if a.samples is None else a.samples)
     table = result.table()
     out = Path(a.out) / variant.name
     out.mkdir(parents=True, exist_ok=True)
@@ -51,13 +55,15 @@ def cmd_modes(a: argparse.Namespace) -> int:
     kinetic = table.filter(regex="^kinetic_")
     strain = table.filter(regex="^strain_")
     speed = result.model.speed_rpm
-    print(f"{variant.name}: {len(table)} modes at {speed:g} rpm, {result.model.n} coordinates")
-    print(f"{'mode':>4} {'f [Hz]':>10} {'zeta':>7} {'kind':<16} {'n':>2} {'spread %':>9}  most kinetic / strain energy")
+    print(f"{variant.name}: {len(table)} modes at {speed:g} rpm, {result.model.n} coordinates; spread: over one "
+          "revolution of the slowest flexible gear; n, split: multiplet")
+    print(f"{'mode':>4} {'f [Hz]':>10} {'zeta':>7} {'kind':<20} {'spread %':>9} {'n':>2} {'split %':>8}  "
+          "most kinetic / strain energy")
     for i, row in table.iterrows():
         k, s = kinetic.iloc[i], strain.iloc[i]
-        print(f"{row['mode']:>4d} {row['frequency_hz']:>10.2f} {row['damping_ratio']:>7.4f} {row['kind']:<16} "
-              f"{row['multiplicity']:>2d} {row['spread_pct']:>9.4f}  {k.idxmax()[8:]} {k.max():.2f} / "
-              f"{s.idxmax()[7:]} {s.max():.2f}")
+        print(f"{row['mode']:>4d} {row['frequency_hz']:>10.2f} {row['damping_ratio']:>7.4f} {row['kind']:<20} "
+              f"{row['spread_pct']:>9.4f} {row['multiplicity']:>2d} {row['split_pct']:>8.4f}  "
+              f"{k.idxmax()[8:]} {k.max():.2f} / {s.idxmax()[7:]} {s.max():.2f}")
     print(f"-> {out / 'modes.csv'}")
     return 0
 

@@ -34,7 +34,7 @@ energy and a the share of their spin and axial motion (phi_z, u_z) in it:
 With exact symmetry (rigid members, mean mesh stiffness) the shares that vanish are round-off; a flexible model's
 tetrahedral meshes break the symmetry slightly, so that the central frames move a little in the planet modes and
 the wrong kind of central motion enters a little, orders of magnitude below the motions that define the kinds:
-the thresholds sit between the two. The pair split of a broken symmetry is the multiplet's ``spread_pct``.
+the thresholds sit between the two. The pair split of a broken symmetry is the multiplet's ``split_pct``.
 """
 
 from __future__ import annotations
@@ -68,9 +68,10 @@ class Modes:
     """Modes of a :class:`~flexgear.modal.linear.LinearModel`, ascending in frequency (module docstring).
 
     ``shapes``: (n_z, n_modes) complex, over the model's independent coordinates; ``energy``: one row per mode,
-    kinetic_* and strain_* shares (each family sums to 1); ``multiplicity`` and ``spread_pct``: the modes of the
+    kinetic_* and strain_* shares (each family sums to 1); ``multiplicity`` and ``split_pct``: the modes of the
     same kind whose frequencies lie within ``pair_rtol`` of each other form a multiplet, 100 (f_max - f_min) /
-    f_mean its spread [%].
+    f_mean its split [%]; ``spread_pct``: each frequency's spread [%] over the angles of the flexible gears
+    (flexgear.modal.period; zero for modes at one operating point).
     """
 
     frequencies_hz: np.ndarray
@@ -78,19 +79,25 @@ class Modes:
     shapes: np.ndarray
     kinds: tuple[str, ...]
     multiplicity: np.ndarray
-    spread_pct: np.ndarray
+    split_pct: np.ndarray
     energy: pd.DataFrame
     model: LinearModel
+    spread_pct: np.ndarray | None = None
+
+    def __post_init__(self) -> None:
+        if self.spread_pct is None:
+            object.__setattr__(self, "spread_pct", np.zeros(len(self.frequencies_hz)))
 
     def __len__(self) -> int:
         return len(self.frequencies_hz)
 
     def table(self) -> pd.DataFrame:
-        """One row per mode: mode (1-based), frequency_hz, damping_ratio, kind, multiplicity, spread_pct and the
-        energy shares."""
+        """One row per mode: mode (1-based), frequency_hz, damping_ratio, kind, spread_pct, multiplicity,
+        split_pct and the energy shares."""
         head = pd.DataFrame({"mode": np.arange(1, len(self) + 1), "frequency_hz": self.frequencies_hz,
                              "damping_ratio": self.damping_ratios, "kind": list(self.kinds),
-                             "multiplicity": self.multiplicity, "spread_pct": self.spread_pct})
+                             "spread_pct": self.spread_pct, "multiplicity": self.multiplicity,
+                             "split_pct": self.split_pct})
         return pd.concat([head, self.energy.reset_index(drop=True)], axis=1)
 
     def kinetic_share(self, select) -> np.ndarray:
@@ -237,7 +244,7 @@ def modes(model: LinearModel, f_max_hz: float | None = None, *, planet_share: fl
     total = np.real(np.einsum("im,im->m", q.conj(), mq))
     spin_axial = np.real(np.einsum("im,im->m", q[axial].conj(), mq[axial])) / np.where(total > 0, total, 1.0)
     kinds = tuple(_kind(model, kinetic, spin_axial, strain, j, planet_share, motion_share) for j in range(freqs.size))
-    mult, spread = _multiplets(freqs, kinds, pair_rtol)
+    mult, split = _multiplets(freqs, kinds, pair_rtol)
     columns = {}
     for prefix, shares in (("kinetic", kinetic), ("strain", strain)):
         for name, values in shares.items():
@@ -246,4 +253,4 @@ def modes(model: LinearModel, f_max_hz: float | None = None, *, planet_share: fl
             if name == "residual" and not groups["residual"].any():
                 continue
             columns[f"{prefix}_{name}"] = values
-    return Modes(freqs, zeta, phi, kinds, mult, spread, pd.DataFrame(columns), model)
+    return Modes(freqs, zeta, phi, kinds, mult, split, pd.DataFrame(columns), model)

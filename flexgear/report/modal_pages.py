@@ -123,7 +123,7 @@ def modal_study(d: ReportData, others: Sequence[ReportData] = ()) -> ModalStudy:
     ``<folder>/<run>``."""
     from flexgear.harmonic.lumped import lumped_harmonic_response
     from flexgear.harmonic.response import harmonic_response
-    from flexgear.modal import campbell, linearize, mesh_frequency_hz, modes
+    from flexgear.modal import campbell, linearize, mesh_frequency_hz, period_modes
     from flexgear.study.runup import runup
 
     lc = d.gearbox.load_case
@@ -144,7 +144,7 @@ def modal_study(d: ReportData, others: Sequence[ReportData] = ()) -> ModalStudy:
         lm = _timed(study, f"{name}: linearisation", "modes", linearize, v)
         if lm is not None:
             linear[name] = lm
-            m = _timed(study, f"{name}: modes", "modes", modes, lm, band)
+            m = _timed(study, f"{name}: modes", "modes", period_modes, v, None, band, first=lm)
             if m is not None:
                 study.modes[name] = m
     if selected in variants:
@@ -211,21 +211,23 @@ def _modal_table_page(name: str, m: Any, study: ModalStudy, role: str) -> Page:
     energy = m.energy.iloc[keep].reset_index(drop=True)
     kin, strain = _grouped(energy, "kinetic"), _grouped(energy, "strain")
     elastic = _elastic(energy)
-    ticks = [f"{i + 1:>2}  {fmt(float(m.frequencies_hz[j]), 5):>7} Hz  {fmt(100 * float(m.damping_ratios[j]), 3):>5} %"
-              f"  {m.kinds[j]:<22.22} {fmt(100 * float(elastic[i]), 2):>5} %" for i, j in enumerate(keep)]
+    ticks = [f"{i + 1:>2}  {fmt(float(m.frequencies_hz[j]), 5):>7} Hz {fmt(float(m.spread_pct[j]), 2):>6} %"
+              f"  {fmt(100 * float(m.damping_ratios[j]), 3):>5} %  {m.kinds[j]:<22.22} "
+              f"{fmt(100 * float(elastic[i]), 2):>5} %" for i, j in enumerate(keep)]
     speed = m.model.speed_rpm
     band = BAND_ORDERS * study.mesh_hz_per_rpm * speed
 
     def draw(fig: Figure) -> None:
         fig.text(0.04, 0.91, f"{name} ({role}) linearised at {fmt(speed)} rpm under the load torque (flexgear.modal):"
                  f" {len(m)} modes up to {fmt(band, 4)} Hz ({BAND_ORDERS}x mesh), {len(resonant(m))} with a "
-                 f"resonance peak; the lowest {len(keep)} shown. Bars: each component's share of the mode's "
-                 "kinetic (K, upper) and strain (S, lower) energy, planets summed, elastic parts included; elastic "
-                 "strain: the share in the flexible bodies' elastic coordinates.", fontsize=7.5,
+                 f"resonance peak; the lowest {len(keep)} shown, each frequency the mean over one revolution of the "
+                 "slowest flexible gear and its spread over it (flexgear.modal.period). Bars: each component's "
+                 "share of the mode's kinetic (K, upper) and strain (S, lower) energy, planets summed, elastic "
+                 "parts included; elastic strain: the share in the flexible bodies' elastic coordinates.", fontsize=7.5,
                  wrap=True)
         bars = fig.add_axes([0.4, 0.07, 0.58, 0.8])
-        fig.text(0.02, 0.875, " #        f      zeta   kind                   elastic strain", family="monospace",
-                 fontsize=7, weight="bold")
+        fig.text(0.02, 0.875, " #        f     spread    zeta   kind                   elastic strain",
+                 family="monospace", fontsize=7, weight="bold")
         y = np.arange(len(keep))
         for shares, dy, label in ((kin, -0.2, "K"), (strain, 0.2, "S")):
             left = np.zeros(len(keep))
