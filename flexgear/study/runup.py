@@ -26,7 +26,7 @@ its neighbourhood (the peak prominence of the track in dB) and :data:`MIN_SNR_DB
 larger of the noise floor (the median amplitude of the spectrogram's bins between the first and the highest order:
 most bins hold no order) and the leakage floor (the strongest order's track times the window's side-lobe level,
 :data:`SIDE_LOBE_DB`: what a strong order leaks into the others' tracks). Ridges are ranked by prominence. Each
-is compared with the nearest predicted crossing of the same order (flexgear.modal.campbell.Campbell.crossings):
+is compared with a predicted crossing of the same order (flexgear.modal.campbell.Campbell.crossings; below):
 error = (n_ridge - n_crossing) / n_crossing.
 
 The ridge of a crossing need not lie exactly at it. A damped mode's steady response peak is shifted by the trend
