@@ -8,6 +8,9 @@
   central members at rest feel no net force or moment), whatever that shape is. Each planet's gyroscopic terms
   (its own spin, the same for all planets) belong to the single-planet problem, so the N - 3 = 2 fold multiplicity
   holds at every speed: the planet pairs stay paired.
+- Mesh phasing (Parker & Lin 2004): order k's mesh forces on the N planets are the phasors e^{i k z_s psi_i}; they
+  excite a kind of mode where they have a component along its planet pattern: (1, ..., 1) for the rotational modes
+  (net moment), e^{+-i psi_i} for the translational ones (net force), the rest for the planet modes.
 - The central members' spin couples their two tilts (gyroscopic moment J_p Omega): a translational pair at rest
   (standing, degenerate) splits into a backward and a forward whirl, apart the more the faster they spin.
 """
@@ -20,6 +23,7 @@ import pytest
 from conftest import VARIANTS
 
 from flexgear.modal import campbell, linearize, mesh_frequency_hz, modes, resonant
+from flexgear.modal.campbell import excited_kinds
 
 SPEEDS_RPM = np.linspace(0.0, 6000.0, 7)
 
@@ -103,3 +107,28 @@ def test_campbell_command_writes_files(tmp_path, capsys):
     assert list(crossings.columns[:4]) == ["speed_rpm", "order", "mode", "kind"]
     assert (out / "campbell.png").stat().st_size > 0
     assert "crossings" in capsys.readouterr().out
+
+
+@pytest.mark.parametrize(("sun_teeth", "planets"), [(44, 5), (30, 3), (33, 4), (41, 6), (27, 7)])
+def test_mesh_phasing_rule_from_the_phasors(sun_teeth, planets):
+    psi = 2 * np.pi * np.arange(planets) / planets
+    for k in range(1, 11):
+        p = np.exp(1j * k * sun_teeth * psi)
+        patterns = np.stack([np.ones(planets), np.exp(1j * psi), np.exp(-1j * psi)], 1) / np.sqrt(planets)
+        along = patterns.conj().T @ p
+        rest = np.linalg.norm(p - patterns @ along)
+        expected = ({"rotational"} if abs(along[0]) > 1e-9 else set()) | (
+            {"translational"} if np.max(np.abs(along[1:])) > 1e-9 else set()) | ({"planet"} if rest > 1e-9 else set())
+        assert excited_kinds(k, sun_teeth, planets) == expected, (k, sun_teeth, planets)
+
+
+def test_crossings_carry_damping_and_excitation(diagram, model1):
+    c = diagram.crossings
+    for _, x in c.head(20).iterrows():
+        line = diagram.table[diagram.table["mode"] == x["mode"]]
+        assert line.damping_ratio.min() - 1e-12 <= x.damping_ratio <= line.damping_ratio.max() + 1e-12
+    g = model1.gearbox.gears
+    for _, x in c.iterrows():
+        assert x.excited == (x.kind in excited_kinds(int(x.order), g.sun_teeth, g.planet_count)
+                             or x.kind not in ("rotational", "translational", "planet"))
+    assert set(c[(c.order == 1) & c.excited].kind) <= {"translational", "mixed"}  # 44 = -1 mod 5

@@ -1,4 +1,5 @@
-"""Run-up order map (flexgear.study.runup): ridges of a synthetic run-up lie at the crossings it was built with."""
+"""Run-up order map (flexgear.study.runup): ridges of a synthetic run-up lie at the crossings it was built with
+(slow ramp), or at their swept predictions under the run's own mesh load (the study's fast ramp)."""
 
 from __future__ import annotations
 
@@ -10,7 +11,15 @@ import pytest
 from scipy.signal import lsim
 
 from flexgear.laws.ramps import step
-from flexgear.study.runup import match_crossings, order_tracks, ridges, spectrogram, swept_peak
+from flexgear.study.runup import (
+    match_crossings,
+    mesh_excitation,
+    order_tracks,
+    ridges,
+    spectrogram,
+    swept_crossings,
+    swept_peak,
+)
 
 DT = 1e-5            # s, the runs' recording step
 RAMP = 4.0           # s: a slow run-up, so that the sweep delay stays below 1 % of the crossing speed
@@ -69,3 +78,67 @@ def test_spectrogram_amplitude_of_a_tone():
     mp = spectrogram(t, 0.3 * np.cos(2 * math.pi * f0 * t), np.full(t.size, 1000.0), PER_RPM)
     j = int(np.argmin(np.abs(mp.frequency_hz - f0)))
     assert np.allclose(mp.amplitude[j], 0.3, rtol=1e-6)
+
+
+STUDY_RAMP = 0.5  # s: the study's STEP ramp to NOMINAL
+INERTIA = 0.3     # inertia torque of the driven members at the ramp's fastest acceleration, in units of the load [-]
+
+
+def _fast_runup() -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The study's ramp and a mesh load that carries the load torque s(t) plus an inertia torque ~ s'(t)."""
+    t = np.arange(0.0, STUDY_RAMP, DT)
+    n = step(t, 0.0, 0.0, STUDY_RAMP, NOMINAL)
+    load = n / NOMINAL + INERTIA * np.gradient(n / NOMINAL, t) * STUDY_RAMP / 1.5  # s' peaks at 1.5 / T
+    return t, n, load / load.max()
+
+
+def _driven(t: np.ndarray, n: np.ndarray, amplitude: np.ndarray, f_n: float, zeta: float, order: int) -> np.ndarray:
+    """Acceleration of a single mode under order ``order`` of the mesh with the force amplitude ``amplitude``."""
+    phase = np.concatenate([[0.0], np.cumsum(0.5 * PER_RPM * (n[1:] + n[:-1]) * DT)])
+    w = 2 * math.pi * f_n
+    sys = ([[0.0, 1.0], [-w * w, -2 * zeta * w]], [[0.0], [1.0]], [[-w * w, -2 * zeta * w]], [[1.0]])
+    return lsim(sys, amplitude * np.cos(2 * math.pi * order * phase), t)[1]
+
+
+def test_fast_sweep_ridges_lie_at_their_swept_predictions():
+    """On the study's 0.5 s ramp a damped mode's ridge lies above its crossing by more than the steady peak shift
+    (~2 zeta^2) plus the sweep delay (the speed gained over the build-up time 1 / (zeta omega_n)). The swept
+    prediction under the run's own mesh load places each ridge of a signal that holds two modes on two orders
+    within the tracks' speed resolution (one hop)."""
+    t, n, load = _fast_runup()
+    modes = ((955.0, 0.073, 1), (2500.0, 0.05, 2))
+    y = sum(_driven(t, n, load, f, z, k) for f, z, k in modes)
+    found = ridges(order_tracks(t, y, n, PER_RPM, orders=(1, 2), ramp_end_s=STUDY_RAMP))
+    for f, z, k in modes:
+        ridge = found[found["order"] == k]["speed_rpm"].iloc[0]
+        crossing = f / (k * PER_RPM)
+        i = int(np.searchsorted(n, crossing))
+        rate = (n[i + 1] - n[i - 1]) / (2 * DT)  # rpm/s
+        sweep_delay = rate / (z * 2 * math.pi * f)  # rpm: n' / (zeta omega_n)
+        assert ridge / crossing - 1.0 > 2 * z * z + sweep_delay / crossing  # both shifts add up
+        swept = swept_peak(t, n, PER_RPM, k, f, z, excitation=load)
+        assert abs(ridge - swept) <= rate * 5e-4  # one hop of the tracks
+
+
+def test_mesh_excitation_is_the_normalised_mesh_load():
+    t, n, load = _fast_runup()
+    signals = pd.DataFrame({"time_s": t, "outer_mesh_force_1_n": 300.0 * load, "inner_mesh_force_1_n": 500.0 * load,
+                            "input_speed_deg_per_s": 6.0 * n})
+    e = mesh_excitation(signals, window_s=1e-4)
+    assert np.allclose(e[100:-100], load[100:-100], atol=1e-6)
+    assert mesh_excitation(signals.drop(columns=["outer_mesh_force_1_n", "inner_mesh_force_1_n"])) is None
+
+
+def test_ridges_match_excited_crossings_by_their_swept_prediction():
+    """A ridge is matched with the crossing whose swept prediction lies nearest, among those its order excites."""
+    t, n, load = _fast_runup()
+    crossings = pd.DataFrame({"speed_rpm": [1302.3, 1330.0, 1400.0], "order": [1, 1, 1], "mode": [1, 2, 3],
+                              "kind": ["translational", "planet", "translational"],
+                              "frequency_hz": [955.0, 975.3, 1026.7], "damping_ratio": [0.073, 0.05, 0.073],
+                              "excited": [True, False, True]})
+    swept = swept_crossings(crossings, t, n, PER_RPM, (1000.0, 2000.0), (1,), load)
+    assert list(swept["mode"]) == [1, 3]
+    assert (swept["swept_rpm"] > swept["speed_rpm"]).all()
+    ridge = pd.DataFrame({"speed_rpm": [float(swept["swept_rpm"].iloc[0])], "order": [1]})
+    matched = match_crossings(ridge, swept, on="swept_rpm")
+    assert matched["mode"].iloc[0] == 1 and matched["swept_error_pct"].iloc[0] == pytest.approx(0.0)

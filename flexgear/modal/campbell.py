@@ -33,7 +33,21 @@ Mesh orders. The mesh frequency is flexgear.theory's, f_m = z_s |omega_sun - ome
 fixed in the star arrangement: f_m = z_s n / 60), linear in n. Order k's line is k f_m(n); a crossing of a mode with
 it is a sign change of g(n) = f(n) - k f_m(n) between two grid speeds, placed by linear interpolation:
 n* = n_a + (n_b - n_a) g_a / (g_a - g_b), where the interpolated frequency equals k f_m(n*). The interpolation
-error is below |f_b - f_a| where f is monotone between grid speeds.
+error is below |f_b - f_a| where f is monotone between grid speeds. Each crossing carries the line's damping
+ratio interpolated the same way.
+
+Which crossings an order excites (mesh phasing, Parker & Lin 2004). The N planets stand equally spaced at
+psi_i = 2 pi i / N; planet i's meshes run z_s psi_i / (2 pi) mesh cycles apart from planet 0's (the ring meshes
+alike: the assembly condition (z_s + z_r) / N integer makes z_r = -z_s mod N). Order k's mesh forces on the planets
+are then the phasors e^{i 2 pi k z_s i / N}; their net force on the central members is
+sum_i e^{i 2 pi k z_s i / N} e^{+-i psi_i}, their net moment about the axis sum_i e^{i 2 pi k z_s i / N}, so with
+l = k z_s mod N:
+
+    l = 0: rotational modes only;   l = 1 or N - 1: translational modes only;   otherwise: planet modes only.
+
+A crossing of order k with a mode of another kind makes no resonance (the order does not excite it), and a planet
+mode (central members at rest) none at the bearings of the central members. Modes of other kinds (``mixed``,
+``elastic_*``: symmetry broken) are taken as excited by every order.
 """
 
 from __future__ import annotations
@@ -48,7 +62,8 @@ import pandas as pd
 from flexgear.modal import LinearModel, Modes
 from flexgear.schema import GearboxSpec, Variant
 
-__all__ = ["Campbell", "campbell", "mesh_frequency_hz", "track", "MESH_ORDERS", "MAX_DAMPING_RATIO", "MAC_MIN"]
+__all__ = ["Campbell", "campbell", "excited_kinds", "mesh_frequency_hz", "track", "MESH_ORDERS", "MAX_DAMPING_RATIO",
+           "MAC_MIN"]
 
 MESH_ORDERS = tuple(range(1, 11))
 """Mesh orders k of the diagram: the harmonics k f_m of the mesh excitation, 1x to 10x."""
@@ -66,6 +81,24 @@ def mesh_frequency_hz(spec: GearboxSpec, speed_rpm: float) -> float:
     from flexgear.theory import theory
 
     return theory(spec.with_fields("load_case", input_speed_rpm=float(speed_rpm))).mesh_frequency
+
+
+SYMMETRIC_KINDS = ("rotational", "translational", "planet")
+"""Mode kinds of a cyclically symmetric planet set, to which the mesh-phasing rule applies (module docstring)."""
+
+
+def excited_kinds(order: int, sun_teeth: int, planet_count: int) -> frozenset[str]:
+    """Kinds of modes that mesh order ``order`` excites with ``planet_count`` equally spaced planets and
+    ``sun_teeth`` sun teeth (module docstring: l = k z_s mod N)."""
+    n = int(planet_count)
+    if n < 2:
+        return frozenset(SYMMETRIC_KINDS)
+    ell = (int(order) * int(sun_teeth)) % n
+    if ell == 0:
+        return frozenset({"rotational"})
+    if ell in (1, n - 1):
+        return frozenset({"translational"})
+    return frozenset({"planet"})
 
 
 def resonant(m: Modes, max_damping_ratio: float = MAX_DAMPING_RATIO) -> np.ndarray:
@@ -126,7 +159,8 @@ class Campbell:
 
     ``table``: one row per line and speed: speed_rpm, mode (the line's number, from 1), frequency_hz,
     damping_ratio, kind; ``crossings``: speed_rpm, order, mode, kind, frequency_hz, one row per crossing of a line
-    with a mesh order; ``mesh_hz_per_rpm``: f_m / n [Hz/rpm]; ``f_max_hz``: the band [Hz]; ``mac_min``: the lowest
+    with a mesh order, with the line's damping_ratio there and whether the order excites the mode (excited);
+    ``mesh_hz_per_rpm``: f_m / n [Hz/rpm]; ``f_max_hz``: the band [Hz]; ``mac_min``: the lowest
     MAC that continued a line (1 with a single speed).
     """
 
@@ -173,11 +207,14 @@ class Campbell:
         return ax
 
 
-def _crossings(table: pd.DataFrame, per_rpm: float, orders: Sequence[int]) -> pd.DataFrame:
-    """Crossings of each line of ``table`` with the mesh orders (module docstring)."""
+def _crossings(table: pd.DataFrame, per_rpm: float, orders: Sequence[int], sun_teeth: int | None = None,
+               planet_count: int | None = None) -> pd.DataFrame:
+    """Crossings of each line of ``table`` with the mesh orders (module docstring); ``excited``: whether the order
+    excites the mode's kind (:func:`excited_kinds`; every crossing without ``sun_teeth`` and ``planet_count``)."""
     rows = []
     for mode, line in table.groupby("mode", sort=True):
         n, f, kind = line.speed_rpm.to_numpy(), line.frequency_hz.to_numpy(), line.kind.to_numpy()
+        zeta = line.damping_ratio.to_numpy()
         for k in orders:
             g = f - k * per_rpm * n
             for a in range(len(n) - 1):
@@ -185,9 +222,13 @@ def _crossings(table: pd.DataFrame, per_rpm: float, orders: Sequence[int]) -> pd
                 if not (g[a] * g[b] < 0.0 or (g[b] == 0.0 and g[a] != 0.0)):
                     continue
                 t = g[a] / (g[a] - g[b])
-                rows.append({"speed_rpm": n[a] + t * (n[b] - n[a]), "order": k, "mode": int(mode),
-                             "kind": kind[a] if t < 0.5 else kind[b], "frequency_hz": f[a] + t * (f[b] - f[a])})
-    columns = ["speed_rpm", "order", "mode", "kind", "frequency_hz"]
+                kd = kind[a] if t < 0.5 else kind[b]
+                excited = (sun_teeth is None or planet_count is None or kd not in SYMMETRIC_KINDS
+                           or kd in excited_kinds(k, sun_teeth, planet_count))
+                rows.append({"speed_rpm": n[a] + t * (n[b] - n[a]), "order": k, "mode": int(mode), "kind": kd,
+                             "frequency_hz": f[a] + t * (f[b] - f[a]),
+                             "damping_ratio": zeta[a] + t * (zeta[b] - zeta[a]), "excited": bool(excited)})
+    columns = ["speed_rpm", "order", "mode", "kind", "frequency_hz", "damping_ratio", "excited"]
     out = pd.DataFrame(rows, columns=columns)
     return out.sort_values(["speed_rpm", "order", "mode"], ignore_index=True)
 
@@ -236,5 +277,6 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
                          "damping_ratio": m.damping_ratios[jj], "kind": m.kinds[jj]})
     table = pd.DataFrame(rows, columns=["speed_rpm", "mode", "frequency_hz", "damping_ratio", "kind"])
     table = table.sort_values(["speed_rpm", "frequency_hz"], ignore_index=True)
-    return Campbell(variant.name, table, _crossings(table, per_rpm, orders), per_rpm, band, tuple(orders),
+    crossings = _crossings(table, per_rpm, orders, spec.gears.sun_teeth, spec.gears.planet_count)
+    return Campbell(variant.name, table, crossings, per_rpm, band, tuple(orders),
                     float(macs.min()) if macs.size else 1.0)

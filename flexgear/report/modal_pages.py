@@ -315,9 +315,12 @@ def _runup_page(study: ModalStudy, name: str) -> Page | None:
             cols = ["speed_rpm", "order", "frequency_hz", "prominence_db"]
             if "crossing_rpm" in ru.ridges.columns:
                 cols += ["crossing_rpm", "kind", "error_pct"]
+            if "swept_rpm" in ru.ridges.columns:
+                cols += ["swept_rpm", "swept_error_pct"]
             tab = ru.ridges.head(5)[cols].rename(columns={"speed_rpm": "n [rpm]", "frequency_hz": "f [Hz]",
                                                           "prominence_db": "prom. [dB]", "crossing_rpm": "crossing",
-                                                          "error_pct": "error [%]"})
+                                                          "error_pct": "error [%]", "swept_rpm": "swept",
+                                                          "swept_error_pct": "vs swept [%]"})
             right = fig.add_axes([0.7, 0.58 - 0.44 * i, 0.28, 0.32])
             right.axis("off")
             right.text(0, 1.0, f"Strongest ridges ({side})" + ("" if len(tab) else ": none found"), fontsize=8,
@@ -332,8 +335,10 @@ def _runup_page(study: ModalStudy, name: str) -> Page | None:
                    f"{fmt(resolved, 4)} rpm (flexgear.study.runup). "
                    + ("Campbell lines and crossings: the diagram's. " if campbell is not None else
                       "No Campbell lines (the diagram is computed for the selected variant only). ")
-                   + "Error: ridge speed against the nearest crossing of the same order; a damped mode's ridge lies "
-                   "above its crossing (excitation growing with the ramp, sweep delay). "
+                   + "Error: ridge speed against the crossing of the same order that the order excites (mesh "
+                   "phasing) and against that crossing's swept prediction (one mode under the run's own speed "
+                   "history and mesh load, tracked alike): a damped mode's ridge lies above its crossing (excitation "
+                   "growing with the ramp, sweep delay). "
                    + _notes_text(study, "runup"), width=200, fontsize=7)
     return (f"Run-up order map of {name}: bearing acceleration against input speed during the ramp", draw)
 

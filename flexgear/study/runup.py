@@ -26,7 +26,7 @@ its neighbourhood (the peak prominence of the track in dB) and :data:`MIN_SNR_DB
 larger of the noise floor (the median amplitude of the spectrogram's bins between the first and the highest order:
 most bins hold no order) and the leakage floor (the strongest order's track times the window's side-lobe level,
 :data:`SIDE_LOBE_DB`: what a strong order leaks into the others' tracks). Ridges are ranked by prominence. Each
-is compared with the nearest predicted crossing of the same order (flexgear.modal.campbell.Campbell.crossings):
+is compared with a predicted crossing of the same order (flexgear.modal.campbell.Campbell.crossings; below):
 error = (n_ridge - n_crossing) / n_crossing.
 
 The ridge of a crossing need not lie exactly at it. A damped mode's steady response peak is shifted by the trend
@@ -34,9 +34,23 @@ of the excitation (the mesh force grows with the load, which ramps with the spee
 acceleration, omega^2 times the displacement): for a response ~ r^3 / |1 - r^2 + 2 i zeta r|, r = n / n_cross, the
 peak lies at r ~ 1 + 2 zeta^2. A fast sweep delays it further: the mode's response builds up over its time
 constant 1 / (zeta omega_n), during which the speed rises by n' / (zeta omega_n). :func:`swept_peak` predicts the
-ridge of one mode with both effects: the single mode q'' + 2 zeta omega_n q' + omega_n^2 q = s(t) cos(2 pi k phi(t))
-(s the ramp's load fraction n / n_nominal, phi the run's mesh phase) integrated along the run's own speed history,
-its acceleration q'' tracked like the run's signal, the track's maximum near the crossing.
+ridge of one mode with both effects: the single mode
+
+    q'' + 2 zeta omega_n q' + omega_n^2 q = s(t) cos(2 pi k phi(t))
+
+(phi the run's mesh phase) integrated along the run's own speed history, its acceleration q'' tracked like the
+run's signal, the track's maximum near the crossing. The excitation's amplitude s(t) is the run's own mesh load:
+the mesh stiffness variation acts on the mean mesh force, Delta k delta^p = (Delta k / k) F for a contact law
+F = k delta^p, so s(t) ~ F(t) = sum_c F_c(t), the sum of the recorded mesh forces averaged over the track window
+(:func:`mesh_excitation`). During the ramp F is not the load fraction n / n_nominal of the load torque: the drive
+also accelerates the driven members, whose inertia torque J alpha(t) the meshes carry on top of it.
+
+Ridges against predictions. :func:`runup` compares each ridge with the crossings of its order that the order
+excites (flexgear.modal.campbell: mesh phasing), each with its swept prediction n_swept (:func:`swept_crossings`,
+the line's damping ratio at the crossing): the ridge is matched with the nearest n_swept, swept_error =
+(n_ridge - n_swept) / n_swept, next to the error against the crossing itself. The Campbell diagram's operating point
+is the full load torque; the modes along the ramp differ where the mesh stiffness matters (the impact law's tangent
+1.5 k delta^0.5 follows the load), which flexgear.modal.linearize at the ridge's speed and time t* shows.
 """
 
 from __future__ import annotations
@@ -52,8 +66,8 @@ import pandas as pd
 from flexgear.results import RunResult
 
 __all__ = ["OrderMap", "RunUp", "order_tracks", "ridges", "match_crossings", "runup", "spectrogram",
-           "mesh_phase", "swept_peak", "DEFAULT_WINDOW_S", "DEFAULT_HOP_S", "MIN_MESH_CYCLES", "MIN_PROMINENCE_DB",
-           "MIN_SNR_DB", "SIDE_LOBE_DB", "ORDERS"]
+           "mesh_phase", "mesh_excitation", "swept_peak", "swept_crossings", "DEFAULT_WINDOW_S", "DEFAULT_HOP_S",
+           "MIN_MESH_CYCLES", "MIN_PROMINENCE_DB", "MIN_SNR_DB", "SIDE_LOBE_DB", "ORDERS"]
 
 DEFAULT_WINDOW_S = 0.01
 """Window length L [s] of the spectrogram and the order tracks: 1000 samples at the runs' 1e-5 s step; the
@@ -210,24 +224,33 @@ def ridges(tracks: pd.DataFrame, floor: tuple[np.ndarray, np.ndarray] | None = N
     return out.sort_values("prominence_db", ascending=False, ignore_index=True)
 
 
-def match_crossings(found: pd.DataFrame, crossings: pd.DataFrame) -> pd.DataFrame:
-    """Each ridge with the nearest predicted crossing of its order (Campbell crossings: speed_rpm, order, mode,
-    kind, frequency_hz): adds crossing_rpm, mode, kind, mode_hz and error_pct = 100 (n_ridge - n_cross) / n_cross
-    (NaN where the order has no crossing)."""
+def match_crossings(found: pd.DataFrame, crossings: pd.DataFrame, on: str = "speed_rpm") -> pd.DataFrame:
+    """Each ridge with the predicted crossing of its order (Campbell crossings: speed_rpm, order, mode, kind,
+    frequency_hz; only those with ``excited`` true where that column is given) whose column ``on`` (speed_rpm: the
+    crossing; swept_rpm: its swept prediction, :func:`swept_crossings`) lies nearest the ridge: adds crossing_rpm,
+    mode, kind, mode_hz and error_pct = 100 (n_ridge - n_cross) / n_cross, and where the crossings carry swept_rpm,
+    swept_rpm and swept_error_pct = 100 (n_ridge - n_swept) / n_swept (NaN where the order has no crossing)."""
     out = found.copy()
-    extra = {"crossing_rpm": [], "mode": [], "kind": [], "mode_hz": [], "error_pct": []}
+    swept = "swept_rpm" in crossings.columns
+    keys = ["crossing_rpm", "mode", "kind", "mode_hz", "error_pct"]
+    keys += ["swept_rpm", "swept_error_pct"] if swept else []
+    extra: dict[str, list] = {key: [] for key in keys}
+    usable = crossings[crossings["excited"].astype(bool)] if "excited" in crossings.columns else crossings
     for _, r in found.iterrows():
-        same = crossings[(crossings["order"] == r["order"]) & (crossings["speed_rpm"] > 0)]
+        same = usable[(usable["order"] == r["order"]) & (usable["speed_rpm"] > 0) & usable[on].notna()]
         if same.empty:
             for key in extra:
                 extra[key].append(np.nan if key != "kind" else "")
             continue
-        c = same.iloc[int(np.argmin(np.abs(same["speed_rpm"].to_numpy() - r["speed_rpm"])))]
+        c = same.iloc[int(np.argmin(np.abs(same[on].to_numpy() - r["speed_rpm"])))]
         extra["crossing_rpm"].append(float(c["speed_rpm"]))
         extra["mode"].append(int(c["mode"]))
         extra["kind"].append(str(c["kind"]))
         extra["mode_hz"].append(float(c["frequency_hz"]))
         extra["error_pct"].append(100.0 * (r["speed_rpm"] - c["speed_rpm"]) / c["speed_rpm"])
+        if swept:
+            extra["swept_rpm"].append(float(c["swept_rpm"]))
+            extra["swept_error_pct"].append(100.0 * (r["speed_rpm"] - c["swept_rpm"]) / c["swept_rpm"])
     for key, values in extra.items():
         out[key] = values
     return out
@@ -243,12 +266,30 @@ SWEPT_SEARCH = 0.25
 """Relative speed range around a crossing in which :func:`swept_peak` takes its track's maximum [-]."""
 
 
+def mesh_excitation(signals: pd.DataFrame, window_s: float = DEFAULT_WINDOW_S) -> np.ndarray | None:
+    """Amplitude s(t) of the mesh excitation along a run (module docstring): the sum of its recorded mesh forces
+    (the columns named ``*mesh_force*`` [N]) averaged over a window of ``window_s`` [s], divided by its largest
+    value [-]; None where the run recorded no mesh force."""
+    from scipy.ndimage import uniform_filter1d
+
+    cols = [c for c in signals.columns if "mesh_force" in c]
+    if not cols:
+        return None
+    t = signals["time_s"].to_numpy()
+    m = max(int(round(window_s / _uniform_step(t))), 1) | 1  # odd: centred
+    f = uniform_filter1d(np.abs(signals[cols].to_numpy(float)).sum(axis=1), m, mode="nearest")
+    top = float(f.max())
+    return f / top if top > 0.0 else None
+
+
 def swept_peak(time_s: np.ndarray, speed_rpm: np.ndarray, mesh_hz_per_rpm: float, order: int, mode_hz: float,
                damping_ratio: float, nominal_rpm: float | None = None, window_s: float = DEFAULT_WINDOW_S,
-               hop_s: float = DEFAULT_HOP_S, min_cycles: float = MIN_MESH_CYCLES) -> float:
+               hop_s: float = DEFAULT_HOP_S, min_cycles: float = MIN_MESH_CYCLES,
+               excitation: np.ndarray | None = None) -> float:
     """Speed [rpm] of the ridge that a single mode (``mode_hz`` [Hz], ``damping_ratio`` [-]) makes on order
-    ``order`` along the speed history ``speed_rpm`` (module docstring: force amplitude n / ``nominal_rpm``, default
-    the highest speed), tracked with the same window; NaN if the order never reaches the mode or the track has no
+    ``order`` along the speed history ``speed_rpm`` (module docstring), tracked with the same window; force
+    amplitude ``excitation`` s(t) (one value per sample, e.g. :func:`mesh_excitation`; None: the load fraction
+    n / ``nominal_rpm``, default the highest speed). NaN if the order never reaches the mode or the track has no
     maximum within :data:`SWEPT_SEARCH` of the crossing."""
     from scipy.signal import lsim
 
@@ -259,7 +300,8 @@ def swept_peak(time_s: np.ndarray, speed_rpm: np.ndarray, mesh_hz_per_rpm: float
         return math.nan
     nominal = float(n.max()) if nominal_rpm is None else float(nominal_rpm)
     w = 2.0 * math.pi * mode_hz
-    force = n / nominal * np.cos(2.0 * math.pi * order * mesh_phase(t, n, mesh_hz_per_rpm))
+    amplitude = n / nominal if excitation is None else np.asarray(excitation, float)
+    force = amplitude * np.cos(2.0 * math.pi * order * mesh_phase(t, n, mesh_hz_per_rpm))
     # state x = (q, q'); output q'' = -w^2 q - 2 zeta w q' + f
     a = [[0.0, 1.0], [-w * w, -2.0 * damping_ratio * w]]
     _, accel, _ = lsim((a, [[0.0], [1.0]], [[-w * w, -2.0 * damping_ratio * w]], [[1.0]]), force, t - t[0])
@@ -270,6 +312,25 @@ def swept_peak(time_s: np.ndarray, speed_rpm: np.ndarray, mesh_hz_per_rpm: float
         return math.nan
     sel = tr[near]
     return float(sel["speed_rpm"].iloc[int(np.argmax(sel["amplitude"].to_numpy()))])
+
+
+def swept_crossings(crossings: pd.DataFrame, time_s: np.ndarray, speed_rpm: np.ndarray, mesh_hz_per_rpm: float,
+                    speed_range_rpm: tuple[float, float], orders: Sequence[int],
+                    excitation: np.ndarray | None = None, window_s: float = DEFAULT_WINDOW_S,
+                    hop_s: float = DEFAULT_HOP_S) -> pd.DataFrame:
+    """The ``crossings`` (flexgear.modal.campbell: speed_rpm, order, frequency_hz, damping_ratio, excited) of the
+    ``orders`` whose crossing speed lies within ``speed_range_rpm`` [rpm], each with swept_rpm, its ridge under the
+    run's own sweep (:func:`swept_peak` with the line's damping ratio and ``excitation``); only the excited ones
+    where the column is given."""
+    lo, hi = speed_range_rpm
+    sel = crossings[crossings["order"].isin(list(orders)) & crossings["speed_rpm"].between(lo, hi)]
+    if "excited" in sel.columns:
+        sel = sel[sel["excited"].astype(bool)]
+    sel = sel.copy()
+    sel["swept_rpm"] = [swept_peak(time_s, speed_rpm, mesh_hz_per_rpm, int(c["order"]), float(c["frequency_hz"]),
+                                   float(c["damping_ratio"]), window_s=window_s, hop_s=hop_s, excitation=excitation)
+                        for _, c in sel.iterrows()]
+    return sel
 
 
 @dataclass(frozen=True)
@@ -332,7 +393,8 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
     """The run-up of a saved run (module docstring) from the ``side`` ("input"/"output") bearing acceleration
     along ``axis`` ("x"/"y"); the instantaneous speed is the recorded input speed, the ramp's end the run's
     ``ramp_time_s``, the mesh frequency per rpm the run's theory values (mesh frequency / nominal input speed).
-    ``campbell``: a flexgear.modal.campbell.Campbell whose crossings the ridges are matched with."""
+    ``campbell``: a flexgear.modal.campbell.Campbell whose crossings the ridges are matched with (module
+    docstring: by their swept predictions under the run's mesh excitation)."""
     if not result.ok or result.signals is None:
         raise ValueError(f"run {result.name!r} has no signals")
     s = result.signals
@@ -351,5 +413,12 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
     tracks = order_tracks(t, y, n, per_rpm, orders, window_s, hop_s, ramp_end_s=ramp)
     found = ridges(tracks, (mp.time_s, mp.floor))
     if campbell is not None:
-        found = match_crossings(found, campbell.crossings)
+        crossings = campbell.crossings
+        if "damping_ratio" in crossings.columns and len(found) and len(tracks):
+            span = (float(tracks["speed_rpm"].min()), float(tracks["speed_rpm"].max()))
+            crossings = swept_crossings(crossings, t, n, per_rpm, span, sorted(set(found["order"])),
+                                        mesh_excitation(s, window_s), window_s, hop_s)
+            found = match_crossings(found, crossings, on="swept_rpm")
+        else:
+            found = match_crossings(found, crossings)
     return RunUp(result.name, mp, tracks, found, ramp, tuple(orders))
