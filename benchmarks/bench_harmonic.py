@@ -4,7 +4,8 @@ run of model 7, and does the frequency domain match settled time integration of 
 Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 200] [--harmonics 10]
      nice -n 5 python benchmarks/bench_harmonic.py checks [model_variants/model1.toml model_variants/model7.toml]
                                                            [--lumped-only | --no-lumped] [--gearbox FILE]
-                                                           [--linearization spin] [--angles M] [--save DIR]
+                                                           [--linearization spin] [--angles J] [--window-angles M]
+                                                           [--save DIR | --signals DIR]
 
 - ``speed``: caches warmed first (a linearisation loads the reduced bodies, a 1e-4 s run compiles the time model);
   then per round, interleaved, flexgear.harmonic.harmonic_response of model 7 over ``--speeds`` speeds from 500 to
@@ -16,18 +17,23 @@ Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 
 - ``checks``: each variant under the ISO 6336 law without friction (the linearisation's scope), its own number of
   stiffness harmonics. The response over 500-7000 rpm locates the peaks of K_v - 1; the first whose height is at
   least :data:`STRONG` of the highest is the first strong crossing n_c. At n_c x :data:`BESIDE` (below, on, above)
-  a settled time run (ramps over :data:`RAMP_S`, then until the settling test passes) gives the 1x and 2x mesh
-  amplitudes (windowed DTFT over the last :data:`WINDOW_S`, whole mesh cycles) of the mesh forces of planet 1 and
-  the four bearing accelerations, and K_v (peak over mean mesh force, flexgear.study.indicators), against the
-  frequency domain at the same speed: relative differences, goal 10 %; "moved": the time value's change from the
-  window before the last. An amplitude the planets' phasing cancels (below :data:`CANCELLED` of its family's
-  largest at that speed in the frequency domain) is shown but not judged. Diagnostics, not judged
-  (flexgear.study.harmonic_check): over the whole settled part (resolution its inverse length) the lines at exactly
-  1x and 2x mesh and at 2 f_mesh -/+ B f_ring (B the ring's bolts, f_ring its rotation), which a rotating member
-  with a B-fold pattern adds and the 0.05 s window cannot tell from 2x; K_v - 1 of the window's mesh-periodic part
-  (what the frequency domain computes); with ``--angles M`` the frequency domain linearised at M gear angles over
-  one ring revolution (K_v - 1 over the angles; the 2x bearing accelerations' complex mean, which the time
-  domain's line at exactly 2 f_mesh corresponds to, and RMS). ``--save DIR`` keeps each time run's signals.
+  the frequency domain over the turning angle (flexgear.harmonic.turning_response: for a flexible ring or output
+  shaft, J operating points a whole number of mesh cycles apart at the pattern phases j / J of the 12 bolts turning
+  at f_ring; without one, flexgear.harmonic.harmonic_response) against a settled time run (ramps over
+  :data:`RAMP_S`, then until the settling test passes; or its signals read back with ``--signals DIR``, the
+  settling test redone on them). Compared: the 1x and 2x amplitudes of the mesh forces of planet 1 and the four
+  bearing accelerations, the angle RMS (all sidebands, flexgear.harmonic.turning eq. 1) against the
+  root-sum-square of the lines at h f_mesh + p B f_ring, |p| <= (J - 1) / 2, over the settled part (whole mesh
+  cycles; flexgear.study.harmonic_check.sideband_rss; P = 0, the line at exactly h f_mesh, without a pattern);
+  and K_v, the quasi-static peak over the angles (eq. 2) against the time window's peak over mean mesh force
+  (the last :data:`WINDOW_S`, flexgear.study.indicators). Relative differences, goal 10 %; "halves": the time
+  value's change from the first half of the settled part to the second; "moved": K_v's from the window before the
+  last. An amplitude below :data:`CANCELLED` of its family's largest at that speed in the frequency domain is
+  shown but not judged. Shown beside, not judged: the frequency domain at the first angle alone, the former 0.05 s
+  window's Hann-windowed DTFT, the line at exactly h f_mesh, for a pattern the 2x bearing accelerations' sidebands
+  p = -2..2 in both domains, K_v - 1 of the window's mesh-periodic part and the static forces' swing over the
+  angles; with ``--window-angles M`` eq. 2 over M operating points spread over the time run's K_v window (every
+  gear at its angle in the run: all turning bodies' load sharing). ``--save DIR`` keeps each time run's signals.
   Then the lumped model of ``--gearbox`` under the same law against its own settled time integration
   (flexgear.study.harmonic_check: the same rule for the first strong peak, its crossing read off the lumped model's
   Campbell diagram through the mode that carries the peak, the three speeds n_c x BESIDE, runs to settle_max_time_s
@@ -340,8 +346,9 @@ def main() -> None:
     only.add_argument("--lumped-only", action="store_true", help="the lumped model's checks only")
     only.add_argument("--no-lumped", action="store_true", help="without the lumped model's checks")
     c.add_argument("--linearization", default="spin", choices=("spin", "quadratic", "each"),
-                   help="the multibody models' linearisation at each check speed (flexgear.harmonic.harmonic_response; "
-                        "the sweep that locates the crossing: spin)")
+                   help="the linearisation at each check speed of a variant without a turning pattern "
+                        "(flexgear.harmonic.harmonic_response; with one: one linearisation per angle; the sweep that "
+                        "locates the crossing: spin)")
     c.add_argument("--angles", type=int, default=None,
                    help="angles J per period of a turning pattern (flexgear.harmonic.turning; default 2 P + 1)")
     c.add_argument("--window-angles", type=int, default=0,
