@@ -64,7 +64,8 @@ def integrated() -> tuple[np.ndarray, np.ndarray, np.ndarray, float]:
     k1, kb = _stiffness(np.zeros(1))
     sol = solve_ivp(rhs, (0.0, t[-1]), [P_N / float(k1[0] + kb), 0.0], method="DOP853", t_eval=t, rtol=1e-10,
                     atol=1e-14)
-    x, v = sol.y
+    assert sol.success, sol.message
+    x = sol.y[0]
     k1, kb = _stiffness(2.0 * math.pi * F_ROT_HZ * t)
     accel = np.array([rhs(ti, yi)[1] for ti, yi in zip(t, sol.y.T, strict=True)])
     return k1 * x, accel, t, dt

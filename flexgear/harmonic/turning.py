@@ -6,9 +6,9 @@ B-fold bolt pattern of their joint (``[components_assumed] ring_bolt_count``, fl
 or output shaft therefore gives a linearised model periodic in the time of the operating point t* with the
 pattern period tau = 1 / (B f_ring) [s] (:func:`turning_pattern`).
 
-Quasi-static in the angle. Where the pattern's passing frequency B f_ring lies far below the modes that respond
-and far from h f_mesh's distance to them, the steady response at mesh harmonic h is the frozen model's response
-at the current angle,
+Quasi-static in the angle. Where the pattern's passing frequency B f_ring is small against the distance from h f_mesh
+to the modes that respond and against their bandwidth, the steady response at mesh harmonic h is the frozen model's
+response at the current angle,
 
     x(t) = Re( X_h(t) e^{i 2 pi h f_mesh t} ),    X_h(t* + tau) = X_h(t*),
 
@@ -43,12 +43,12 @@ Where it fails. (a) Sidebands near a resonance: a mode within about B f_ring of 
 answers each line at its own frequency, not at h f_mesh; (b) orders beyond (J - 1) / 2 alias; (c) t* sets every
 gear's angle: over the m_j (up to N mesh cycles) the sun and the planets turn by up to N / z_sun and N / z_planet
 revolutions, so their own departures from cyclic symmetry (a flexible gear's finite-element mesh) are sampled
-along, not resolved: they spread into every order p of the pattern, and the slow lines at their rotation
-frequencies and its combinations with f_ring are left out of (2), as are free vibrations the time run still
-carries; (d) the
-first-order limits of flexgear.harmonic.response (parametric terms, loss of contact). A variant without a turning
-asymmetric flexible body (rigid ring and output shaft, or the planetary arrangement, whose ring stands still)
-has J = 1 and gives flexgear.harmonic.harmonic_response's values.
+along, not resolved: they spread into every order p of the pattern, the time signal's lines at h f_mesh plus
+their rotation frequencies are not in (1), and the slow lines of their load sharing (at their rotation frequencies
+and combinations with f_ring) are in (2) only as far as the m_j sample them; free vibrations the time run still
+carries are in neither; (d) the first-order limits of flexgear.harmonic.response (parametric terms, loss of
+contact). A variant without a turning asymmetric flexible body (rigid ring and output shaft, or the planetary
+arrangement, whose ring stands still) has J = 1 and gives flexgear.harmonic.harmonic_response's values.
 """
 
 from __future__ import annotations
