@@ -8,8 +8,8 @@
     (eq. 1 of the module) the root-sum-square of those lines, each sideband |X_{h,p}|, and (eq. 2) the time
     signal's peak over its mean, which holds the load sharing F_s(theta) = k_1 P / (k_1 + k_b). The tolerances
     are the quasi-static approximation's: the FRF's change over B f_rot at h f (2.7 % at 2 f, each sideband
-    answering at its own frequency; they cancel to second order in the root-sum-square), and the peak's sampling
-    by the mesh cycles (pi B f_rot / f in phase).
+    answering at its own frequency; second order, below 1e-3, in the root-sum-square), and the peak's sampling by
+    the mesh cycles (pi B f_rot / f in phase: below 5e-3 of K_v - 1).
 (2) Without a turning asymmetric flexible body (model 1, rigid) the response over the angle is
     flexgear.harmonic.harmonic_response's, exactly; a flexible ring or output shaft carries the bolt pattern.
 """
@@ -81,7 +81,7 @@ def test_angle_rms_and_sidebands_match_the_time_lines(integrated):
         rms = angle_rms(freq)
         for h in (1, 2):
             timed = sideband_rss(signal, dt, h * F_HZ, spacing, (count - 1) // 2)
-            assert rms[h - 1] == pytest.approx(timed, rel=0.01)
+            assert rms[h - 1] == pytest.approx(timed, rel=2e-3)
             sidebands = sideband_amplitudes(freq[:, h - 1])
             assert sidebands.index.tolist() == list(range(-4, 5))
             assert math.sqrt((sidebands**2).sum()) == pytest.approx(rms[h - 1], rel=1e-12)  # Parseval
@@ -99,7 +99,7 @@ def test_quasi_static_peak_matches_the_time_peak_factor(integrated):
     static, dyn, _ = _frozen(theta)
     kv = quasi_static_peak(static[:, None], dyn[:, None, :])
     kv_t = force.max() / force.mean()
-    assert kv - 1.0 == pytest.approx(kv_t - 1.0, rel=0.02)
+    assert kv - 1.0 == pytest.approx(kv_t - 1.0, rel=5e-3)
     # the static load sharing is a visible part of it: the frozen peak at the mean stiffness alone is lower
     assert kv - 1.0 > 1.1 * (waveform_peak(dyn.mean(axis=0), static.mean()) / static.mean() - 1.0)
     # one angle: flexgear.harmonic.base's peak factor
