@@ -4,7 +4,8 @@ run of model 7, and does the frequency domain match settled time integration of 
 Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 200] [--harmonics 10]
      nice -n 5 python benchmarks/bench_harmonic.py checks [model_variants/model1.toml model_variants/model7.toml]
                                                            [--lumped-only | --no-lumped] [--gearbox FILE]
-                                                           [--linearization spin] [--angles M] [--save DIR]
+                                                           [--linearization spin] [--angles J] [--window-angles M]
+                                                           [--save DIR | --signals DIR]
 
 - ``speed``: caches warmed first (a linearisation loads the reduced bodies, a 1e-4 s run compiles the time model);
   then per round, interleaved, flexgear.harmonic.harmonic_response of model 7 over ``--speeds`` speeds from 500 to
@@ -16,18 +17,23 @@ Run: nice -n 5 python benchmarks/bench_harmonic.py speed [--repeat 1] [--speeds 
 - ``checks``: each variant under the ISO 6336 law without friction (the linearisation's scope), its own number of
   stiffness harmonics. The response over 500-7000 rpm locates the peaks of K_v - 1; the first whose height is at
   least :data:`STRONG` of the highest is the first strong crossing n_c. At n_c x :data:`BESIDE` (below, on, above)
-  a settled time run (ramps over :data:`RAMP_S`, then until the settling test passes) gives the 1x and 2x mesh
-  amplitudes (windowed DTFT over the last :data:`WINDOW_S`, whole mesh cycles) of the mesh forces of planet 1 and
-  the four bearing accelerations, and K_v (peak over mean mesh force, flexgear.study.indicators), against the
-  frequency domain at the same speed: relative differences, goal 10 %; "moved": the time value's change from the
-  window before the last. An amplitude the planets' phasing cancels (below :data:`CANCELLED` of its family's
-  largest at that speed in the frequency domain) is shown but not judged. Diagnostics, not judged
-  (flexgear.study.harmonic_check): over the whole settled part (resolution its inverse length) the lines at exactly
-  1x and 2x mesh and at 2 f_mesh -/+ B f_ring (B the ring's bolts, f_ring its rotation), which a rotating member
-  with a B-fold pattern adds and the 0.05 s window cannot tell from 2x; K_v - 1 of the window's mesh-periodic part
-  (what the frequency domain computes); with ``--angles M`` the frequency domain linearised at M gear angles over
-  one ring revolution (K_v - 1 over the angles; the 2x bearing accelerations' complex mean, which the time
-  domain's line at exactly 2 f_mesh corresponds to, and RMS). ``--save DIR`` keeps each time run's signals.
+  the frequency domain over the turning angle (flexgear.harmonic.turning_response: for a flexible ring or output
+  shaft, J operating points a whole number of mesh cycles apart at the pattern phases j / J of the 12 bolts turning
+  at f_ring; without one, flexgear.harmonic.harmonic_response) against a settled time run (ramps over
+  :data:`RAMP_S`, then until the settling test passes; or its signals read back with ``--signals DIR``, the
+  settling test redone on them). Compared: the 1x and 2x amplitudes of the mesh forces of planet 1 and the four
+  bearing accelerations, the angle RMS (all sidebands, flexgear.harmonic.turning eq. 1) against the
+  root-sum-square of the lines at h f_mesh + p B f_ring, |p| <= (J - 1) / 2, over the settled part (whole mesh
+  cycles; flexgear.study.harmonic_check.sideband_rss; P = 0, the line at exactly h f_mesh, without a pattern);
+  and K_v, the quasi-static peak over the angles (eq. 2) against the time window's peak over mean mesh force
+  (the last :data:`WINDOW_S`, flexgear.study.indicators). Relative differences, goal 10 %; "halves": the time
+  value's change from the first half of the settled part to the second; "moved": K_v's from the window before the
+  last. An amplitude below :data:`CANCELLED` of its family's largest at that speed in the frequency domain is
+  shown but not judged. Shown beside, not judged: the frequency domain at the first angle alone, the former 0.05 s
+  window's Hann-windowed DTFT, the line at exactly h f_mesh, for a pattern the 2x bearing accelerations' sidebands
+  p = -2..2 in both domains, K_v - 1 of the window's mesh-periodic part and the static forces' swing over the
+  angles; with ``--window-angles M`` eq. 2 over M operating points spread over the time run's K_v window (every
+  gear at its angle in the run: all turning bodies' load sharing). ``--save DIR`` keeps each time run's signals.
   Then the lumped model of ``--gearbox`` under the same law against its own settled time integration
   (flexgear.study.harmonic_check: the same rule for the first strong peak, its crossing read off the lumped model's
   Campbell diagram through the mode that carries the peak, the three speeds n_c x BESIDE, runs to settle_max_time_s
@@ -141,115 +147,152 @@ def _strong_crossing(response) -> float:
     return float(n[strong[0]])
 
 
-def checks(a: argparse.Namespace) -> None:
+def _time_signals(a: argparse.Namespace, run, n: float, f_mesh: float):
+    """(signals, start of the settled part [s], how obtained) of the settled time run of ``run`` at ``n`` [rpm]:
+    run now (flexgear.mbs.run.run_variant to "settled") or read from ``--signals DIR`` (the settling test of the
+    run, flexgear.settling.settled_start, on the whole saved signals)."""
+    if a.signals:
+        import pandas as pd
+
+        from flexgear.settling import SettleRule, settled_start
+
+        path = Path(a.signals) / f"{run.name}_{n:g}rpm.parquet"
+        sig = pd.read_parquet(path)
+        screening = run.gearbox.screening
+        test = settled_start(sig, RAMP_S + screening.after_ramp_delay_s, f_mesh, SettleRule.from_settings(screening))
+        if not test.settled:
+            raise RuntimeError(f"{path}: {test.reason}")
+        return sig, float(test.start_s), f"read {path.name}"
     from flexgear.mbs.run import run_variant
+
+    t0 = time.perf_counter()
+    result = run_variant(run, t_end_s="settled")
+    assert result.ok, result.meta.get("reason")
+    if not result.meta.get("settled"):
+        raise RuntimeError(f"{run.name} at {n:g} rpm: {result.meta.get('settle_reason')}")
+    if a.save:
+        Path(a.save).mkdir(parents=True, exist_ok=True)
+        result.signals.to_parquet(Path(a.save) / f"{run.name}_{n:g}rpm.parquet")
+    return result.signals, float(result.meta["settled_at_s"]), f"time run {time.perf_counter() - t0:.0f} s"
+
+
+def _family_scale(freq, column: str, n: float) -> float:
+    family = [c for c in COLUMNS if ("accel" in c) == ("accel" in column)]
+    return max(freq.amplitudes(c).loc[n].to_numpy()[:2].max() for c in family)
+
+
+def checks(a: argparse.Namespace) -> None:
+    from flexgear.harmonic import turning_pattern, turning_response
     from flexgear.study.compare import harmonic_amplitudes
-    from flexgear.study.harmonic_check import line_amplitude, periodic_peak_factor
+    from flexgear.study.harmonic_check import line_amplitude, periodic_peak_factor, sideband_rss
     from flexgear.study.indicators import _kv
 
     print(load_average())
-    worst = 0.0
+    worst, judged_all = 0.0, []
     for path in [] if a.lumped_only else a.variants:
         variant = _iso(load_variant(path))
         spec = variant.gearbox
         harmonics = spec.contact_assumed.stiffness_harmonics
+        pattern = turning_pattern(variant)
         t0 = time.perf_counter()
         response = harmonic_response(variant, np.arange(500.0, 7000.0 + 1.0, 25.0), harmonics)
         crossing = _strong_crossing(response)
         print(f"\n{variant.name}: response 500-7000 rpm in {time.perf_counter() - t0:.1f} s; first strong peak of "
-              f"K_v at {crossing:g} rpm (K_v {response.dynamic_factor().loc[crossing]:.4f})")
+              f"K_v at {crossing:g} rpm (K_v {response.dynamic_factor().loc[crossing]:.4f}); turning pattern: "
+              + ("none (one angle)" if pattern is None else
+                 f"{'+'.join(pattern.components)}, {pattern.order}-fold"))
         for factor in BESIDE:
             n = round(crossing * factor, 1)
-            freq = harmonic_response(variant, [n], harmonics, linearization=a.linearization)
+            t0 = time.perf_counter()
+            freq = turning_response(variant, [n], harmonics, angles=a.angles, linearization=a.linearization)
+            t_freq = time.perf_counter() - t0
             lc = dict(input_speed_rpm=n, ramp_time_s=RAMP_S, end_time_s=END_S)
             run = dataclasses.replace(variant, gearbox=spec.with_fields("load_case", **lc))
-            t0 = time.perf_counter()
-            result = run_variant(run, t_end_s="settled")
-            assert result.ok, result.meta.get("reason")
-            sig = result.signals
+            f_mesh = mesh_frequency_hz(spec, n)
+            sig, start, how = _time_signals(a, run, n, f_mesh)
             t = sig["time_s"].to_numpy()
             dt = float(t[-1] - t[-2])  # the recorded step (a run may start with shorter ones)
-            f_mesh = mesh_frequency_hz(spec, n)
             k = int(round(math.floor(WINDOW_S * f_mesh) / f_mesh / dt))
-            if not np.allclose(np.diff(t[-k - 1:]), dt, rtol=1e-6):
-                raise RuntimeError("the analysed window is not uniformly sampled")
-            print(f"  {n:g} rpm ({factor:g} x): time run {time.perf_counter() - t0:.0f} s, settled "
-                  f"{result.meta.get('settled')} at {result.meta.get('settled_at_s')} s, window {k * dt:.4f} s "
-                  f"ending {t[-1]:.4f} s")
-            start = float(result.meta.get("settled_at_s") or t[-2 * k])
             long = int(round(math.floor((t[-1] - start) * f_mesh) / f_mesh / dt))  # the settled part, whole cycles
-            f_out = abs(spec.gears.sun_teeth / spec.gears.ring_teeth * n / 60.0)  # the ring's rotation [Hz]
-            bolts = spec.components_assumed.ring_bolt_count
-            print(f"    settled part {long * dt:.3f} s (resolution {1.0 / (long * dt):.1f} Hz): lines at exactly "
-                  f"h f_mesh, and at 2 f_mesh -/+ {bolts} f_ring (f_ring {f_out:.2f} Hz, {bolts} bolts)")
-            if a.save:
-                Path(a.save).mkdir(parents=True, exist_ok=True)
-                sig.to_parquet(Path(a.save) / f"{variant.name}_{n:g}rpm.parquet")
+            if not np.allclose(np.diff(t[-long - 1:]), dt, rtol=1e-6):
+                raise RuntimeError("the settled part is not uniformly sampled")
+            order = 0 if pattern is None else freq.sideband_order
+            spacing = 0.0 if pattern is None else 1.0 / pattern.period_s(n)
+            print(f"  {n:g} rpm ({factor:g} x): frequency domain at {freq.count} angle(s) {t_freq:.0f} s; {how}, "
+                  f"settled at {start:.4f} s, settled part {long * dt:.3f} s (resolution {1.0 / (long * dt):.1f} Hz)"
+                  + ("" if pattern is None else f"; lines h f_mesh + p {pattern.order} f_ring, |p| <= {order}, "
+                     f"{pattern.order} f_ring = {spacing:.1f} Hz"))
             for column in COLUMNS:
-                timed = harmonic_amplitudes(sig[column].to_numpy()[-k:], dt, f_mesh, (1, 2))
-                before = harmonic_amplitudes(sig[column].to_numpy()[-2 * k:-k], dt, f_mesh, (1, 2))
-                fd = freq.amplitudes(column).iloc[0].to_numpy()[:2]
-                family = [c for c in freq.indicators if ("accel" in c) == ("accel" in column) and "max" not in c
-                          and c != "dynamic_factor" and "transmission" not in c]
-                scale = max(freq.amplitudes(c).iloc[0].to_numpy()[:2].max() for c in family)
+                fd = freq.amplitudes(column).loc[n].to_numpy()[:2]
+                one = np.abs(freq.angles[n][0].complex(column).iloc[0].to_numpy()[:2])
+                scale = _family_scale(freq, column, n)
+                x = sig[column].to_numpy()[-long:]
+                window = harmonic_amplitudes(x[-k:], dt, f_mesh, (1, 2))  # the former time value
+                half = long // 2
                 cells = []
-                for h in (0, 1):
-                    rel = fd[h] / timed[h] - 1.0
-                    judged = fd[h] >= CANCELLED * scale
+                for h in (1, 2):
+                    td = sideband_rss(x, dt, h * f_mesh, spacing, order)
+                    parts = [sideband_rss(y, dt, h * f_mesh, spacing, order) for y in (x[:half], x[half:])]
+                    rel = fd[h - 1] / td - 1.0
+                    judged = fd[h - 1] >= CANCELLED * scale
                     if judged:
                         worst = max(worst, abs(rel))
-                    cells.append(f"{h + 1}x freq {fd[h]:.4g} time {timed[h]:.4g} ({100 * rel:+.1f} %"
-                                 f"{'' if judged else ', cancelled: not judged'}; moved "
-                                 f"{100 * (timed[h] / before[h] - 1.0):+.1f} %)")
+                        judged_all.append(rel)
+                    line = line_amplitude(x, dt, h * f_mesh)
+                    cells.append(f"{h}x freq {fd[h - 1]:.4g} time {td:.4g} ({100 * rel:+.1f} %"
+                                 f"{'' if judged else ', below CANCELLED: not judged'}; halves "
+                                 f"{100 * (parts[1] / parts[0] - 1.0):+.1f} %) [one angle {one[h - 1]:.4g}; "
+                                 f"{WINDOW_S:g} s window {window[h - 1]:.4g}; line at {h} f_mesh {line:.3g}]")
                 print(f"    {column}: " + "; ".join(cells))
-                x = sig[column].to_numpy()[-long:]
-                lines = [line_amplitude(x, dt, h * f_mesh) for h in (1, 2)]
-                lines += [line_amplitude(x, dt, 2 * f_mesh + s * bolts * f_out) for s in (-1, 1)]
-                print(f"      settled part: 1x {lines[0]:.4g}, 2x {lines[1]:.4g}; 2 f_mesh -/+ {bolts} f_ring "
-                      f"{lines[2]:.4g} / {lines[3]:.4g}")
-            fo = np.stack([sig[f"outer_mesh_force_{i + 1}_n"].to_numpy()[-k:] for i in range(spec.gears.planet_count)],
-                          axis=1)
-            fi = np.stack([sig[f"inner_mesh_force_{i + 1}_n"].to_numpy()[-k:] for i in range(spec.gears.planet_count)],
-                          axis=1)
-            kv_t, kv_f = _kv(fo, fi), float(freq.dynamic_factor().iloc[0])
-            kv_b = _kv(*(np.stack([sig[f"{kind}_mesh_force_{i + 1}_n"].to_numpy()[-2 * k:-k]
-                                   for i in range(spec.gears.planet_count)], axis=1) for kind in ("outer", "inner")))
+                if pattern is not None and "accel" in column:
+                    sb = freq.sidebands(column, n, 2)
+                    print("      2x sidebands p -2..2, freq / time: " + ", ".join(
+                        f"{p:+d}: {sb.loc[p]:.3g} / {line_amplitude(x, dt, 2 * f_mesh + p * spacing):.3g}"
+                        for p in range(-2, 3) if p in sb.index))
+            planets = spec.gears.planet_count
+            forces = [np.stack([sig[f"{kind}_mesh_force_{i + 1}_n"].to_numpy() for i in range(planets)], axis=1)
+                      for kind in ("outer", "inner")]
+            kv_t = _kv(*(f[-k:] for f in forces))
+            kv_b = _kv(*(f[-2 * k:-k] for f in forces))
+            kv_f = float(freq.dynamic_factor().loc[n])
+            kv_1 = float(freq.angles[n][0].dynamic_factor().iloc[0])
             rel = (kv_f - 1.0) / (kv_t - 1.0) - 1.0
             worst = max(worst, abs(rel))
+            judged_all.append(rel)
             print(f"    K_v - 1: freq {kv_f - 1:.4g} time {kv_t - 1:.4g} ({100 * rel:+.1f} %; moved "
-                  f"{100 * ((kv_t - 1.0) / (kv_b - 1.0) - 1.0):+.1f} %)")
-            kv_p = periodic_peak_factor(np.hstack([fo, fi]), dt, f_mesh, harmonics)
-            print(f"      the window's mesh-periodic part (1x-{harmonics}x): K_v - 1 {kv_p - 1:.4g} "
-                  f"({100 * ((kv_f - 1.0) / (kv_p - 1.0) - 1.0):+.1f} %); the rest: {kv_t - kv_p:+.4g} of the mean "
-                  "force")
-            if a.angles:
-                _angles(variant, n, harmonics, a.angles, f_out)
+                  f"{100 * ((kv_t - 1.0) / (kv_b - 1.0) - 1.0):+.1f} %) [one angle {kv_1 - 1:.4g}]")
+            kv_p = periodic_peak_factor(np.hstack([f[-k:] for f in forces]), dt, f_mesh, harmonics)
+            static = freq.static_forces_n(n)
+            swing = float((static / static.mean() - 1.0).abs().to_numpy().max())
+            print(f"      the window's mesh-periodic part: K_v - 1 {kv_p - 1:.4g}; the rest {kv_t - kv_p:+.4g} of the "
+                  f"mean force; static mesh forces over the angles: largest |F_s / mean - 1| {swing:.3g}")
+            if a.window_angles:
+                _window_kv(run, n, harmonics, t[-k], t[-1], a.window_angles, kv_t)
     if not a.lumped_only:
-        print(f"\nlargest judged difference: {100 * worst:.1f} % (goal 10 %)")
+        print(f"\njudged differences: {len(judged_all)}, within 10 %: {sum(abs(r) <= 0.1 for r in judged_all)}; "
+              f"largest {100 * worst:.1f} % (goal 10 %)")
     if not a.no_lumped:
         lumped_checks(a.gearbox)
     print(load_average())
 
 
-def _angles(variant, n: float, harmonics: int, count: int, f_out: float) -> None:
-    """The frequency domain at ``n`` [rpm] linearised at ``count`` gear angles over one ring revolution (t* = T +
-    j / (count f_ring)): K_v - 1 and the 2x bearing accelerations' complex mean and RMS over the angles (the time
-    domain's line at exactly 2 f_mesh is the mean; a rotating asymmetry's sidebands carry the rest)."""
+def _window_kv(run, n: float, harmonics: int, t_a: float, t_b: float, count: int, kv_t: float) -> None:
+    """Diagnostic: eq. 2 of flexgear.harmonic.turning over ``count`` operating points t* spread over the time run's
+    K_v window [t_a, t_b] [s] (every gear at its angle in the run, the run's ramps): the quasi-static peak of the
+    gear angles the window passes through, all turning bodies together."""
+    from flexgear.harmonic.turning import quasi_static_peak
     from flexgear.modal.linear import linearize
 
-    ramp = variant.gearbox.load_case.ramp_time_s
-    kv, waves = [], {c: [] for c in COLUMNS if "accel" in c}
-    for j in range(count):
-        freq = harmonic_response(linearize(variant, speed_rpm=n, t_star=ramp + j / (count * f_out)), [n], harmonics)
-        kv.append(float(freq.dynamic_factor().iloc[0]) - 1.0)
-        for c, w in waves.items():
-            w.append(complex(freq.complex(c).iloc[0][2]))
-    print(f"    frequency domain at {count} gear angles over one ring revolution: K_v - 1 {min(kv):.4g} to "
-          f"{max(kv):.4g}; 2x bearing accelerations, |mean| / RMS / min-max over the angles:")
-    for c, w in waves.items():
-        z = np.array(w)
-        print(f"      {c}: {abs(z.mean()):.3g} / {np.sqrt(np.mean(np.abs(z) ** 2)):.3g} / "
-              f"{np.abs(z).min():.3g}-{np.abs(z).max():.3g}")
+    t0 = time.perf_counter()
+    static, dyn = [], []
+    for ts in np.linspace(t_a, t_b, count):
+        r = harmonic_response(linearize(run, speed_rpm=n, t_star=float(ts)), [n], harmonics)
+        meshes = list(r.static_forces_n)
+        static.append([r.static_forces_n[m] for m in meshes])
+        dyn.append([r.complex(m).iloc[0].to_numpy() for m in meshes])
+    kv = quasi_static_peak(np.array(static), np.array(dyn))
+    print(f"      quasi-static over the window's gear angles ({count} points, {time.perf_counter() - t0:.0f} s): "
+          f"K_v - 1 {kv - 1:.4g} ({100 * ((kv - 1.0) / (kv_t - 1.0) - 1.0):+.1f} % from the time domain)")
 
 
 def lumped_checks(path: str) -> None:
@@ -303,11 +346,17 @@ def main() -> None:
     only.add_argument("--lumped-only", action="store_true", help="the lumped model's checks only")
     only.add_argument("--no-lumped", action="store_true", help="without the lumped model's checks")
     c.add_argument("--linearization", default="spin", choices=("spin", "quadratic", "each"),
-                   help="the multibody models' linearisation at each check speed (flexgear.harmonic.harmonic_response; "
-                        "the sweep that locates the crossing: spin)")
-    c.add_argument("--angles", type=int, default=0,
-                   help="also linearise at this many gear angles over one ring revolution at each check speed")
-    c.add_argument("--save", default=None, help="directory: each time run's signals as <model>_<speed>rpm.parquet")
+                   help="the linearisation at each check speed of a variant without a turning pattern "
+                        "(flexgear.harmonic.harmonic_response; with one: one linearisation per angle; the sweep that "
+                        "locates the crossing: spin)")
+    c.add_argument("--angles", type=int, default=None,
+                   help="angles J per period of a turning pattern (flexgear.harmonic.turning; default 2 P + 1)")
+    c.add_argument("--window-angles", type=int, default=0,
+                   help="diagnostic: the quasi-static K_v over this many gear angles of the time run's K_v window")
+    io = c.add_mutually_exclusive_group()
+    io.add_argument("--save", default=None, help="directory: each time run's signals as <model>_<speed>rpm.parquet")
+    io.add_argument("--signals", default=None,
+                    help="directory of saved signals (<model>_<speed>rpm.parquet) to read instead of running")
     c.add_argument("--gearbox", default=str(ROOT / "model_variants" / "gearbox.toml"),
                    help="gearbox file of the lumped model's checks")
     a = ap.parse_args()

@@ -19,7 +19,9 @@ Diagnostics of a settled run: :func:`line_amplitude`, the amplitude at exactly o
 which tells a mesh harmonic from the sidebands h f_mesh +- p f_rot that a rotating asymmetric member (flexible
 gears' meshes, the ring's bolt pattern) adds and that the analysed window's resolution 1 / WINDOW_S merges with
 it; :func:`periodic_peak_factor`, K_v of the window's mesh-periodic part alone (what the frequency domain
-computes).
+computes); :func:`sideband_rss`, the amplitude of a mesh harmonic with its sidebands, the root-sum-square of the
+lines at h f_mesh + p B f_ring, p = -P..P, which the frequency domain over the turning angle gives as the RMS over
+the angles (flexgear.harmonic.turning, eq. 1).
 
 Comparison (:func:`compare_lumped`): frequency domain over time domain minus 1 for each amplitude, and
 (K_v,f - 1) / (K_v,t - 1) - 1. An amplitude the planets' phasing cancels (below :data:`CANCELLED` of its family's
@@ -41,7 +43,7 @@ from flexgear.study.compare import harmonic_amplitudes
 from flexgear.study.indicators import _kv
 
 __all__ = ["CheckSpeeds", "LumpedCheck", "check_speeds", "settled_lumped_run", "window_amplitudes",
-           "compare_lumped", "line_amplitude", "periodic_peak_factor",
+           "compare_lumped", "line_amplitude", "sideband_rss", "periodic_peak_factor",
            "STRONG", "BESIDE", "WINDOW_S", "RAMP_S", "CANCELLED", "COLUMNS", "SWEEP_RPM"]
 
 STRONG = 0.5
@@ -201,6 +203,17 @@ def line_amplitude(signal: np.ndarray, dt: float, frequency_hz: float) -> float:
     w = np.hanning(x.size)
     t = np.arange(x.size) * dt
     return float(2.0 * abs(np.exp(-2j * math.pi * frequency_hz * t) @ (w * x)) / w.sum())
+
+
+def sideband_rss(signal: np.ndarray, dt: float, frequency_hz: float, spacing_hz: float, order: int) -> float:
+    """sqrt(sum_{p=-P..P} A(f + p f_s)^2), A = :func:`line_amplitude` of ``signal`` sampled at ``dt`` [s], f =
+    ``frequency_hz`` [Hz], f_s = ``spacing_hz`` [Hz] (a turning pattern's passing frequency B f_ring), P =
+    ``order``; P = 0 is the line at exactly f. Lines at 0 Hz or below are left out. The lines need to lie some
+    resolutions 1 / (n dt) apart (line_amplitude's leakage)."""
+    if order < 0:
+        raise ValueError(f"order: expected >= 0, got {order}")
+    lines = [frequency_hz + p * spacing_hz for p in range(-order, order + 1)]
+    return float(math.sqrt(sum(line_amplitude(signal, dt, f) ** 2 for f in lines if f > 0.0)))
 
 
 def periodic_peak_factor(forces: np.ndarray, dt: float, mesh_frequency_hz: float, harmonics: int) -> float:
