@@ -1,4 +1,4 @@
-"""Flexible bodies under the gear loads (issue: flexible physics), law = "iso6336", converged coarse bodies.
+"""Flexible bodies under the gear loads, law = "iso6336", converged coarse bodies.
 
 - model 4 (flexible sun and ring) changes the inner mesh-force ripple against model 1 by more than 10 % and by
   more than ten times what halving the step changes (measured on model 1 here: model 4 at h/2 costs minutes;

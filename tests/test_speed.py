@@ -56,8 +56,7 @@ def short_model7():
     """Model 6 (every gear flexible: sun, planets, ring; stand-in annulus bodies) on a shortened load case.
 
     Every flexible gear pair's contact columns are updated per step, as in model 7; the shafts stay rigid
-    because the stand-in annuli have no bearing-seat interface (the supports act at the seats since the
-    flexible-physics issue).
+    because the stand-in annuli have no bearing-seat interface (the supports act at the seats).
     """
     v = load_variant(VARIANTS / "model6.toml")
     g = v.gearbox
