@@ -14,17 +14,24 @@ other coordinate) with constraint Jacobian C then read, per body b,
 with K_yy = K_e + A^T K_aa A, K_yr = A^T K_ar, C_y = C_a A. Where A has full row rank the attachment-space
 couplings are recovered exactly, K_ar = (A A^T)^-1 A K_yr (likewise K_aa, C_a); :func:`recover` checks that
 every coupling lies in A's row space. Eliminating y, a = -H(s) g with the body's dynamic flexibility at its
-attachments; the assembled problem over x = [r; lambda; a; g] is the nonlinear eigenproblem T(s) x = 0,
+attachments; the assembled problem over x = [r; lambda; a; g] is the eigenproblem T(s) x = 0,
 
     T(s) = [[K_rr - s M_rr, C_r^T, K_ra, 0], [C_r, 0, C_a, 0], [K_ar, C_a^T, K_aa, -I], [0, 0, -I, -H(s)]].
 
-With the reduced body, H(s) = A (K_e - s M_e)^-1 A^T, T(s) x = 0 has exactly the linear model's eigenvalues
-(the check of the recovery). With the full FE model (K, M of flexgear.fe.fem, the tied ring and output shaft's of
-flexgear.fe.ring_shaft), H(s) = W^T F(s) W, F(s) = sum_j phi_j phi_j^T / (lambda_j - s) over its flexible free-free
-modes (the frame carries the rigid motion; mean axes R^T M u = 0 as the reduced modes): the modes with
-lambda_j < lambda_c are computed (sparse shift-invert, flexgear.fe.cms.full_free_modes), the rest exactly as the
-Neumann series sum_k s^k W^T (S M)^k X_0, X_0 = S W - sum_{j<c} phi_j phi_j^T W / lambda_j, with S the free
-body's flexible static flexibility (one sparse Cholesky factorisation); it converges as (s / lambda_c)^k.
+Each body's H(s) is written as w diag(1 / (lambda_j - s)) w^T + sum_k s^k R_k: modes with coordinates eta_j
+(-kappa w_j^T g + (lambda_j - s) eta_j = 0, g scaled by kappa) and a power series. Up to the series' terms of
+order s^2 and higher, T(s) = T_0 - s T_1 is a linear pencil (dense, shift-inverted eigen solve); each of its
+eigenpairs (s, x) then moves to the root of its Rayleigh functional x^T T(s) x = 0 with the whole series (T is
+symmetric: the error is of second order in the series' effect on the mode shape).
+
+- Reduced body: its modes K_e v = lambda M_e v, w = A v, no series. T(s) x = 0 has exactly the linear model's
+  eigenvalues (the check of the recovery).
+- Full FE model (K, M of flexgear.fe.fem; the tied ring and output shaft's of flexgear.fe.ring_shaft):
+  H(s) = W^T F(s) W, F(s) = sum_j phi_j phi_j^T / (lambda_j - s) over its flexible free-free modes (the frame
+  carries the rigid motion; mean axes R^T M u = 0, as the reduced modes). The modes with lambda_j < lambda_c are
+  computed (sparse shift-invert, flexgear.fe.cms), the others summed exactly as the Neumann series
+  R_k = W^T (S M)^k X_0, X_0 = S W - sum_{j<c} phi_j phi_j^T W / lambda_j, with S the free body's static
+  flexibility on the mean-axis subspace (one sparse Cholesky factorisation); its terms fall as (s / lambda_c)^k.
 
 The linearisation used for the couplings keeps every mode of the gears' bases (no residual compliance,
 ``dynamic_cutoff_mesh_orders = 0``): the full FE carries that compliance itself.
@@ -40,8 +47,8 @@ import scipy.sparse as sp
 
 from flexgear.spec import Variant
 
-__all__ = ["Attachments", "LinearSystem", "linear_system", "attachments", "recover", "ReducedFlexibility",
-           "FullFlexibility", "full_flexibility", "assembled", "nonlinear_eigenvalues"]
+__all__ = ["Attachments", "LinearSystem", "Coupled", "Flexibility", "linear_system", "attachments", "recover",
+           "reduced_flexibility", "body_fe_model", "full_flexibility", "assembled", "eigenvalues"]
 
 _RANK_TOL = 1e-10  # relative singular value below which constraint rows are redundant
 
@@ -165,7 +172,7 @@ def attachments(system: LinearSystem) -> list[Attachments]:
                 blocks.append(w)
         weights = sp.hstack(blocks, format="csr")
         shapes = red.modes if body.basis is None else red.modes @ body.basis
-        motion = np.asarray((weights.T @ shapes))
+        motion = np.asarray(weights.T @ shapes)
         k_e = body.modal_matrices[1] if body.modal_matrices is not None else np.diag(red.stiffness)
         out.append(Attachments(comp, index, weights, motion, np.asarray(k_e, float),
                                system.mass[np.ix_(index, index)]))
@@ -319,33 +326,36 @@ def assembled(coupled: Coupled, flexibilities: list[Flexibility], scale: float |
     return t0, t1, remainder
 
 
-def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = np.inf,
-                newton: int = 4) -> np.ndarray:
+def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = np.inf, newton: int = 4,
+                refine: int = 1) -> np.ndarray:
     """Roots s <= ``s_max`` of T(s) = T_0 - s T_1 + remainder(s) (ascending, s = omega^2 [1/s^2]): the linear
     pencil's real positive eigenvalues, each then moved to the root of its Rayleigh functional x^T T(s) x = 0 (T
-    symmetric: the error is of second order in the remainder's effect on the eigenvector)."""
+    symmetric: the error is of second order in the remainder's effect on the eigenvector), ``refine`` times more
+    after an inverse-iteration step x <- T(s)^-1 T'(s) x."""
     from scipy.linalg import eig
 
     sigma = 0.0 if not np.isfinite(s_max) else 0.5 * s_max
     # shift-inverted pencil: (T_0 - sigma T_1)^-1 T_1 x = mu x, s = sigma + 1 / mu
-    op = np.linalg.solve(t0 - sigma * t1, t1)
-    mu, x = eig(op)
+    mu, x = eig(np.linalg.solve(t0 - sigma * t1, t1))
     ok = np.abs(mu) > 1e-14 * np.abs(mu).max()
-    s = sigma + 1.0 / mu[ok]
-    x = x[:, ok]
+    s, x = sigma + 1.0 / mu[ok], x[:, ok]
     real = (np.abs(s.imag) <= 1e-8 * np.abs(s)) & (s.real > 0) & (s.real <= 1.05 * s_max)
     s, x = s[real].real, x[:, real].real
     order = np.argsort(s)
     s, x = s[order], x[:, order]
-    if remainder is not None:
-        for i in range(len(s)):
-            v = x[:, i]
+    if remainder is None:
+        return s[s <= s_max]
+    for i in range(len(s)):
+        v = x[:, i]
+        for step in range(refine + 1):
             for _ in range(newton):
                 h, dh = remainder(s[i])
-                f = v @ (t0 - s[i] * t1 + h) @ v
-                df = v @ (-t1 + dh) @ v
-                s[i] -= f / df
-    return s[s <= s_max]
+                s[i] -= (v @ (t0 - s[i] * t1 + h) @ v) / (v @ (dh - t1) @ v)
+            if step < refine:
+                h, dh = remainder(s[i])
+                v = np.linalg.solve(t0 - s[i] * t1 + h, (dh - t1) @ v)
+                v /= np.linalg.norm(v)
+    return np.sort(s[s <= s_max])
 
 
 def body_fe_model(spec, name: str, reduced, level: str):
@@ -366,7 +376,7 @@ def body_fe_model(spec, name: str, reduced, level: str):
 
 
 def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.ndarray, cut: float = 6.25,
-                     tol: float = 1e-12, max_terms: int = 60) -> Flexibility:
+                     tol: float = 1e-10, max_terms: int = 60) -> Flexibility:
     """The full FE model's H(s) at the attachments ``weights`` W (3n, n_a) for s <= ``s_max`` (module docstring):
     its flexible free-free modes with lambda_j < ``cut`` s_max as coordinates (sparse shift-invert,
     flexgear.fe.cms), the others as the series R_k = W^T X_k, X_k = S M X_{k-1}, until s_max^k |R_k| <= ``tol``
