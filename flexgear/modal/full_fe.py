@@ -327,11 +327,11 @@ def assembled(coupled: Coupled, flexibilities: list[Flexibility], scale: float |
 
 
 def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = np.inf, newton: int = 4,
-                refine: int = 1) -> np.ndarray:
+                refine: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Roots s <= ``s_max`` of T(s) = T_0 - s T_1 + remainder(s) (ascending, s = omega^2 [1/s^2]): the linear
     pencil's real positive eigenvalues, each then moved to the root of its Rayleigh functional x^T T(s) x = 0 (T
     symmetric: the error is of second order in the remainder's effect on the eigenvector), ``refine`` times more
-    after an inverse-iteration step x <- T(s)^-1 T'(s) x."""
+    after an inverse-iteration step x <- T(s)^-1 T'(s) x. Returns (s, x (n, modes) unit vectors)."""
     from scipy.linalg import eig
 
     sigma = 0.0 if not np.isfinite(s_max) else 0.5 * s_max
@@ -344,7 +344,7 @@ def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = n
     order = np.argsort(s)
     s, x = s[order], x[:, order]
     if remainder is None:
-        return s[s <= s_max]
+        return s[s <= s_max], x[:, s <= s_max]
     for i in range(len(s)):
         v = x[:, i]
         for step in range(refine + 1):
@@ -355,7 +355,10 @@ def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = n
                 h, dh = remainder(s[i])
                 v = np.linalg.solve(t0 - s[i] * t1 + h, (dh - t1) @ v)
                 v /= np.linalg.norm(v)
-    return np.sort(s[s <= s_max])
+        x[:, i] = v
+    order = np.argsort(s)
+    s, x = s[order], x[:, order]
+    return s[s <= s_max], x[:, s <= s_max]
 
 
 def body_fe_model(spec, name: str, reduced, level: str):
@@ -375,13 +378,13 @@ def body_fe_model(spec, name: str, reduced, level: str):
     return fe
 
 
-def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.ndarray, cut: float = 6.25,
-                     tol: float = 1e-10, max_terms: int = 60) -> Flexibility:
+def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.ndarray, cut: float = 2.25,
+                     tol: float = 1e-10, max_terms: int = 80) -> Flexibility:
     """The full FE model's H(s) at the attachments ``weights`` W (3n, n_a) for s <= ``s_max`` (module docstring):
-    its flexible free-free modes with lambda_j < ``cut`` s_max as coordinates (sparse shift-invert,
-    flexgear.fe.cms), the others as the series R_k = W^T X_k, X_k = S M X_{k-1}, until s_max^k |R_k| <= ``tol``
-    |R_0|. ``frequencies_hz``: the reduced body's free-free frequencies (upper bounds of the full model's), to
-    size the eigen solve."""
+    its lowest flexible free-free modes as coordinates (sparse shift-invert, flexgear.fe.cms), as many as reach
+    lambda >= ``cut`` s_max, the others as the series R_k = W^T X_k, X_k = S M X_{k-1}, until s_max^k |R_k| <= ``tol``
+    |R_0| (its ratio s_max / lambda_c <= 1 / ``cut``). ``frequencies_hz``: the reduced body's free-free
+    frequencies (each above the full model's of the same order), to size the eigen solve."""
     from threadpoolctl import threadpool_limits
 
     from flexgear.fe.cms import _FreeBodySolver
@@ -395,9 +398,7 @@ def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.
             lam, phi = cons.eigen(fe, k, m)
             if lam[-1] >= cut * s_max or k >= fe.n_dof // 4:
                 break
-            k *= 2
-        keep = lam < cut * s_max
-        lam, phi = lam[keep], phi[:, keep]
+            k += max(4, k // 2)
         phi = phi / np.sqrt(np.einsum("ij,ij->j", phi, m @ phi))  # mass-normalised
         w = np.asarray(weights.todense())
         part = phi.T @ w  # (p, n_a)

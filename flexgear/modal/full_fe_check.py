@@ -41,7 +41,10 @@ __all__ = ["FullFEComparison", "compare_full_fe", "default_f_max_hz"]
 class FullFEComparison:
     """Frequencies [Hz] (module docstring), each (n,) ascending; ``recovery`` and ``leak`` (relative) the checks of
     the couplings' recovery; ``deflection_change``: the largest relative difference of the contacts' static
-    deflections between the model and the all-modes linearisation; ``seconds``: wall time per step."""
+    deflections between the model and the all-modes linearisation; ``seconds``: wall time per step; ``bodies``:
+    {body: (attachment motions, its full FE free-free modes below f_max, the reduced body's, series terms)};
+    ``mac``: the modal assurance criterion of each pair on the common coordinates; ``unpaired``: the full
+    assembly's frequencies below f_max [Hz] without a reduced partner (modes the reduced bases leave out)."""
 
     variant: str
     f_max_hz: float
@@ -52,6 +55,9 @@ class FullFEComparison:
     leak: float
     deflection_change: float
     seconds: dict[str, float]
+    bodies: dict[str, tuple[int, int, int, int]] = dataclasses.field(default_factory=dict)
+    mac: np.ndarray | None = None
+    unpaired: np.ndarray | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -66,13 +72,20 @@ class FullFEComparison:
     def table(self) -> str:
         lines = [f"{self.variant}: {len(self.full)} modes below {self.f_max_hz:.0f} Hz, zero speed",
                  f"{'mode':>4} {'model [Hz]':>12} {'all modes [Hz]':>15} {'full FE [Hz]':>13} {'model err %':>12} "
-                 f"{'all-modes err %':>16}"]
+                 f"{'all-modes err %':>16} {'MAC':>6}"]
+        mac = np.full(len(self.full), np.nan) if self.mac is None else self.mac
         for i, (a, b, c) in enumerate(zip(self.model, self.all_modes, self.full, strict=True)):
             lines.append(f"{i + 1:4d} {a:12.3f} {b:15.3f} {c:13.3f} {100 * (a / c - 1):12.4f} "
-                         f"{100 * (b / c - 1):16.4f}")
+                         f"{100 * (b / c - 1):16.4f} {mac[i]:6.3f}")
         lines.append(f"max |model err| {100 * np.abs(self.error).max():.4f} %, max |all-modes err| "
                      f"{100 * np.abs(self.basis_error).max():.4f} %, recovery {self.recovery:.1e}, "
                      f"leak {self.leak:.1e}, static deflection change {self.deflection_change:.1e}")
+        if self.unpaired is not None and len(self.unpaired):
+            lines.append(f"{len(self.unpaired)} full-FE assembly modes below f_max without a reduced partner [Hz]: "
+                         + " ".join(f"{f:.0f}" for f in self.unpaired))
+        for name, (n_a, n_full, n_red, n_terms) in self.bodies.items():
+            lines.append(f"  {name}: {n_a} attachment motions; free-free modes below f_max: full FE {n_full}, "
+                         f"reduced {n_red}; {n_terms} series terms")
         return "\n".join(lines)
 
 
@@ -90,14 +103,31 @@ def _frequencies(model, s_max: float) -> np.ndarray:
     return w2[(w2 > 0.0) & (w2 <= s_max)]
 
 
-def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=None) -> FullFEComparison:
+def _pairs(x_red: np.ndarray, x_full: np.ndarray, common: slice) -> tuple[np.ndarray, np.ndarray]:
+    """For each reduced mode, the full mode of the most similar shape on the ``common`` coordinates (r and the
+    attachment motions a, the same in both problems): (indices, MAC), one full mode per reduced mode at most."""
+    from scipy.optimize import linear_sum_assignment
+
+    a = x_red[common] / np.linalg.norm(x_red[common], axis=0)
+    b = x_full[common] / np.linalg.norm(x_full[common], axis=0)
+    mac = (a.T @ b) ** 2
+    rows, cols = linear_sum_assignment(-mac)
+    out = np.full(a.shape[1], -1)
+    out[rows] = cols
+    return out, mac[np.arange(a.shape[1]), out]
+
+
+def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=None,
+                    cache: dict | None = None) -> FullFEComparison:
     """:class:`FullFEComparison` of ``variant`` at zero speed below ``f_max_hz`` (default
-    :func:`default_f_max_hz`). ``progress``: a callable taking a message, or None."""
+    :func:`default_f_max_hz`). ``progress``: a callable taking a message, or None; ``cache``: a dict that keeps
+    the full FE flexibilities between calls (they depend on the mesh, the attachments and ``f_max_hz`` only)."""
     from flexgear.modal.linear import linearize
 
     say = progress or (lambda msg: None)
     f_max = default_f_max_hz(variant) if f_max_hz is None else float(f_max_hz)
     s_max = (2 * np.pi * f_max) ** 2
+    s_top = 1.5 * s_max  # the full set reaches above the reduced one's top: its partners may lie higher
     seconds = {}
     t = time.perf_counter()
     model = linearize(variant, 0.0)
@@ -112,37 +142,45 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     system = linear_system(variant, 0.0)
     bodies = attachments(system)
     coupled = recover(system, bodies)
-    s_all = _frequencies(all_model, 1.05 * s_max)
-    s_rec = eigenvalues(*assembled(coupled, [reduced_flexibility(b) for b in bodies])[:2], s_max=1.05 * s_max)
-    n = min(len(s_all), len(s_rec))
-    recovery = float(np.abs(np.sqrt(s_rec[:n] / s_all[:n]) - 1.0).max()) if len(s_rec) == len(s_all) else np.inf
+    s_all = _frequencies(all_model, s_max)
+    s_rec, x_rec = eigenvalues(*assembled(coupled, [reduced_flexibility(b) for b in bodies])[:2], s_max=s_max)
+    recovery = float(np.abs(np.sqrt(s_rec / s_all) - 1.0).max()) if len(s_rec) == len(s_all) else np.inf
     seconds["recover"] = time.perf_counter() - t
     t = time.perf_counter()
-    flex, cache, fe_cache = [], {}, {}
+    cache = {} if cache is None else cache
+    flex, fe_cache, done = [], {}, {}
     for b in bodies:
         name = next(nm for nm, body in system.bodies.items() if body.flexible and _component(nm) == b.component)
         body = system.bodies[name]
         fe_key = "planet" if name.startswith("planet") else name
-        key = (fe_key, b.weights.indices.tobytes(), np.round(b.weights.data, 12).tobytes())
+        key = (variant.mesh_level, fe_key, b.weights.indices.tobytes(), np.round(b.weights.data, 12).tobytes(),
+               s_top)
         if key not in cache:
             if fe_key not in fe_cache:
                 say(f"  {name}: full FE model")
                 fe_cache = {fe_key: body_fe_model(system.spec, name, body.reduced, variant.mesh_level)}
             say(f"  {name}: full FE flexibility at {b.weights.shape[1]} attachment motions")
-            cache[key] = full_flexibility(fe_cache[fe_key], b.weights, 1.05 * s_max, body.reduced.frequencies_hz)
-        flex.append(cache[key])
+            cache[key] = full_flexibility(fe_cache[fe_key], b.weights, s_top, body.reduced.frequencies_hz)
+        f = cache[key]
+        done[name] = (b.weights.shape[1], int(np.count_nonzero(f.eigenvalues <= s_max)),
+                      int(np.count_nonzero((2 * np.pi * body.reduced.frequencies_hz) ** 2 <= s_max)), len(f.moments))
+        flex.append(f)
     seconds["full FE bodies"] = time.perf_counter() - t
     t = time.perf_counter()
     t0, t1, rest = assembled(coupled, flex)
-    s_full = eigenvalues(t0, t1, rest, s_max=1.05 * s_max)
+    s_full, x_full = eigenvalues(t0, t1, rest, s_max=s_top)
     seconds["assembled eigenvalues"] = time.perf_counter() - t
     s_model = _frequencies(model, s_max)
-    n = len(s_model)
-    if len(s_full) < n or len(s_all) < n:
-        raise RuntimeError(f"{variant.name}: {len(s_model)} model modes below {f_max:.0f} Hz but "
-                           f"{len(s_full)} full FE and {len(s_all)} all-modes modes up to 5 % above")
-    hz = [np.sqrt(s[:n]) / (2 * np.pi) for s in (s_model, s_all, s_full)]
-    return FullFEComparison(variant.name, f_max, *hz, recovery, coupled.leak, change, seconds)
+    if len(s_model) != len(s_all):
+        raise RuntimeError(f"{variant.name}: {len(s_model)} model modes below {f_max:.0f} Hz, {len(s_all)} with "
+                           "every basis mode")
+    n_common = len(coupled.rest) + coupled.c_r.shape[0] + coupled.n_attachments
+    common_rows = np.r_[0:len(coupled.rest), len(coupled.rest) + coupled.c_r.shape[0]:n_common]
+    pair, mac = _pairs(x_rec, x_full, common_rows)
+    unpaired = np.setdiff1d(np.flatnonzero(s_full <= s_max), pair)
+    hz = [np.sqrt(s) / (2 * np.pi) for s in (s_model, s_all, s_full[pair])]
+    return FullFEComparison(variant.name, f_max, *hz, recovery, coupled.leak, change, seconds, done, mac,
+                            np.sqrt(s_full[unpaired]) / (2 * np.pi))
 
 
 def _component(body: str) -> str:
