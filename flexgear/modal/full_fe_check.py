@@ -44,7 +44,10 @@ class FullFEComparison:
     deflections between the model and the all-modes linearisation; ``seconds``: wall time per step; ``bodies``:
     {body: (attachment motions, its full FE free-free modes below f_max, the reduced body's, series terms)};
     ``mac``: the modal assurance criterion of each pair on the common coordinates; ``unpaired``: the full
-    assembly's frequencies below f_max [Hz] without a reduced partner (modes the reduced bases leave out)."""
+    assembly's frequencies below f_max [Hz] without a reduced partner (modes the reduced bases leave out), and
+    ``unpaired_bodies`` the body whose full FE modes carry each; ``model_frequencies`` [Hz] the model's own
+    below f_max (``model`` holds them in order where the model has as many modes as the all-modes one, else NaN).
+    """
 
     variant: str
     f_max_hz: float
@@ -58,6 +61,8 @@ class FullFEComparison:
     bodies: dict[str, tuple[int, int, int, int]] = dataclasses.field(default_factory=dict)
     mac: np.ndarray | None = None
     unpaired: np.ndarray | None = None
+    unpaired_bodies: list[str] = dataclasses.field(default_factory=list)
+    model_frequencies: np.ndarray | None = None
 
     @property
     def error(self) -> np.ndarray:
@@ -80,9 +85,13 @@ class FullFEComparison:
         lines.append(f"max |model err| {100 * np.abs(self.error).max():.4f} %, max |all-modes err| "
                      f"{100 * np.abs(self.basis_error).max():.4f} %, recovery {self.recovery:.1e}, "
                      f"leak {self.leak:.1e}, static deflection change {self.deflection_change:.1e}")
+        if self.model_frequencies is not None and np.isnan(self.model).any():
+            lines.append(f"the model has {len(self.model_frequencies)} modes below f_max, the all-modes one "
+                         f"{len(self.all_modes)} [Hz]: " + " ".join(f"{f:.1f}" for f in self.model_frequencies))
         if self.unpaired is not None and len(self.unpaired):
-            lines.append(f"{len(self.unpaired)} full-FE assembly modes below f_max without a reduced partner [Hz]: "
-                         + " ".join(f"{f:.0f}" for f in self.unpaired))
+            lines.append(f"{len(self.unpaired)} full-FE assembly modes below f_max without a reduced partner [Hz, "
+                         "body]: " + ", ".join(f"{f:.0f} {b}" for f, b in zip(self.unpaired, self.unpaired_bodies,
+                                                                               strict=False)))
         for name, (n_a, n_full, n_red, n_terms) in self.bodies.items():
             lines.append(f"  {name}: {n_a} attachment motions; free-free modes below f_max: full FE {n_full}, "
                          f"reduced {n_red}; {n_terms} series terms")
@@ -108,8 +117,8 @@ def _pairs(x_red: np.ndarray, x_full: np.ndarray, common: slice) -> tuple[np.nda
     attachment motions a, the same in both problems): (indices, MAC), one full mode per reduced mode at most."""
     from scipy.optimize import linear_sum_assignment
 
-    a = x_red[common] / np.linalg.norm(x_red[common], axis=0)
-    b = x_full[common] / np.linalg.norm(x_full[common], axis=0)
+    a = x_red[common] / np.maximum(np.linalg.norm(x_red[common], axis=0), 1e-300)
+    b = x_full[common] / np.maximum(np.linalg.norm(x_full[common], axis=0), 1e-300)
     mac = (a.T @ b) ** 2
     rows, cols = linear_sum_assignment(-mac)
     out = np.full(a.shape[1], -1)
@@ -127,7 +136,7 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     say = progress or (lambda msg: None)
     f_max = default_f_max_hz(variant) if f_max_hz is None else float(f_max_hz)
     s_max = (2 * np.pi * f_max) ** 2
-    s_top = 1.5 * s_max  # the full set reaches above the reduced one's top: its partners may lie higher
+    s_top = 1.05 * s_max  # the full set reaches above the reduced one's top: its partners may lie higher
     seconds = {}
     t = time.perf_counter()
     model = linearize(variant, 0.0)
@@ -171,16 +180,29 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     s_full, x_full = eigenvalues(t0, t1, rest, s_max=s_top)
     seconds["assembled eigenvalues"] = time.perf_counter() - t
     s_model = _frequencies(model, s_max)
-    if len(s_model) != len(s_all):
-        raise RuntimeError(f"{variant.name}: {len(s_model)} model modes below {f_max:.0f} Hz, {len(s_all)} with "
-                           "every basis mode")
+    model_hz = np.sqrt(s_model) / (2 * np.pi)
+    if len(s_model) != len(s_all):  # the model's own frequencies are listed apart: no pairing by order
+        s_model = np.full(len(s_all), np.nan)
     n_common = len(coupled.rest) + coupled.c_r.shape[0] + coupled.n_attachments
     common_rows = np.r_[0:len(coupled.rest), len(coupled.rest) + coupled.c_r.shape[0]:n_common]
     pair, mac = _pairs(x_rec, x_full, common_rows)
     unpaired = np.setdiff1d(np.flatnonzero(s_full <= s_max), pair)
     hz = [np.sqrt(s) / (2 * np.pi) for s in (s_model, s_all, s_full[pair])]
+    owners = _owners(coupled, flex, [b.component for b in bodies], x_full[:, unpaired])
     return FullFEComparison(variant.name, f_max, *hz, recovery, coupled.leak, change, seconds, done, mac,
-                            np.sqrt(s_full[unpaired]) / (2 * np.pi))
+                            np.sqrt(s_full[unpaired]) / (2 * np.pi), owners, model_hz)
+
+
+def _owners(coupled, flex: list, names: list[str], x: np.ndarray) -> list[str]:
+    """For each mode x of the full assembly, the body whose full FE modes eta carry most of it."""
+    start = len(coupled.rest) + coupled.c_r.shape[0] + 2 * coupled.n_attachments
+    share = []
+    for f in flex:
+        n = f.participation.shape[1]
+        share.append(np.linalg.norm(x[start:start + n], axis=0))
+        start += n
+    share = np.array(share).reshape(len(flex), -1)
+    return [names[i] for i in np.argmax(share, axis=0)] if share.size else []
 
 
 def _component(body: str) -> str:
