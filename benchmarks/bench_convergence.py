@@ -4,6 +4,7 @@ FE: benchmarks/bench_tied.py.)
 
 Run: python benchmarks/bench_convergence.py [--level coarse] [--orders 0 2 4 8] [--modes 0 10 20 40]
                                             [--kernel-orders 4 8 16 32] [component ...]
+     python benchmarks/bench_convergence.py --assembly [model7] [--f-max HZ]
 
 Per component (sun, planet, ring; shafts: frequencies only), all on the same FE model, interface held
 as the gear's joint (RBE3, flexgear.fe.compliance):
@@ -19,6 +20,10 @@ as the gear's joint (RBE3, flexgear.fe.compliance):
   order K (the part above the kernel, local: tooth bending, foundation), for each K, against the tooth
   compliance of the ISO 6336 mesh stiffness 1 / (c_gamma b_half) ([lumped_assumed] of gearbox.toml)
   and the study's impact law linearised at the theoretical mean mesh force per half.
+
+``--assembly VARIANT``: the variant's linearised modes at zero speed below 3x the mesh frequency (``--f-max``)
+against the same assembly with every flexible body as its full FE model (flexgear.modal.full_fe_check): the
+table of the model's (residual compliance), the all-modes basis' and the full FE frequencies.
 """
 
 from __future__ import annotations
@@ -128,6 +133,20 @@ def study(spec, component: str, level: str, orders: list[int], modes: list[int],
     print(f"[{component} done in {time.perf_counter() - t0:.0f} s]", flush=True)
 
 
+def assembly(name: str, f_max_hz: float | None) -> None:
+    """Print the full-FE assembly check of variant ``name`` (module docstring)."""
+    from pathlib import Path
+
+    from flexgear.modal.full_fe_check import compare_full_fe
+    from flexgear.spec import load_variant
+
+    t0 = time.perf_counter()
+    variant = load_variant(Path(__file__).resolve().parents[1] / "model_variants" / f"{name}.toml")
+    result = compare_full_fe(variant, f_max_hz, progress=lambda msg: print(msg, flush=True))
+    print(result.table())
+    print("  ".join(f"{k} {v:.0f} s" for k, v in result.seconds.items()) + f"  [{time.perf_counter() - t0:.0f} s]")
+
+
 def main() -> None:
     from pathlib import Path
 
@@ -140,7 +159,13 @@ def main() -> None:
     ap.add_argument("--modes", type=int, nargs="+", default=[0, 10, 20, 40])
     ap.add_argument("--kernel-orders", type=int, nargs="*", default=[4, 8, 16, 32])
     ap.add_argument("--gearbox", default=str(Path(__file__).resolve().parents[1] / "model_variants/gearbox.toml"))
+    ap.add_argument("--assembly", nargs="?", const="model7", default=None, metavar="VARIANT",
+                    help="compare the variant's linearised modes with the full-FE assembly (default model7)")
+    ap.add_argument("--f-max", type=float, default=None, help="highest frequency [Hz] (default 3x mesh frequency)")
     args = ap.parse_args()
+    if args.assembly:
+        assembly(args.assembly, args.f_max)
+        return
     spec = load_gearbox(args.gearbox)
     for component in args.components:
         study(spec, component, args.level, sorted(args.orders), sorted(args.modes), args.kernel_orders)
