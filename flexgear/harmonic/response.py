@@ -99,12 +99,9 @@ def linearize_same_angle(variant: Any, speed_rpm: float, reference_rpm: float) -
 
     if not (speed_rpm > 0.0 and reference_rpm > 0.0):
         raise ValueError(f"speeds must be > 0 rpm, got {speed_rpm}, {reference_rpm}")
-    spec = variant.gearbox
     ratio = reference_rpm / speed_rpm
-    orders = spec.reduction_assumed.dynamic_cutoff_mesh_orders
-    spec = spec.with_fields("reduction_assumed", dynamic_cutoff_mesh_orders=orders * ratio)
-    t_star = 0.5 * spec.load_case.ramp_time_s * (1.0 + ratio)
-    return linearize(dataclasses.replace(variant, gearbox=spec), speed_rpm=float(speed_rpm), t_star=t_star)
+    t_star = 0.5 * variant.gearbox.load_case.ramp_time_s * (1.0 + ratio)
+    return linearize(variant, speed_rpm=float(speed_rpm), t_star=t_star, cutoff_rpm=float(reference_rpm))
 
 
 def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> tuple[np.ndarray, list[Any]]:

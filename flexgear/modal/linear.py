@@ -137,13 +137,23 @@ def _component_name(body: str) -> str:
     return f"planet_{body[len('planet'):]}" if body.startswith("planet") else body
 
 
-def _with_speed(variant: Variant, speed_rpm: float | None) -> tuple[Variant, float]:
-    """The variant with mean mesh stiffness and, if given, the input speed ``speed_rpm``."""
+def _with_speed(variant: Variant, speed_rpm: float | None,
+                cutoff_rpm: float | None = None) -> tuple[Variant, float]:
+    """The variant with mean mesh stiffness and, if given, the input speed ``speed_rpm``; the gears' dynamic cut-off
+    (``[reduction_assumed] dynamic_cutoff_mesh_orders`` x f_mesh, flexgear.mbs.gearbox) held at the mesh frequency
+    of ``cutoff_rpm`` [rpm] (default: the load case's speed), so that the modes a gear keeps do not change with the
+    speed analysed (at rest the cut-off would otherwise fall to zero)."""
     spec = variant.gearbox
     lc = spec.load_case
     speed = lc.input_speed_rpm if speed_rpm is None else float(speed_rpm)
     built = ZERO_SPEED_RPM if speed == 0.0 else speed
+    reference = lc.input_speed_rpm if cutoff_rpm is None else float(cutoff_rpm)
+    if not reference > 0.0:
+        raise ValueError(f"cutoff_rpm must be > 0 rpm, got {cutoff_rpm!r}")
     spec = spec.with_fields("contact_assumed", stiffness_variation="constant")
+    orders = spec.reduction_assumed.dynamic_cutoff_mesh_orders
+    if orders > 0.0 and built != reference:  # f_mesh is proportional to the input speed
+        spec = spec.with_fields("reduction_assumed", dynamic_cutoff_mesh_orders=orders * reference / built)
     spec = spec.with_fields("load_case", input_speed_rpm=built)
     return dataclasses.replace(variant, gearbox=spec), speed
 
@@ -346,12 +356,14 @@ def _settings(t_star: float):
 
 
 def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float | None = None,
-              mass_source=None, reduced_source=None) -> LinearModel:
+              cutoff_rpm: float | None = None, mass_source=None, reduced_source=None) -> LinearModel:
     """The variant linearised at its operating point (module docstring).
 
     ``speed_rpm``: input speed [rpm] (default the load case's; 0 stands for :data:`ZERO_SPEED_RPM`); the load
-    torque is the load case's. ``t_star`` [s]: the time of the operating point (default the ramp time; it sets
-    the gears' angles, on which flexible gears' contact columns depend). ``mass_source``, ``reduced_source``: as
+    torque is the load case's. ``cutoff_rpm`` [rpm]: the speed whose mesh frequency sets the gears' dynamic
+    cut-off (default the load case's: the same modes at every speed analysed). ``t_star`` [s]: the time of the
+    operating point (default the ramp time; it sets the gears' angles, on which flexible gears' contact columns
+    depend). ``mass_source``, ``reduced_source``: as
     flexgear.mbs.gearbox.build_star_gearbox.
     """
     import exudyn as exu
@@ -359,7 +371,7 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
 
     from flexgear.mbs.gearbox import build_star_gearbox
 
-    built, speed = _with_speed(variant, speed_rpm)
+    built, speed = _with_speed(variant, speed_rpm, cutoff_rpm)
     spec = built.gearbox
     t_star = spec.load_case.ramp_time_s if t_star is None else float(t_star)
     sc = exu.SystemContainer()
