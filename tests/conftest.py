@@ -13,6 +13,7 @@ cache is built by both workers at once instead of by one while the other waits.
 
 import ast
 import dataclasses
+import functools
 from pathlib import Path
 
 import pytest
@@ -174,3 +175,13 @@ def gearbox():
 def model1():
     """Table 3's model 1 with the exact geometry's mass properties: no meshes needed for rigid tests."""
     return dataclasses.replace(load_variant(VARIANTS / "model1.toml"), rigid_mass_properties="exact")
+
+
+@pytest.fixture(scope="session")
+def coarse_fe(gearbox):
+    """``coarse_fe(name)``: the FE model of component ``name`` at the coarse level as every reduced body is built on
+    it (flexgear.fe.ring_shaft.part_fe_model), built once per worker process for the test modules that compare
+    against full FE; the functions those tests call leave a model unchanged."""
+    from flexgear.fe.ring_shaft import part_fe_model
+
+    return functools.cache(lambda name: part_fe_model(gearbox, name, "coarse"))
