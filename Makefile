@@ -35,7 +35,7 @@ install: $(STAMP)
 $(STAMP): pyproject.toml
 	@if [ ! -x "$(PY)" ]; then .ci/make-venv "$(VENV)" $(PYTHON_CANDIDATES); fi
 	@echo "installing flexgear and its dependencies into $(VENV) (pip install -e .[test])"
-	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -e ".[test]"
 	@touch $(STAMP)
 
 venv: install
@@ -45,7 +45,7 @@ lint: install
 	$(PY) -c "from importlinter.cli import lint_imports; raise SystemExit(lint_imports(no_cache=True, no_logo=True))"
 
 test: lint
-	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadgroup
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadgroup --prebuild
 
 test-heavy: install
 	$(PY) -m pytest -q -m heavy

@@ -5,7 +5,9 @@ A cache entry is read through :func:`load_or_build`: an entry that cannot be rea
 killed copy, a full disk, a network disk) is rebuilt with a one-line :class:`CacheWarning` naming the file, and
 a missing or damaged entry is built under a lock file (``<path>.lock``, ``fcntl.flock``) so that processes that
 need the same entry at once (matrix workers, pytest-xdist workers) build it once: the others wait for the lock
-and then load the file the first one wrote.
+and then load the file the first one wrote. With ``$FLEXGEAR_BUILD_LOG`` set, every build appends one JSON line to
+that file: the entry, its wall and CPU time [s], the process and the running test (``$PYTEST_CURRENT_TEST``);
+a nested build (a mesh inside a reduced body) is counted in both.
 """
 
 from __future__ import annotations
@@ -13,9 +15,11 @@ from __future__ import annotations
 import contextlib
 import gzip
 import hashlib
+import json
 import os
 import tempfile
 import threading
+import time
 import warnings
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -111,7 +115,22 @@ def load_or_build(path: Path, load: Callable[[], T | None], build: Callable[[], 
             bad = exc if isinstance(exc, UnreadableEntry) else UnreadableEntry(path, f"{type(exc).__name__}: {exc}")
             warnings.warn(f"{bad}: rebuilding it", CacheWarning, stacklevel=2)
             value = None
-        return value if value is not None else build()
+        return value if value is not None else _logged(path, build)
+
+
+def _logged(path: Path, build: Callable[[], T]) -> T:
+    """``build()``, its times appended to ``$FLEXGEAR_BUILD_LOG`` when that is set (module docstring)."""
+    log = os.environ.get("FLEXGEAR_BUILD_LOG")
+    if not log:
+        return build()
+    wall, cpu = time.perf_counter(), time.process_time()
+    value = build()
+    line = {"entry": str(path), "wall_s": round(time.perf_counter() - wall, 3),
+            "cpu_s": round(time.process_time() - cpu, 3), "pid": os.getpid(),
+            "test": os.environ.get("PYTEST_CURRENT_TEST", "")}
+    with open(log, "a") as fh:  # one short line per write: lines of several processes do not interleave
+        fh.write(json.dumps(line) + "\n")
+    return value
 
 
 _HELD = threading.local()

@@ -6,11 +6,14 @@ go to one worker, so that the fixture is built once, and every other test is sha
 (:func:`pytest_xdist_make_scheduler`); the units holding ``slow`` tests are handed out first, so that the long runs
 do not start last and leave one worker running alone at the end. The mesh cache (``meshes/`` or
 ``$FLEXGEAR_CACHE_DIR``) is shared by the workers: a missing mesh or reduced body is built by the first worker that
-needs it while the other waits for it (flexgear.cache.load_or_build).
+needs it while the other waits for it (flexgear.cache.load_or_build). With ``--prebuild`` (``make test``) each
+worker first builds its share of the cache entries the suite uses (:data:`PREBUILD_CHAINS`), so that a cold
+cache is built by both workers at once instead of by one while the other waits.
 """
 
 import ast
 import dataclasses
+import functools
 from pathlib import Path
 
 import pytest
@@ -120,6 +123,49 @@ def pytest_xdist_make_scheduler(config, log):
     return ModuleFixtureScheduling(config, log)
 
 
+PREBUILD_CHAINS = (
+    ("ring", "planet", "mesh:ring", "mesh:planet"),
+    ("sun", "output_shaft", "input_shaft", "tied", "mesh:sun", "mesh:output_shaft", "mesh:input_shaft"),
+)
+"""The coarse meshes and reduced bodies of gearbox.toml that the suite uses, in chains of about equal cold cost:
+chain k is built by xdist worker k (of n: chains k, k + n, ...) before its first test. The ring's mesh is first in
+the first chain: the tied ring and output shaft of the second needs it by the time that chain gets there.
+"name": the component's reduced body, "tied": the tied ring and output shaft, "mesh:name": the component's
+mesh at the level's element order."""
+
+
+def pytest_addoption(parser):
+    parser.addoption("--prebuild", action="store_true", help="under pytest-xdist, each worker builds its share of "
+                     "the mesh cache the suite uses before its first test (tests/conftest.py PREBUILD_CHAINS)")
+
+
+def _prebuild(spec, task: str) -> None:
+    """Build (or find cached) one entry of :data:`PREBUILD_CHAINS`; a cached body is not loaded."""
+    from flexgear.fe.mesh import component_mesh
+    from flexgear.fe.reduced import component_mass_properties
+    from flexgear.fe.ring_shaft import tied_pair_mass_properties
+
+    if task == "tied":
+        tied_pair_mass_properties(spec, "coarse")
+    elif task.startswith("mesh:"):
+        component_mesh(spec, task.removeprefix("mesh:"), "coarse")
+    else:
+        component_mass_properties(spec, task, "coarse")
+
+
+@pytest.fixture(scope="session", autouse=True)
+def prebuilt_cache(request):
+    """``--prebuild`` on an xdist worker: its share of :data:`PREBUILD_CHAINS`, before its first test."""
+    worker = getattr(request.config, "workerinput", None)
+    if not request.config.getoption("prebuild") or worker is None:
+        return
+    index, count = int(worker["workerid"].removeprefix("gw")), int(worker["workercount"])
+    spec = load_gearbox(VARIANTS / "gearbox.toml")
+    for chain in PREBUILD_CHAINS[index::count]:
+        for task in chain:
+            _prebuild(spec, task)
+
+
 @pytest.fixture(scope="session")
 def gearbox():
     return load_gearbox(VARIANTS / "gearbox.toml")
@@ -129,3 +175,13 @@ def gearbox():
 def model1():
     """Table 3's model 1 with the exact geometry's mass properties: no meshes needed for rigid tests."""
     return dataclasses.replace(load_variant(VARIANTS / "model1.toml"), rigid_mass_properties="exact")
+
+
+@pytest.fixture(scope="session")
+def coarse_fe(gearbox):
+    """``coarse_fe(name)``: the FE model of component ``name`` at the coarse level as every reduced body is built on
+    it (flexgear.fe.ring_shaft.part_fe_model), built once per worker process for the test modules that compare
+    against full FE; the functions those tests call leave a model unchanged."""
+    from flexgear.fe.ring_shaft import part_fe_model
+
+    return functools.cache(lambda name: part_fe_model(gearbox, name, "coarse"))

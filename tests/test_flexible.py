@@ -6,6 +6,7 @@ a number that theory or an independent computation predicts.
 
 from __future__ import annotations
 
+import functools
 import time
 
 import numpy as np
@@ -22,8 +23,10 @@ STEEL = Material(density_kg_m3=7850.0, youngs_modulus_pa=2.1e11, poisson_ratio=0
 RING_R, RING_T, RING_B = 0.155, 0.006, 0.010  # mean radius, radial thickness, width [m] (thin: t/R = 0.04)
 
 
+@functools.cache
 def ring_mesh(maxh: float):
-    """Plain ring (annulus of RING_* dimensions) centred at the origin, axis z; top face named."""
+    """Plain ring (annulus of RING_* dimensions) centred at the origin, axis z; top face named. Meshed once per
+    process and size: fe_model raises the order on a copy, so the tests that share it leave it unchanged."""
     import ngsolve as ngs
     from netgen.occ import Axes, Cylinder, OCCGeometry, X, Z
 

@@ -57,13 +57,12 @@ def held_frequencies(body, name: str, k: int) -> np.ndarray:
 
 
 @pytest.fixture(scope="module", params=["ring", "output_shaft"])
-def part(gearbox, request):
+def part(gearbox, coarse_fe, request):
     """(name, FE model, reduced body with one rigid bolt-patch interface, the full model clamped on the discs)."""
     from flexgear.fe.reduced import component_reduced_body
-    from flexgear.fe.ring_shaft import part_fe_model
 
     name = request.param
-    fe = part_fe_model(gearbox, name, "coarse")
+    fe = coarse_fe(name)
     body = component_reduced_body(gearbox, name, "coarse")
     assert np.array_equal(body.nodes, fe.nodes)
     return name, fe, body, Clamped(fe, body.interface("bolt_patches").nodes)

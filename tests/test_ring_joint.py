@@ -13,13 +13,8 @@ def spec(gearbox):
 
 
 @pytest.fixture(scope="module")
-def fe_pair(spec):
-    from flexgear.fe.fem import fe_model
-    from flexgear.fe.mesh import component_mesh
-
-    order = spec.meshing_assumed["coarse"].element_order
-    return tuple(fe_model(component_mesh(spec, name, "coarse", order=1).ngsolve_mesh(), spec.material_assumed, order)
-                 for name in ("ring", "output_shaft"))
+def fe_pair(coarse_fe):
+    return coarse_fe("ring"), coarse_fe("output_shaft")
 
 
 def test_tie_carries_rigid_motions_and_mass_exactly(spec, fe_pair):

@@ -82,10 +82,11 @@ def test_tie_errors_name_the_problem(tubes):
 
 
 @pytest.fixture(scope="module")
-def pair(gearbox):
-    from flexgear.fe.ring_shaft import pair_fe_models
+def pair(coarse_fe):
+    """flexgear.fe.ring_shaft.pair_fe_models(gearbox, "coarse")."""
+    from flexgear.fe.ring_shaft import PAIR
 
-    return pair_fe_models(gearbox, "coarse")
+    return tuple(coarse_fe(name) for name in PAIR)
 
 
 def test_ring_and_shaft_tied_as_the_full_fe_reference_ties_them(gearbox, pair):

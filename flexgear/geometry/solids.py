@@ -274,7 +274,8 @@ def component_solid(layout: ComponentLayout, flank_points: int = FLANK_POINTS):
 
 def occ_mass_properties(shape, density: float) -> tuple[float, np.ndarray, np.ndarray]:
     """Exact (OCC) mass [kg], centre of mass [m] and inertia about it [kg m^2] of a solid."""
-    c = shape.center
-    inertia = np.array([[shape.inertia[i, j] for j in range(3)] for i in range(3)]) \
-        if not isinstance(shape.inertia, np.ndarray) else shape.inertia
-    return density * shape.mass, np.array([c.x, c.y, c.z]), density * np.asarray(inertia, float)
+    # each property is one volume integration of the whole solid: read every one once
+    c, mass, inertia = shape.center, shape.mass, shape.inertia
+    if not isinstance(inertia, np.ndarray):
+        inertia = np.array([[inertia[i, j] for j in range(3)] for i in range(3)])
+    return density * mass, np.array([c.x, c.y, c.z]), density * np.asarray(inertia, float)
