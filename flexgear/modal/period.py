@@ -31,7 +31,7 @@ from flexgear.modal.linear import LinearModel, linearize
 from flexgear.modal.modes import Modes, modes
 from flexgear.spec import Variant
 
-__all__ = ["period_modes", "period_samples", "DEFAULT_SAMPLES", "GEARS", "NO_CONTINUATION"]
+__all__ = ["period_modes", "period_samples", "is_gear", "DEFAULT_SAMPLES", "NO_CONTINUATION"]
 
 DEFAULT_SAMPLES = 12
 """Operating points J over the period: twelve angles of the slowest flexible gear (30 degrees apart)."""
@@ -40,8 +40,11 @@ NO_CONTINUATION = 1.0
 """Relative frequency change at which a mode counts as having no continuation at the next sample (its root turned
 overdamped there): :func:`_follow` prefers that to any continuation that moves it further."""
 
-GEARS = ("sun", "ring", *(f"planet_{i}" for i in range(1, 65)))
-"""Components whose contact columns turn with them when flexible."""
+
+def is_gear(component: str) -> bool:
+    """Whether ``component`` (flexgear.modal.linear's component names) is a gear: its contact columns turn with it
+    when it is flexible."""
+    return component in ("sun", "ring") or component.startswith("planet_")
 
 
 def _spin(model: LinearModel, component: str) -> float:
@@ -57,7 +60,7 @@ def period_samples(model: LinearModel, samples: int = DEFAULT_SAMPLES) -> np.nda
     """Times t*_j [s] of the operating points over one revolution of the slowest flexible gear (module docstring);
     one (the ramp time) for a model without a flexible gear or at rest."""
     ramp = model.variant.gearbox.load_case.ramp_time_s
-    spins = [_spin(model, c) for c in model.flexible if c in GEARS]
+    spins = [_spin(model, c) for c in model.flexible if is_gear(c)]
     slowest = min(spins, default=0.0)
     if samples < 1:
         raise ValueError(f"samples: at least 1, got {samples}")
