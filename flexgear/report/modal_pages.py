@@ -326,7 +326,7 @@ def _runup_page(study: ModalStudy, name: str) -> Page | None:
             right.text(0, 1.0, f"Strongest ridges ({side})" + ("" if len(tab) else ": none found"), fontsize=8,
                        weight="bold", transform=right.transAxes)
             if len(tab):
-                draw_table(right, tab.astype(object).map(lambda v: fmt(v, 4)), top=0.95, fontsize=6.3, wrap=12)
+                draw_table(right, tab.astype(object).map(lambda v: fmt(v, 4)), top=0.95, fontsize=6.3, wrap=13)
         resolved = min((float(ru.tracks["speed_rpm"].min()) for _, ru in maps if len(ru.tracks)), default=np.nan)
         text_block(fig.add_axes([0.07, 0.02, 0.9, 0.05]),
                    "Spectrogram (Hann, 10 ms) against the instantaneous input speed of the load case's STEP ramp; "
