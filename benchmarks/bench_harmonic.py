@@ -297,7 +297,7 @@ def _window_kv(run, n: float, harmonics: int, t_a: float, t_b: float, count: int
     t0 = time.perf_counter()
     static, dyn = [], []
     for ts in np.linspace(t_a, t_b, count):
-        r = harmonic_response(linearize(run, speed_rpm=n, t_star=float(ts)), [n], harmonics)
+        r = harmonic_response(linearize(run, speed_rpm=n, t_star=float(ts), cutoff_rpm=n), [n], harmonics)
         meshes = list(r.static_forces_n)
         static.append([r.static_forces_n[m] for m in meshes])
         dyn.append([r.complex(m).iloc[0].to_numpy() for m in meshes])

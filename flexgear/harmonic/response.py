@@ -106,14 +106,14 @@ def linearize_same_angle(variant: Any, speed_rpm: float, reference_rpm: float) -
 
 def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> tuple[np.ndarray, list[Any]]:
     """(speeds [rpm] of the linearisations, the flexgear.modal.linear.LinearModel at each, on the first one's
-    coordinates unless ``each``)."""
+    coordinates unless ``each``: then each with its own speed's dynamic cut-off, the time model's)."""
     from flexgear.modal.linear import linearize
 
     if linearization not in LINEARIZATIONS:
         raise ValueError(f"linearization: expected one of {', '.join(LINEARIZATIONS)}, got {linearization!r}")
     if linearization == "each":
         nodes = np.unique(speeds_rpm)
-        return nodes, [linearize(variant, speed_rpm=float(n)) for n in nodes]
+        return nodes, [linearize(variant, speed_rpm=float(n), cutoff_rpm=float(n)) for n in nodes]
     lo, hi = float(speeds_rpm.min()), float(speeds_rpm.max())
     if lo <= 0.0:
         raise ValueError(f"linearization {linearization!r}: speeds > 0 rpm expected, got {lo:g}")

@@ -237,7 +237,7 @@ def turning_response(variant: Any, speeds_rpm: Sequence[float], harmonics: int =
     ramp = variant.gearbox.load_case.ramp_time_s
     per = {}
     for n in speeds:
-        per[n] = [harmonic_response(linearize(variant, speed_rpm=n, t_star=float(ts)), [n], harmonics)
+        per[n] = [harmonic_response(linearize(variant, speed_rpm=n, t_star=float(ts), cutoff_rpm=n), [n], harmonics)
                   for ts in pattern_times_s(pattern, n, count, ramp)]
     return TurningResponse(per, pattern, variant.name)
 
