@@ -291,17 +291,14 @@ def _window_kv(run, n: float, harmonics: int, t_a: float, t_b: float, count: int
     """Eq. 2 of flexgear.harmonic.turning over ``count`` operating points t* spread over the time run's K_v window
     [t_a, t_b] [s] (every gear at its angle in the run, the run's ramps): the quasi-static peak over the gear angles
     the window passes through, all turning bodies together. Returns (K_v, wall time [s])."""
-    from flexgear.harmonic.turning import quasi_static_peak
+    from flexgear.harmonic.turning import TurningResponse
     from flexgear.modal.linear import linearize
 
     t0 = time.perf_counter()
-    static, dyn = [], []
-    for ts in np.linspace(t_a, t_b, count):
-        r = harmonic_response(linearize(run, speed_rpm=n, t_star=float(ts), cutoff_rpm=n), [n], harmonics)
-        meshes = list(r.static_forces_n)
-        static.append([r.static_forces_n[m] for m in meshes])
-        dyn.append([r.complex(m).iloc[0].to_numpy() for m in meshes])
-    return quasi_static_peak(np.array(static), np.array(dyn)), time.perf_counter() - t0
+    points = [harmonic_response(linearize(run, speed_rpm=n, t_star=float(ts), cutoff_rpm=n), [n], harmonics)
+              for ts in np.linspace(t_a, t_b, count)]
+    kv = float(TurningResponse({n: points}, None, run.name).dynamic_factor().loc[n])
+    return kv, time.perf_counter() - t0
 
 
 def lumped_checks(path: str) -> None:
