@@ -27,8 +27,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from flexgear.fe.attachment import LoadCircle, circle_band, fourier_basis, local_directions
+from flexgear.laws.compiled import bound_entry, ramp_state
 from flexgear.laws.ramps import drive_angle
 
 __all__ = ["ModalColumn", "modal_contact_coefficients", "modal_contact_fourier", "ContactKinematics", "PreStepChain"]
@@ -77,6 +79,28 @@ def modal_contact_coefficients(nodes: np.ndarray, modes: np.ndarray, point: np.n
     return fourier_basis(2 * np.pi * np.arange(n_grid) / n_grid, order) @ coef
 
 
+@njit(cache=True)
+def interpolated_entries(buffer, t, ramp_time, drive_speed, tables, dest, n_modes, signs, psi,
+                         spin):  # pragma: no cover - compiled
+    """The constraint blocks' modal entries at time ``t`` [s], written straight into their flat ``buffer``: the
+    numbers of flexgear.laws.compiled.interpolated_columns at the drive angle theta = ``drive_speed`` x integral of
+    the STEP ramp (``ramp_time`` [s]), coefficient m of column set j going to ``buffer[dest[j, m]]`` (-1: to no
+    block)."""
+    theta = drive_speed * ramp_state(t, ramp_time)[0]
+    n_grid = tables.shape[1]
+    two_pi = 2.0 * math.pi
+    for j in range(dest.shape[0]):
+        a = ((psi[j] - spin[j] * theta) % two_pi) * (n_grid / two_pi)
+        fl = math.floor(a)
+        w = a - fl
+        i0 = int(fl) % n_grid
+        i1 = (i0 + 1) % n_grid
+        for m in range(n_modes[j]):
+            k = dest[j, m]
+            if k >= 0:
+                buffer[k] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])
+
+
 class ContactKinematics:
     """Pre-step update of the modal columns of the contact constraint's ``scalingMarker1``.
 
@@ -108,11 +132,22 @@ class ContactKinematics:
         starts = np.cumsum([0] + [f.size for f in flat])
         self._views = [(obj, self._buffer[a:b].reshape(len(sub[0]), -1))
                        for (obj, _, sub), a, b in zip(blocks, starts[:-1], starts[1:], strict=True)]
+        # the pre-step writes the modal entries straight into the buffer: entry m of column set j goes to
+        # dest[j, m] (-1: a column that no block holds); the buffer's other entries keep the base values
+        where = np.full(base.size, -1, dtype=np.int64)
+        where[self._gather] = np.arange(self._gather.size)
+        entries = self.rows[:, None] * base.shape[1] + self.first[:, None] + np.arange(width)[None, :]
+        self._dest = np.where(np.arange(width)[None, :] < self.n_modes[:, None],
+                              where[np.minimum(entries, base.size - 1)], -1)
+        np.take(base.ravel(), self._gather, out=self._buffer)
+        self._args = (float(ramp_time), float(drive_speed), self.tables, self._dest, self.n_modes, self.signs,
+                      self.psi, self.spin)
+        self._kernel = None  # the kernel's compiled entry for these arguments (first call)
 
     def matrix_at(self, t: float) -> np.ndarray:
         """The constraint's scaling matrix (frame + modal columns) at time t (compiled; the returned
         array is overwritten by the next call)."""
-        from flexgear.laws.compiled import interpolated_columns, ramp_state
+        from flexgear.laws.compiled import interpolated_columns
 
         theta = self.drive_speed * ramp_state(float(t), self.ramp_time)[0]
         interpolated_columns(self.matrix, theta, self.tables, self.rows, self.first, self.n_modes, self.signs,
@@ -135,9 +170,14 @@ class ContactKinematics:
         return out
 
     def __call__(self, mbs, t: float) -> bool:
-        np.take(self.matrix_at(t).ravel(), self._gather, out=self._buffer)
+        """Pre-step: each gear pair's block at the step's time t (the entries of :meth:`matrix_at`)."""
+        kernel = self._kernel
+        if kernel is None:
+            kernel = self._kernel = bound_entry(interpolated_entries, (self._buffer, float(t), *self._args))
+        kernel(self._buffer, t, *self._args)
+        set_parameter = mbs.SetObjectParameter
         for obj, scaling in self._views:
-            mbs.SetObjectParameter(obj, "scalingMarker1", scaling)
+            set_parameter(obj, "scalingMarker1", scaling)
         return True
 
 
