@@ -45,9 +45,10 @@ basis.
 from __future__ import annotations
 
 import numpy as np
+from numba import njit
 
 from flexgear.geometry.elements import BearingElement, FixedJointElement
-from flexgear.laws.compiled import ramp_state, turn_columns
+from flexgear.laws.compiled import bound_entry, ramp_state, turn_columns
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
 _ON_AXIS_M = 1e-9
@@ -255,6 +256,15 @@ class LinearSeat:
         return [(self.obj, "scalingMarker1", *turning_form(self.rows), self.spin)]
 
 
+@njit(cache=True)
+def turned_blocks(buffer, t, ramp_time, drive_speed, const, cos_part, sin_part, spin_index, spins,
+                  target):  # pragma: no cover - compiled
+    """flexgear.laws.compiled.turn_columns at the drive angle of time ``t`` [s] (``drive_speed`` x integral of the
+    STEP ramp ``ramp_time`` [s]), in one compiled call."""
+    turn_columns(buffer, const, cos_part, sin_part, spin_index, spins, target,
+                 drive_speed * ramp_state(t, ramp_time)[0])
+
+
 class TurningBlocks:
     """Pre-step function: the constraint coefficients of the linear joints and seats that turn with the spin
     (``entries``: their :meth:`turning` lists, (constraint, parameter, C, A, B, spin per drive angle)), each matrix
@@ -278,6 +288,9 @@ class TurningBlocks:
             cols = np.arange(a, b)
             self.target[:, a:b] = rows * a + np.arange(rows)[:, None] * (b - a) + (cols - a)[None, :]
             self.items.append((e[0], e[1], self.buffer[rows * a:rows * b].reshape(rows, b - a)))
+        self._args = (self.ramp_time, self.drive_speed, self.const, self.cos_part, self.sin_part, self.spin_index,
+                      self.spins, self.target)
+        self._kernel = None  # turned_blocks' compiled entry for these arguments (first call)
 
     def turned(self, t: float) -> np.ndarray:
         """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
@@ -285,8 +298,10 @@ class TurningBlocks:
         return self.const + np.cos(phi) * self.cos_part + np.sin(phi) * self.sin_part
 
     def __call__(self, mbs, t: float) -> bool:
-        turn_columns(self.buffer, self.const, self.cos_part, self.sin_part, self.spin_index, self.spins, self.target,
-                     self.drive_speed * ramp_state(t, self.ramp_time)[0])
+        kernel = self._kernel
+        if kernel is None:
+            kernel = self._kernel = bound_entry(turned_blocks, (self.buffer, float(t), *self._args))
+        kernel(self.buffer, t, *self._args)
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:
             set_parameter(obj, param, matrix)
