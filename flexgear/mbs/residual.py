@@ -63,7 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flexgear.laws.compiled import ramp_state
+from flexgear.laws.compiled import bound_entry, ramp_state
 from flexgear.mbs.bodies import matrix_container, motion_at_point, normal_lever, resting_node, zero_user_jacobian
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
 from flexgear.mbs.deflection import centrifugal_modal_load, centrifugal_response, held_interfaces
@@ -264,9 +264,11 @@ class CentrifugalYield:
 
     def __init__(self, residual: ResidualCompliance, obj: int, ramp_time: float, drive_speed: float):
         coords = residual.coordinates
-        self.obj, self.ramp_time, self.drive_speed = obj, ramp_time, drive_speed
+        self.obj, self.ramp_time, self.drive_speed = obj, float(ramp_time), drive_speed
         self.unit = np.linalg.solve(residual.matrix[np.ix_(coords, coords)], residual.yield_per_drive_speed2[coords])
         self._steady = False
+        self._force = np.empty_like(self.unit)  # the step's load, written in place (Exudyn copies it)
+        self._ramp = None  # ramp_state's compiled entry (first call)
 
     def force(self, t: float) -> np.ndarray:
         """K y(t) [N]."""
@@ -275,6 +277,11 @@ class CentrifugalYield:
     def __call__(self, mbs, t: float) -> bool:
         if t > self.ramp_time and self._steady:  # constant after the ramp: written once
             return True
-        mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        ramp = self._ramp
+        if ramp is None:
+            ramp = self._ramp = bound_entry(ramp_state, (float(t), float(self.ramp_time)))
+        # the numbers of :meth:`force`, without temporaries
+        np.multiply((self.drive_speed * ramp(t, self.ramp_time)[1]) ** 2, self.unit, out=self._force)
+        mbs.SetObjectParameter(self.obj, "forceVector", self._force)
         self._steady = t > self.ramp_time
         return True

@@ -29,7 +29,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flexgear.laws.compiled import ramp_state
+from flexgear.laws.compiled import bound_entry, ramp_state
 from flexgear.mbs.bodies import matrix_container, zero_user_jacobian
 from flexgear.mbs.deflection import centrifugal_modal_load
 
@@ -120,6 +120,9 @@ class SpinSchedule:
         self._dense = [dense_modal_matrices(b.modal_matrices, b.spin) for b in bodies]  # each body's format
         self._next = 0.0  # time of the next matrix update
         self._steady = False
+        self._force = np.empty_like(self.cent)  # the step's load, written in place (Exudyn copies it)
+        self._ramp = None  # ramp_state's compiled entry (first call)
+        self._work = [(np.empty(b.spin.softening.shape), np.empty(b.spin.gyroscopic.shape)) for b in bodies]
 
     @property
     def finished(self) -> bool:
@@ -138,14 +141,23 @@ class SpinSchedule:
     def __call__(self, mbs, t: float) -> bool:
         if self._steady:
             return True
-        if self.bodies:
-            mbs.SetObjectParameter(self.obj, "forceVector", self.force(t))
+        if self.bodies:  # the numbers of :meth:`force`, without temporaries
+            ramp = self._ramp
+            if ramp is None:
+                ramp = self._ramp = bound_entry(ramp_state, (float(t), self.ramp_time))
+            np.multiply(ramp(t, self.ramp_time)[1] ** 2, self.cent, out=self._force)
+            mbs.SetObjectParameter(self.obj, "forceVector", self._force)
         last = t >= self.ramp_time
         if t >= self._next or last:
-            for b, (k, d), dense in zip(self.bodies, self.matrices(t), self._dense, strict=True):
-                mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", matrix_container(k, dense))
-                mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", matrix_container(d, dense))
             r = ramp_state(float(t), self.ramp_time)[1]
+            for b, (k, d), dense in zip(self.bodies, self._work, self._dense, strict=True):
+                # :func:`spin_terms` at r Omega_n into the work arrays; a dense body's arrays go to Exudyn as they are
+                # (it stores an array as a dense matrix), a sparse body's as triplets
+                w = float(r * b.nominal_spin_rad_s)
+                np.subtract(b.modal_matrices[1], np.multiply(w * w, b.spin.softening, out=k), out=k)
+                np.add(b.modal_matrices[2], np.multiply(2.0 * w, b.spin.gyroscopic, out=d), out=d)
+                mbs.SetObjectParameter(b.modal_equations, "stiffnessMatrix", k if dense else matrix_container(k))
+                mbs.SetObjectParameter(b.modal_equations, "dampingMatrix", d if dense else matrix_container(d))
             for f in self.frames:
                 mbs.SetObjectParameter(f.obj, "dampingMatrix", matrix_container(f.gyroscopic(r * f.spin_rad_s)))
             self._next = t + self.interval
