@@ -91,6 +91,55 @@ def test_spin_schedule_follows_the_ramp(gearbox):
         assert np.allclose(sched.force(t), w * w * s.centrifugal, rtol=1e-12, atol=0.0)
 
 
+def test_spin_schedule_writes_its_own_numbers():
+    """The pre-step writes, bit for bit, :meth:`SpinSchedule.force` every step and :meth:`SpinSchedule.matrices`
+    when due: a dense body's matrices as arrays (Exudyn stores them as dense matrices), a sparse body's as the
+    triplets of flexgear.mbs.bodies.matrix_container."""
+    from types import SimpleNamespace
+
+    from flexgear.mbs.bodies import matrix_container
+    from flexgear.mbs.spin import SpinMatrices, SpinSchedule
+
+    rng = np.random.default_rng(7)
+
+    def body(m: int, dense: bool, nominal: float, obj: int):
+        g = rng.normal(size=(m, m)) if dense else np.zeros((m, m))
+        s = rng.normal(size=(m, m)) if dense else np.diag(rng.uniform(1.0, 2.0, m))
+        lam = rng.uniform(1e6, 1e8, m)
+        spin = SpinMatrices(g - g.T, s + s.T, rng.normal(size=m))
+        return SimpleNamespace(reduced=SimpleNamespace(n_modes=m), spin=spin, nominal_spin_rad_s=nominal,
+                               modal_nodes=[obj], modal_equations=obj,
+                               modal_matrices=(np.eye(m), np.diag(lam), np.diag(1e-5 * lam)))
+
+    class Recorder:
+        def __init__(self):
+            self.written = {}
+
+        def AddObject(self, item):  # noqa: N802 (Exudyn's name)
+            return 99
+
+        def SetObjectParameter(self, obj, param, value):  # noqa: N802 (Exudyn's name)
+            self.written[obj, param] = value
+
+    bodies = [body(5, True, 203.3, 1), body(4, False, -71.9, 2)]
+    rec = Recorder()
+    sched = SpinSchedule(rec, bodies, 0.1, 0.015)
+    for t, due in ((0.0, True), (0.013, False), (0.019, True), (0.031, False), (0.1, True)):
+        rec.written.clear()
+        sched(rec, t)
+        assert np.array_equal(rec.written[99, "forceVector"], sched.force(t))
+        if not due:
+            assert sorted(rec.written) == [(99, "forceVector")]
+            continue
+        (k0, d0), (k1, d1) = sched.matrices(t)
+        assert np.array_equal(rec.written[1, "stiffnessMatrix"], k0)
+        assert np.array_equal(rec.written[1, "dampingMatrix"], d0)
+        for param, a in (("stiffnessMatrix", k1), ("dampingMatrix", d1)):
+            triplets = rec.written[2, param].GetPythonObject()["triplets"]
+            assert np.array_equal(triplets, matrix_container(a).GetPythonObject()["triplets"])
+    assert sched.finished
+
+
 def _short_runs(case: str, formulations: tuple[str, ...]):
     """``case`` on a short load case in each formulation, with every mode dynamic (no dropped modes: the reference's
     generic joints and marker seats have no residual seat coordinates, and this compares formulations, not the
