@@ -5,6 +5,7 @@ FE: benchmarks/bench_tied.py.)
 Run: python benchmarks/bench_convergence.py [--level coarse] [--orders 0 2 4 8] [--modes 0 10 20 40]
                                             [--kernel-orders 4 8 16 32] [component ...]
      python benchmarks/bench_convergence.py --assembly [model7] [--f-max HZ]
+     python benchmarks/bench_convergence.py --band [--cutoff-orders 3 3.5 4 5] [--band-orders 3] [body ...]
 
 Per component (sun, planet, ring; shafts: frequencies only), all on the same FE model, interface held
 as the gear's joint (RBE3, flexgear.fe.compliance):
@@ -20,6 +21,14 @@ as the gear's joint (RBE3, flexgear.fe.compliance):
   order K (the part above the kernel, local: tooth bending, foundation), for each K, against the tooth
   compliance of the ISO 6336 mesh stiffness 1 / (c_gamma b_half) ([lumped_assumed] of gearbox.toml)
   and the study's impact law linearised at the theoretical mean mesh force per half.
+
+``--band``: for each body (the components, and "tied": the ring and output shaft reduced together), the basis of
+the production reduction with every fixed-interface mode below each of ``--cutoff-orders`` x the mesh frequency
+(``[reduction_assumed] fixed_interface_cutoff_hz`` in mesh orders): its fixed-interface mode count, coordinates, and its
+free-free modes below ``--band-orders`` x the mesh frequency against the full FE model's (the largest error, the
+first more than 1 % off, full FE modes without a partner). A body with a rigid interface (the ring or the output
+shaft alone: its bolt patches joined to the rigid partner) is compared with its full FE model with those patches
+rigid.
 
 ``--assembly VARIANT``: the variant's linearised modes at zero speed below 3x the mesh frequency (``--f-max``)
 against the same assembly with every flexible body as its full FE model (flexgear.modal.full_fe_check): the
@@ -147,13 +156,107 @@ def assembly(name: str, f_max_hz: float | None) -> None:
     print("  ".join(f"{k} {v:.0f} s" for k, v in result.seconds.items()) + f"  [{time.perf_counter() - t0:.0f} s]")
 
 
+def _body_fe(spec, body: str, level: str):
+    """FE model, interfaces, load circles and rigid interfaces of ``body`` as the production reduction has them."""
+    from flexgear.fe.reduced import BOLT_PATCHES, component_interfaces, component_load_circles
+    from flexgear.fe.ring_shaft import pair_fe_models, part_fe_model, tied_pair, tied_pair_interfaces
+
+    order = spec.reduction_assumed.attachment_order
+    if body == "tied":
+        ring, shaft = pair_fe_models(spec, level)
+        tied = tied_pair(ring, shaft, spec)
+        return tied.fe, tied_pair_interfaces(tied, shaft, spec), component_load_circles(spec, "ring", order), ()
+    fe = part_fe_model(spec, body, level)
+    itfs = component_interfaces(fe, spec, body)
+    return fe, itfs, component_load_circles(spec, body, order), tuple(i.name for i in itfs if i.name == BOLT_PATCHES)
+
+
+def _patch_reference(fe, itfs, rigid: tuple[str, ...], f_max_hz: float) -> np.ndarray:
+    """Flexible free-free frequencies [Hz] below ``f_max_hz`` of the full FE model whose ``rigid`` interfaces' nodes
+    each move as one rigid body (the physics a rigid-patch reduction stands for: joined to a rigid partner)."""
+    import scipy.sparse as sp
+    import scipy.sparse.linalg as sla
+
+    from flexgear.fe.fem import rigid_body_modes
+    from flexgear.fe.spectrum import lowest_eigenpairs
+
+    patches = [i for i in itfs if i.name in rigid]
+    bdofs = np.concatenate([(3 * i.nodes[:, None] + np.arange(3)).ravel() for i in patches])
+    idofs = np.setdiff1d(np.arange(fe.n_dof), bdofs)
+    rows, cols, vals = [idofs], [np.arange(idofs.size)], [np.ones(idofs.size)]
+    for j, itf in enumerate(patches):
+        r = rigid_body_modes(fe.nodes[itf.nodes], centre=itf.point)  # (3k, 6)
+        dofs = (3 * itf.nodes[:, None] + np.arange(3)).ravel()
+        rr, cc = np.nonzero(r)
+        rows.append(dofs[rr]), cols.append(idofs.size + 6 * j + cc), vals.append(r[rr, cc])
+    t = sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
+                      shape=(fe.n_dof, idofs.size + 6 * len(patches)))
+    k, m = (t.T @ fe.K @ t).tocsc(), (t.T @ fe.M @ t).tocsc()
+
+    def eigen(n: int) -> tuple[np.ndarray, np.ndarray]:
+        lam, vec = sla.eigsh(k, k=n + 6, M=m, sigma=-1.0, which="LM", tol=1e-10)
+        order = np.argsort(lam)[6:]  # the six rigid-body modes
+        return lam[order], vec[:, order]
+
+    lam = lowest_eigenpairs(eigen, max_hz=f_max_hz)[0]
+    return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
+
+
+def band(spec, body: str, level: str, cutoff_orders: list[float], band_orders: float,
+         verbose: bool = False) -> list[dict]:
+    """Free-free modes below ``band_orders`` x f_mesh of ``body`` reduced with each fixed-interface cutoff against
+    full FE (module docstring, ``--band``)."""
+    from flexgear.fe.attachment import modal_basis
+    from flexgear.fe.cms import _FreeBodySolver, reduction_basis
+    from flexgear.fe.spectrum import lowest_eigenpairs
+    from flexgear.modal import mesh_frequency_hz
+
+    f_mesh = mesh_frequency_hz(spec, spec.load_case.input_speed_rpm)
+    f_band = band_orders * f_mesh
+    t0 = time.process_time()
+    fe, itfs, circles, rigid = _body_fe(spec, body, level)
+    m = fe.mass_operator()
+    solver = None if rigid else _FreeBodySolver(fe)
+    free = None if rigid else solver.constrained((m @ solver.R).T)
+    if rigid:  # the reference holds the rigid patches rigid too
+        full = _patch_reference(fe, itfs, rigid, 1.02 * f_band)
+    else:
+        full = np.sqrt(np.maximum(lowest_eigenpairs(lambda k: free.eigen(fe, k, m), max_hz=1.02 * f_band)[0], 0.0))
+        full /= 2 * np.pi
+    full = full[full < f_band]
+    parts = reduction_basis(fe, itfs, None, "rbe3", circles, solver=solver, rigid=rigid,
+                            max_hz=max(cutoff_orders) * f_mesh)
+    f_fixed = np.sqrt(np.maximum(np.einsum("ij,ij->j", parts.fixed, fe.K @ parts.fixed), 0.0)) / (2 * np.pi)
+    rows = []
+    for c in sorted(cutoff_orders):
+        keep = f_fixed < c * f_mesh
+        modes, lam, _ = modal_basis(np.hstack([parts.static, parts.fixed[:, keep], parts.attached]), fe.K, m)
+        red = np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi)
+        k = min(full.size, red.size)
+        err = red[:k] / full[:k] - 1.0
+        if verbose:
+            print("   ", " ".join(f"{a:.0f}/{b:.0f}" for a, b in zip(red[:k], full[:k], strict=True)))
+        off = np.flatnonzero(np.abs(err) > 0.01)
+        row = {"body": body, "cutoff_orders": c, "fixed_interface_modes": int(keep.sum()), "modes": int(red.size),
+               "full_below": int(full.size), "reduced_below": int(np.count_nonzero(red < f_band)),
+               "largest_error_pct": float(100 * np.abs(err).max()) if k else 0.0,
+               "first_off_1pct_hz": float(full[off[0]]) if off.size else None}
+        rows.append(row)
+        print(f"  {body}: cutoff {c:g} x f_mesh: {row['fixed_interface_modes']} fixed-interface modes, "
+              f"{row['modes']} modes in all; below {f_band:.0f} Hz full FE {row['full_below']}, reduced "
+              f"{row['reduced_below']}, largest error {row['largest_error_pct']:.3f} %, first more than 1 % off at "
+              f"{row['first_off_1pct_hz']} Hz", flush=True)
+    print(f"  {body}: {time.process_time() - t0:.0f} s CPU", flush=True)
+    return rows
+
+
 def main() -> None:
     from pathlib import Path
 
     from flexgear.spec import load_gearbox
 
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("components", nargs="*", default=list(COMPONENTS[:3]), choices=COMPONENTS)
+    ap.add_argument("components", nargs="*", help=f"bodies among {', '.join([*COMPONENTS, 'tied'])}")
     ap.add_argument("--level", default="coarse")
     ap.add_argument("--orders", type=int, nargs="+", default=[0, 2, 4, 6, 8])
     ap.add_argument("--modes", type=int, nargs="+", default=[0, 10, 20, 40])
@@ -162,12 +265,21 @@ def main() -> None:
     ap.add_argument("--assembly", nargs="?", const="model7", default=None, metavar="VARIANT",
                     help="compare the variant's linearised modes with the full-FE assembly (default model7)")
     ap.add_argument("--f-max", type=float, default=None, help="highest frequency [Hz] (default 3x mesh frequency)")
+    ap.add_argument("--band", action="store_true", help="fixed-interface cutoffs against full FE (docstring)")
+    ap.add_argument("--cutoff-orders", type=float, nargs="+", default=[3.0, 3.5, 4.0, 5.0])
+    ap.add_argument("--band-orders", type=float, default=3.0)
     args = ap.parse_args()
+    if set(args.components) - {*COMPONENTS, "tied"}:
+        ap.error(f"bodies must be among {[*COMPONENTS, 'tied']}, got {args.components}")
     if args.assembly:
         assembly(args.assembly, args.f_max)
         return
     spec = load_gearbox(args.gearbox)
-    for component in args.components:
+    if args.band:
+        for body in args.components or [*COMPONENTS, "tied"]:
+            band(spec, body, args.level, args.cutoff_orders, args.band_orders)
+        return
+    for component in args.components or list(COMPONENTS[:3]):
         study(spec, component, args.level, sorted(args.orders), sorted(args.modes), args.kernel_orders)
 
 

@@ -1,9 +1,8 @@
 """The bolted ring and output shaft: what do the joined forms (one tied body when both are flexible, one rigid
 bolt-patch interface and one joint when one of them is rigid) cost and change against two bodies joined per bolt?
 
-Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections build checks mbs band] [--bolted]
+Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections build checks mbs] [--bolted]
                                                [--baseline DIR] [--variants 1 3 4 5 6 7] [--t-end S] [--out FILE]
-                                               [--band-modes 29 90 150] [--band-orders 3]
 
 - build: each body built cold in its own process from the cached meshes (the reduction without its cache): the
   ring's and the output shaft's bodies (flexgear.fe.reduced) and the tied pair (flexgear.fe.ring_shaft); with
@@ -20,10 +19,7 @@ Run: nice -n 5 python benchmarks/bench_tied.py [--level coarse] [--sections buil
   system's second-order coordinates and constraint rows, wall and CPU time of the run, and the agreement of every
   signal over the last ``--window`` seconds (flexgear.study.agreement: means within 0.1 %, 1x mesh amplitudes
   within 2 %); then model 7's time against the baseline's and against model 1's.
-- band: the tied pair reduced with each fixed-interface mode count of ``--band-modes`` against its full FE model:
-  how many of its free-free modes below ``--band-orders`` x the mesh frequency the reduced body has, and the first
-  more than 1 % off (the spectrum the meshes excite, where [reduction_assumed] fixed_interface_modes is chosen
-  for the lowest twelve).
+The tied body's spectrum against full FE in the band the meshes excite: benchmarks/bench_convergence.py --band.
 Results are printed and, with ``--out``, written as JSON (atomically).
 """
 
@@ -41,7 +37,6 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ("ring", "output_shaft", "tied")
 BASELINE_CASES = ("ring", "output_shaft")
-N_BAND_COMPARE = 200  # full FE free-free modes computed for the band section: more than the tied pair has below 3x
 
 
 def _builder(spec, case: str, level: str):
@@ -214,52 +209,11 @@ def checks_section(level: str, bolted: bool) -> dict:
     return out
 
 
-def band_section(level: str, modes: list[int], band_orders: float) -> list[dict]:
-    """The tied pair reduced with each fixed-interface mode count of ``modes`` (the cached body's interfaces and
-    attachment modes) against its full FE model: free-free modes below ``band_orders`` x the mesh frequency."""
-    import numpy as np
-
-    from flexgear.fe.reduced import component_load_circles
-    from flexgear.fe.ring_shaft import pair_fe_models, tied_pair, tied_pair_interfaces
-    from flexgear.fe.tied import reduce
-    from flexgear.modal import mesh_frequency_hz
-    from flexgear.spec import load_gearbox
-
-    spec = load_gearbox(ROOT / "model_variants" / "gearbox.toml")
-    band = band_orders * mesh_frequency_hz(spec, spec.load_case.input_speed_rpm)
-    ring, shaft = pair_fe_models(spec, level, False)
-    tied = tied_pair(ring, shaft, spec)
-    itfs = tied_pair_interfaces(tied, shaft, spec)
-    circles = component_load_circles(spec, "ring", spec.reduction_assumed.attachment_order)
-    full, out = None, []
-    for n in modes:
-        t0 = time.process_time()
-        body = reduce(tied, itfs, n, n_compare=0 if full is not None else N_BAND_COMPARE, load_circles=circles)
-        full = np.asarray(body.full_frequencies_hz) if full is None else full
-        f_full = full[(full > 1.0) & (full < band)]
-        f_red = np.asarray(body.frequencies_hz)
-        f_red = f_red[f_red > 1.0]
-        k = min(f_full.size, f_red.size)
-        err = np.abs(f_red[:k] / f_full[:k] - 1.0)
-        off = np.flatnonzero(err > 0.01)
-        row = {"fixed_interface_modes": n, "modes": body.n_modes, "full_below": int(f_full.size),
-               "reduced_below": int(np.count_nonzero(f_red < band)),
-               "first_off_1pct_hz": float(f_full[off[0]]) if off.size else None, "cpu_s": time.process_time() - t0}
-        print(f"  band: {n} fixed-interface modes ({row['modes']} in all): free-free modes below {band:.0f} Hz, "
-              f"full FE {row['full_below']}, reduced {row['reduced_below']}; first more than 1 % off at "
-              f"{row['first_off_1pct_hz']} Hz; {row['cpu_s']:.0f} s CPU", flush=True)
-        out.append(row)
-    return out
-
-
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--level", default="coarse")
     parser.add_argument("--sections", nargs="+", default=["build", "checks"],
-                        choices=["build", "checks", "mbs", "band"])
-    parser.add_argument("--band-modes", type=int, nargs="+", default=[29, 90, 150],
-                        help="band: fixed-interface mode counts to try")
-    parser.add_argument("--band-orders", type=float, default=3.0, help="band: the band in mesh orders")
+                        choices=["build", "checks", "mbs"])
     parser.add_argument("--bolted", action="store_true", help="also run flexgear.fe.bolted's own full-FE modes")
     parser.add_argument("--baseline", type=Path, help="a checkout of the code to compare with (build, mbs)")
     parser.add_argument("--variants", type=int, nargs="+", default=[1, 3, 4, 5, 6, 7])
@@ -281,8 +235,6 @@ def main() -> None:
         results["build"] = build_section(args.level, args.baseline)
     if "checks" in args.sections:
         results["checks"] = checks_section(args.level, args.bolted)
-    if "band" in args.sections:
-        results["band"] = band_section(args.level, args.band_modes, args.band_orders)
     if "mbs" in args.sections:
         if args.baseline is None:
             parser.error("--sections mbs needs --baseline DIR")

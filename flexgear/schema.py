@@ -250,7 +250,8 @@ class MeshingSettings:
 class ReductionSettings:
     """Component-mode synthesis settings for flexible bodies (assumed)."""
 
-    fixed_interface_modes: int = _num(0, 200, integer=True)
+    # every fixed-interface mode below this frequency [Hz] joins each body's basis
+    fixed_interface_cutoff_hz: float = _num(0.0, lo_open=True)
     modal_stiffness_damping_s: float = _num(0.0)
     contact_fourier_order: int = _num(1, 60, integer=True)
     # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
@@ -288,6 +289,8 @@ class JointsAssumed:
 
 _REFERENCE = 'the production formulation is the only one; formulation = "reference" selects Exudyn\'s'
 REMOVED_FIELDS: dict[str, str] = {
+    "reduction_assumed.fixed_interface_modes": ("a basis is sized by frequency, not by count: every fixed-interface "
+                                                "mode below fixed_interface_cutoff_hz"),
     "solver_assumed.linear_solver": "Eigen's sparse LU is the only linear solver",
     "solver_assumed.frame_equations": f"{_REFERENCE} ObjectRigidBody",
     "solver_assumed.sparse_ordering": "the sparse LU keeps its ordering while the pattern holds (production)",

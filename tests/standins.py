@@ -34,12 +34,14 @@ def _annulus(r_in: float, r_out: float, width: float, interface_outer: bool, mat
     radius = r_out if interface_outer else r_in
     sel = np.flatnonzero(np.abs(r - radius) < 1e-6)
     if bolts == 0:
-        return reduce(fe, [interface(fe, sel, name)], 20, n_compare=0, keep_modes=modes or None)
+        body = reduce(fe, [interface(fe, sel, name)], 20, n_compare=0)
+        return body.truncated(modes) if modes else body
     angle = np.arctan2(fe.nodes[sel, 1], fe.nodes[sel, 0])
     nearest = np.round(angle / (2 * np.pi) * bolts) % bolts
     off = np.angle(np.exp(1j * (angle - 2 * np.pi * nearest / bolts)))  # from the nearest bolt's angle
     patches = sel[np.abs(off) * radius <= patch_half_width]
-    return reduce(fe, [interface(fe, patches, name)], 20, n_compare=0, keep_modes=modes or None, rigid=(name,))
+    body = reduce(fe, [interface(fe, patches, name)], 20, n_compare=0, rigid=(name,))
+    return body.truncated(modes) if modes else body
 
 
 def annulus_source(spec, component: str, level: str):

@@ -71,6 +71,7 @@ def component(gearbox, request):
 def test_gear_compliance_under_kernel_loads_equals_full_fe(component):
     """Held at the bore (the ring on its rigid bolt patches is checked against full FE with the patches clamped,
     tests/test_rigid_partner.py, and as the tied ring and output shaft, tests/test_tied_pair.py)."""
+    from flexgear.design import as_design
     from flexgear.fe.reduced import component_contacts, component_load_circles, gear_seat
 
     spec, name, fe, body = component
@@ -81,9 +82,14 @@ def test_gear_compliance_under_kernel_loads_equals_full_fe(component):
     reduced = fg.static_compliance(body, points, normals, held, kernel=kernel)
     assert np.max(np.abs(reduced - full)) < 0.02 * np.max(np.abs(full))
     assert reduced.sum(axis=1) == pytest.approx(full.sum(axis=1), rel=0.02)  # all contacts loaded together
-    # the lowest free-free frequencies still converge to the full model's
-    f_full = full_free_modes(fe, 6, free_body_solver(fe))[0]
-    assert body.frequencies_hz[:6] == pytest.approx(f_full, rel=0.02)
+    # every free-free mode below 3x the mesh frequency (the band the assembly is checked in) within 1 % of the full
+    # model's, at or above it (a Ritz basis): the basis holds the fixed-interface modes below
+    # [reduction_assumed] fixed_interface_cutoff_hz (flexgear.fe.spectrum)
+    f_full = full_free_modes(fe, 8, free_body_solver(fe))[0]
+    f_full = f_full[f_full < 3.0 * as_design(spec).theory.mesh_frequency]
+    assert 0 < f_full.size < 8  # the eight computed reach past the band
+    assert body.frequencies_hz[:f_full.size] == pytest.approx(f_full, rel=0.01)
+    assert np.all(body.frequencies_hz[:f_full.size] >= f_full * (1 - 1e-7))
 
 
 def timoshenko_seat_compliance(spec, shaft: str, load: tuple[float, float], held: tuple[float, float]

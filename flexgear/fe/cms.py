@@ -10,8 +10,7 @@ is T = [Psi_s, Phi_f]:
 
   written C u = q. Static (constraint) modes Psi_s minimise u^T K u subject to C u = e_k; the
   fixed-interface modes Phi_f solve K phi = omega^2 M phi subject to C phi = 0. The interface
-  nodes stay free to deform, so a bore or a bolt patch does not stiffen the body (rigid patches
-  made rings and gears 10-78 % too stiff in the prototype).
+  nodes stay free to deform, so a bore or a bolt patch does not stiffen the body.
 - ``kind="rbe2"`` (rigid interface): the interface nodes move as a rigid patch, u_b = R_b q; static
   modes [R_b; -K_ii^-1 K_ib R_b], fixed-interface modes from (K_ii, M_ii): classical Craig-Bampton.
   Mixed (``rigid=`` names): those interfaces rigid, the others RBE3 rows on the interior (bolt patches).
@@ -52,6 +51,7 @@ from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import FEModel, rigid_body_modes
 from flexgear.fe.invariants import EPS as _EPS
 from flexgear.fe.invariants import ffrf_invariants
+from flexgear.fe.spectrum import lowest_eigenpairs
 from flexgear.geometry.massprops import MassProperties
 
 __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights", "reduce", "reduction_basis",
@@ -204,8 +204,7 @@ class _Constrained:
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
         k = min(k, self.s.n - self.p - 2)
         lam, vec = sla.eigsh(fe.K, k=k, M=m, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
-        order = np.argsort(lam)
-        return lam[order], vec[:, order]
+        return np.sort(lam), vec[:, np.argsort(lam)]
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
@@ -313,8 +312,8 @@ class ReducedBody:
                        inv, z["surface_triangles"], info)
 
 
-def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str], n_modes: int,
-                       patterns: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, int]:
+def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str], n_modes: int | None,
+                       patterns: np.ndarray, max_hz: float | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Craig-Bampton basis with the interfaces named in ``rigid`` as rigid patches (RBE2: their nodes move as
     one, u_b = R_b q) and the others distributing (RBE3 rows C u = q, nodes free to deform).
 
@@ -355,15 +354,17 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     static[idofs, :ub.shape[1]] = solve(-np.asarray(fe.K[bdofs][:, idofs].T @ ub))
     if soft:
         static[idofs, ub.shape[1]:] = solve(None, np.eye(c.shape[0]))
-    fixed = np.zeros((fe.n_dof, n_modes))
-    if n_modes:
-        shape = (len(idofs), len(idofs))
-        op = sla.LinearOperator(shape, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
-        m_ii = fe.mass_operator(np.setdiff1d(np.arange(fe.n_nodes), bnodes))  # rows and columns idofs
-        v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
-        # shift-invert about 0 reads K_ii only through OPinv (ARPACK mode 3): op stands for it
-        lam, vec = sla.eigsh(op, k=n_modes, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
-        fixed[idofs] = vec[:, np.argsort(lam)]
+    op = sla.LinearOperator((len(idofs),) * 2, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
+    m_ii = fe.mass_operator(np.setdiff1d(np.arange(fe.n_nodes), bnodes))  # rows and columns idofs
+    v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
+
+    def eigen(k: int) -> tuple[np.ndarray, np.ndarray]:  # shift-invert about 0 reads K_ii only through OPinv
+        lam, vec = sla.eigsh(op, k=k, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
+        return np.sort(lam), vec[:, np.argsort(lam)]
+
+    vec = lowest_eigenpairs(eigen, n_modes, max_hz, limit=len(idofs) - c.shape[0] - 2)[1]
+    fixed = np.zeros((fe.n_dof, vec.shape[1]))
+    fixed[idofs] = vec
     attached = np.zeros_like(patterns)
     if patterns.shape[1]:
         attached[idofs] = solve(patterns[idofs])
@@ -383,9 +384,10 @@ class BasisParts:
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
-def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str = "rbe3",
+def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int | None, kind: str = "rbe3",
                     load_circles: list[LoadCircle] | None = None,
-                    solver: _FreeBodySolver | None = None, rigid: tuple[str, ...] = ()) -> BasisParts:
+                    solver: _FreeBodySolver | None = None, rigid: tuple[str, ...] = (),
+                    max_hz: float | None = None) -> BasisParts:
     """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation
     (``solver``: the free body's, if already made)."""
     circles = list(load_circles or [])
@@ -393,28 +395,31 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int, kind: str 
                 else np.zeros((fe.n_dof, 0)))
     rigid_set = {i.name for i in itfs} if kind == "rbe2" else set(rigid)
     if rigid_set:
-        return BasisParts(*_rigid_patch_basis(fe, itfs, rigid_set, n_modes, patterns))
+        return BasisParts(*_rigid_patch_basis(fe, itfs, rigid_set, n_modes, patterns, max_hz))
     solver = solver or _FreeBodySolver(fe)
     con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(None, np.eye(con.p))
-    fixed = con.eigen(fe, n_modes, fe.mass_operator())[1] if n_modes else np.zeros((fe.n_dof, 0))
+    m = fe.mass_operator()
+    vec = lowest_eigenpairs(lambda k: con.eigen(fe, k, m), n_modes, max_hz, limit=con.s.n - con.p - 2)[1]
+    fixed = vec if vec.shape[1] else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
     return BasisParts(static, fixed, attached, solver)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")  # small BLAS calls in solver loops: threads only contend
-def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: str = "rbe3",
-           n_compare: int = 12, keep_modes: int | None = None,
-           load_circles: list[LoadCircle] | None = None, rigid: tuple[str, ...] = ()) -> ReducedBody:
-    """Craig-Bampton reduction of ``fe`` with ``interfaces`` and ``n_modes`` fixed-interface modes.
+def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int | None = None, kind: str = "rbe3",
+           n_compare: int = 12, load_circles: list[LoadCircle] | None = None, rigid: tuple[str, ...] = (),
+           max_hz: float | None = None) -> ReducedBody:
+    """Craig-Bampton reduction of ``fe`` with ``interfaces`` and ``n_modes`` fixed-interface modes, or with every
+    fixed-interface mode below ``max_hz`` [Hz] (exactly one of the two; flexgear.fe.spectrum).
 
     ``kind``: "rbe3" (distributing interfaces, default; those named in ``rigid`` are rigid patches all the
     same) or "rbe2" (all rigid patches). ``load_circles``
     (flexgear.fe.attachment.LoadCircle): their Fourier load patterns' static responses with the
     interfaces held join the basis as attachment modes (exact compliance under the contact kernel's
     loads). The basis is mass-orthonormalised (dependent directions dropped) and its free-free modes
-    are the flexible coordinates: 6 J + n_modes + sum(2 N + 1) - 6 of them, less dropped ones (all,
-    or the lowest ``keep_modes``, which loses the static correction). ``n_compare`` lowest free-free
+    are the flexible coordinates: 6 J + n_modes + sum(2 N + 1) - 6 of them, less dropped ones (the lowest
+    alone: ReducedBody.truncated, which loses the static correction). ``n_compare`` lowest free-free
     modes of the full FE model are computed for the comparison stored in the result (0 skips it).
     """
     if kind not in ("rbe3", "rbe2"):
@@ -426,22 +431,20 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int, kind: s
         raise ValueError("reduce: at least one interface is needed (it fixes the static modes' rigid part)")
     itfs = [interface(fe, i) if isinstance(i, str) else i for i in interfaces]
     t0 = time.perf_counter()
-    parts = reduction_basis(fe, itfs, n_modes, kind, load_circles, rigid=tuple(rigid))
+    parts = reduction_basis(fe, itfs, n_modes, kind, load_circles, rigid=tuple(rigid), max_hz=max_hz)
     t_full, full = time.perf_counter(), np.zeros(0)
     if n_compare:  # here, while the factor exists: it is freed before the dense work on the basis
         full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
     t_full = time.perf_counter() - t_full
-    n_attached = parts.attached.shape[1]
+    n_attached, n_fixed = parts.attached.shape[1], parts.fixed.shape[1]
     basis = np.hstack([parts.static, parts.fixed, parts.attached])
     del parts  # the factor and the blocks: the peak memory is the factor's or the basis's, not both
     modes, lam, dropped = modal_basis(basis, fe.K, fe.mass_operator())
     del basis
-    if keep_modes is not None:
-        modes, lam = modes[:, :keep_modes], lam[:keep_modes]
     t_reduce = time.perf_counter() - t0 - t_full
     invariants = ffrf_invariants(fe.mass_scalar, fe.nodes, modes)
     info = {"n_dof_full": float(fe.n_dof), "n_nodes": float(fe.n_nodes),
             "attachment_vectors": float(n_attached), "dropped_directions": float(dropped),
             "reduce_time_s": t_reduce, "total_time_s": time.perf_counter() - t0}
     return ReducedBody(fe.nodes, modes, lam, np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), full, itfs, kind,
-                       n_modes, fe.mass_properties(), invariants, fe.surface_triangles, info)
+                       n_fixed, fe.mass_properties(), invariants, fe.surface_triangles, info)

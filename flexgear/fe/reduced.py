@@ -17,7 +17,8 @@ frame, with the band the contact kernel reads (one normal module). The shafts ca
 their interfaces, whose static modes the basis holds anyway.
 The mesh is the component's cached mesh at the variant's level (flexgear.fe.mesh); the tooth
 compliance itself is in the contact law. Results are cached by a hash of the geometry, the
-mesh level and the reduction settings (flexgear.mbs.flexible.cached_reduced_body).
+mesh level and the reduction settings (:func:`cached_reduced_body`). Each basis holds every fixed-interface
+mode below ``[reduction_assumed] fixed_interface_cutoff_hz``.
 """
 
 from __future__ import annotations
@@ -258,7 +259,8 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
     patches = name in ("ring", "output_shaft")
     # the bolt patches' union, its kind and clamped disc enter the key of the bodies that have it
     extra = [(BOLT_PATCHES, "union", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
-    key = geometry_hash(spec, name, mesh_settings, red.fixed_interface_modes, _INTERFACE_KIND, _WHOLE_BASIS,
+    max_hz = red.fixed_interface_cutoff_hz
+    key = geometry_hash(spec, name, mesh_settings, max_hz, _INTERFACE_KIND, _WHOLE_BASIS,
                         [c.key() for c in circles], _REDUCTION_VERSION, *extra)
 
     def build() -> ReducedBody:
@@ -273,8 +275,8 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
         mesh = component_mesh(d, name, level, order=1, progress=progress)
         fe = fe_model(mesh.ngsolve_mesh(), spec.material_assumed, mesh_settings.element_order)
         itfs = component_interfaces(fe, d, name)
-        return reduce(fe, itfs, red.fixed_interface_modes, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
-                      rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES))
+        return reduce(fe, itfs, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
+                      rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES), max_hz=max_hz)
 
     return f"{name}-{level}-{key}", build
 

@@ -5,15 +5,15 @@ pair than two bodies joined per bolt (flexgear.fe.reduced, flexgear.fe.bolted):
 
 - **Both flexible** (:func:`tied_pair_body`): the two FE models tied over the bolts' clamped discs as the full-FE
   reference ties them (flexgear.fe.bolted: the shaft's web nodes in each disc follow the ring's flange face,
-  flexgear.fe.tied eq. 1) and reduced as one body (flexgear.fe.tied.reduce), with the reduction of every
-  component body (flexgear.fe.reduced): RBE3 interfaces, ``[reduction_assumed] fixed_interface_modes``
-  fixed-interface modes, attachment modes of the ring's contact bands (``attachment_order``). Its interface is
-  the output shaft's bearing seat ("bearing_seat"), the pair's only seat; the ring's contact bands are the ring's
-  own (the ring's nodes come first, with their indices in the ring's model). Beside it the body carries the
-  measuring interface "ring_seat" (no static modes of its own): the ring's side of the joint, the union of its
-  clamped discs, each disc weighted equally (as flexgear.fe.reduced.gear_seat takes it for the ring alone), the
-  seat the ring's deflections are measured from. Its mass properties are those of the tied FE model, exactly
-  the sum of the ring's and the shaft's (flexgear.fe.tied): a rigid twin of the pair has the same.
+  flexgear.fe.tied eq. 1) and reduced as one body (flexgear.fe.tied.reduce), with the reduction of every component
+  body (flexgear.fe.reduced): RBE3 interfaces, every fixed-interface mode below ``[reduction_assumed]
+  fixed_interface_cutoff_hz``, attachment modes of the ring's contact bands
+  (``attachment_order``). Its interface is the output shaft's bearing seat ("bearing_seat"), the pair's only seat;
+  the ring's contact bands are the ring's own (the ring's nodes come first, with their indices in the ring's model).
+  Beside it the body carries the measuring interface "ring_seat" (no static modes of its own): the ring's side of
+  the joint, the union of its clamped discs, each disc weighted equally (as flexgear.fe.reduced.gear_seat takes it
+  for the ring alone), the seat the ring's deflections are measured from. Its mass properties are those of the tied
+  FE model, exactly the sum of the ring's and the shaft's (flexgear.fe.tied): a rigid twin of the pair has the same.
 - **One of the pair rigid**: every clamped disc moves with the one rigid part, so the flexible part is reduced
   with one rigid multi-point interface "bolt_patches" over all discs (flexgear.fe.reduced.patch_union: 6
   coordinates, not 72), its own body of flexgear.fe.reduced; one fixed joint to the rigid part replaces 12.
@@ -100,7 +100,7 @@ def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> lis
 def _tied_key(spec: GearboxSpec, level: str) -> str:
     red = spec.reduction_assumed
     circles = component_load_circles(spec, "ring", red.attachment_order)
-    key = geometry_hash(spec, "tied", PAIR, spec.meshing_assumed[level], red.fixed_interface_modes,
+    key = geometry_hash(spec, "tied", PAIR, spec.meshing_assumed[level], red.fixed_interface_cutoff_hz,
                         [c.key() for c in circles], spec.joints_assumed.bolt_clamp_diameter_mm, _TIED_VERSION)
     return f"ring_output_shaft_tied-{level}-{key}"
 
@@ -119,7 +119,7 @@ def _tied_build(spec: GearboxSpec, level: str, progress: bool) -> Callable[[], R
         red = spec.reduction_assumed
         circles = component_load_circles(spec, "ring", red.attachment_order)
         t_tie = time.perf_counter() - t0
-        body = reduce(tied, itfs, red.fixed_interface_modes, n_compare=0, load_circles=circles)
+        body = reduce(tied, itfs, n_compare=0, load_circles=circles, max_hz=red.fixed_interface_cutoff_hz)
         info = {**body.info, "n_nodes_ring": float(n_ring), "fe_and_tie_time_s": t_tie}
         return dataclasses.replace(body, interfaces=[*body.interfaces, seat], info=info)
 

@@ -233,10 +233,10 @@ def tie_parts(parts: Sequence[FEModel], ties: Sequence[Tie], names: Sequence[str
     return TiedFE(fe, names, offsets, column, t_s)
 
 
-def reduce(model: FEModel | TiedFE | Sequence[FEModel], interfaces: list[Interface | str], n_modes: int,
-           kind: str = "rbe3", n_compare: int = 12, keep_modes: int | None = None,
+def reduce(model: FEModel | TiedFE | Sequence[FEModel], interfaces: list[Interface | str],
+           n_modes: int | None = None, kind: str = "rbe3", n_compare: int = 12,
            load_circles: list[LoadCircle] | None = None, rigid: tuple[str, ...] = (),
-           ties: Sequence[Tie] = (), names: Sequence[str] | None = None) -> ReducedBody:
+           ties: Sequence[Tie] = (), names: Sequence[str] | None = None, max_hz: float | None = None) -> ReducedBody:
     """Craig-Bampton reduction (flexgear.fe.cms.reduce, same arguments) of an FE model or a tied assembly.
 
     ``model``: an FE model; a :class:`TiedFE`; or a list of FE models, tied by ``ties`` (and named ``names``)
@@ -254,5 +254,5 @@ def reduce(model: FEModel | TiedFE | Sequence[FEModel], interfaces: list[Interfa
         fe = model.fe
     else:
         fe = tie_parts(list(model), ties, names).fe
-    return _reduce_fe(fe, interfaces, n_modes, kind=kind, n_compare=n_compare, keep_modes=keep_modes,
-                      load_circles=load_circles, rigid=rigid)
+    return _reduce_fe(fe, interfaces, n_modes, kind=kind, n_compare=n_compare, load_circles=load_circles,
+                      rigid=rigid, max_hz=max_hz)
