@@ -8,12 +8,14 @@ do not start last and leave one worker running alone at the end. The mesh cache 
 ``$FLEXGEAR_CACHE_DIR``) is shared by the workers: a missing mesh or reduced body is built by the first worker that
 needs it while the other waits for it (flexgear.cache.load_or_build). With ``--prebuild`` (``make test``) each
 worker first builds its share of the cache entries the suite uses (:data:`PREBUILD_CHAINS`), so that a cold
-cache is built by both workers at once instead of by one while the other waits.
+cache is built by both workers at once instead of by one while the other waits. The FE models of
+:func:`coarse_fe` are built once per worker process, and the tests that use them are one unit of work: with
+``--prebuild`` it goes to the worker that builds the tied ring and output shaft, whose FE models that build
+shares (:func:`_coarse_fe_model`), so that the run builds each of them once.
 """
 
 import ast
 import dataclasses
-import functools
 from pathlib import Path
 
 import pytest
@@ -63,6 +65,15 @@ def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
     return out
 
 
+def _fixture_user_modules(folder: Path, fixture: str) -> set[str]:
+    """The test modules (paths as in node ids) that request ``fixture`` in a test or fixture function."""
+    def requests(node: ast.AST) -> bool:
+        return isinstance(node, ast.FunctionDef) and fixture in {a.arg for a in node.args.args + node.args.kwonlyargs}
+
+    return {path.relative_to(ROOT).as_posix() for path in sorted(folder.rglob("test_*.py"))
+            if any(map(requests, ast.walk(ast.parse(path.read_text()))))}
+
+
 def _slow_tests(folder: Path) -> dict[str, set[str]]:
     """Per test module (its path as in node ids): the names of its test functions marked ``slow``: by their own
     decorators (a mark on the function or on one of its parameters), by a fixture of the module they request whose
@@ -100,6 +111,9 @@ def pytest_xdist_make_scheduler(config, log):
 
     users = _module_fixture_users(Path(__file__).resolve().parent)
     slow = _slow_tests(Path(__file__).resolve().parent)
+    fe_modules = _fixture_user_modules(Path(__file__).resolve().parent, "coarse_fe")
+    fe_unit = "coarse_fe"
+    tied_chain = next(i for i, chain in enumerate(PREBUILD_CHAINS) if "tied" in chain)
 
     def module_and_test(nodeid: str) -> tuple[str, str]:
         module, _, rest = nodeid.partition("::")
@@ -107,17 +121,29 @@ def pytest_xdist_make_scheduler(config, log):
 
     class ModuleFixtureScheduling(LoadScopeScheduling):
         def _split_scope(self, nodeid: str) -> str:
+            """A module's tests that share its module-scoped fixtures are one unit; those of the modules that use
+            :func:`coarse_fe` are all one unit, so that its FE models are built in one worker process."""
             module, test = module_and_test(nodeid)
             grouped = users.get(module, set())
-            return module if "*" in grouped or test in grouped else nodeid
+            if "*" in grouped or test in grouped:
+                return fe_unit if module in fe_modules else module
+            return nodeid
+
+        def _may_take(self, node, scope: str) -> bool:
+            """With ``--prebuild``, the :func:`coarse_fe` unit goes to the worker that builds the tied pair."""
+            if scope != fe_unit or not config.getoption("prebuild"):
+                return True
+            return node.gateway.id == f"gw{tied_chain % max(self.numnodes, 1)}"
 
         def _assign_work_unit(self, node) -> None:
-            """The pending unit with the most slow tests next (then the one with the most tests, then the first)."""
+            """The pending unit with the most slow tests next (then the one with the most tests, then the first),
+            of those this worker may take (any, when it may take none of them)."""
             def priority(scope: str) -> tuple[int, int]:
                 unit = self.workqueue[scope]
                 return sum(test in slow.get(module, ()) for module, test in map(module_and_test, unit)), len(unit)
 
-            self.workqueue.move_to_end(max(self.workqueue, key=priority), last=False)
+            allowed = [scope for scope in self.workqueue if self._may_take(node, scope)] or list(self.workqueue)
+            self.workqueue.move_to_end(max(allowed, key=priority), last=False)
             super()._assign_work_unit(node)
 
     return ModuleFixtureScheduling(config, log)
@@ -146,7 +172,18 @@ def _prebuild(spec, task: str) -> None:
     from flexgear.fe.ring_shaft import tied_pair_mass_properties
 
     if task == "tied":
-        tied_pair_mass_properties(spec, "coarse")
+        from flexgear.fe import ring_shaft
+
+        build = ring_shaft.part_fe_model
+
+        def shared(part_spec, component, level="coarse", progress=False):
+            if part_spec is spec and level == "coarse":
+                return _coarse_fe_model(component, build)
+            return build(part_spec, component, level, progress)
+
+        with pytest.MonkeyPatch.context() as mp:  # the tied build's FE models are coarse_fe's
+            mp.setattr(ring_shaft, "part_fe_model", shared)
+            tied_pair_mass_properties(spec, "coarse")
     elif task.startswith("mesh:"):
         component_mesh(spec, task.removeprefix("mesh:"), "coarse")
     else:
@@ -177,11 +214,24 @@ def model1():
     return dataclasses.replace(load_variant(VARIANTS / "model1.toml"), rigid_mass_properties="exact")
 
 
+_COARSE_FE: dict[str, object] = {}
+"""The FE models of :func:`coarse_fe`, by component, of this process."""
+
+
+def _coarse_fe_model(name: str, build=None):
+    """The FE model of component ``name`` of gearbox.toml at the coarse level (flexgear.fe.ring_shaft.part_fe_model,
+    or ``build`` with its arguments), built once per process."""
+    if name not in _COARSE_FE:
+        if build is None:
+            from flexgear.fe.ring_shaft import part_fe_model as build
+        _COARSE_FE[name] = build(load_gearbox(VARIANTS / "gearbox.toml"), name, "coarse")
+    return _COARSE_FE[name]
+
+
 @pytest.fixture(scope="session")
-def coarse_fe(gearbox):
+def coarse_fe():
     """``coarse_fe(name)``: the FE model of component ``name`` at the coarse level as every reduced body is built on
     it (flexgear.fe.ring_shaft.part_fe_model), built once per worker process for the test modules that compare
-    against full FE; the functions those tests call leave a model unchanged."""
-    from flexgear.fe.ring_shaft import part_fe_model
-
-    return functools.cache(lambda name: part_fe_model(gearbox, name, "coarse"))
+    against full FE (and shared with the tied pair's build of ``--prebuild``); the functions those tests and that
+    build call leave a model unchanged."""
+    return _coarse_fe_model
