@@ -47,8 +47,9 @@ import scipy.sparse as sp
 
 from flexgear.spec import Variant
 
-__all__ = ["Attachments", "LinearSystem", "Coupled", "Flexibility", "linear_system", "attachments", "recover",
-           "reduced_flexibility", "body_fe_model", "full_flexibility", "assembled", "eigenvalues"]
+__all__ = ["Attachments", "LinearSystem", "Coupled", "Flexibility", "linear_system", "attachments",
+           "carries_attachments", "recover", "reduced_flexibility", "body_fe_model", "full_flexibility", "assembled",
+           "eigenvalues"]
 
 _RANK_TOL = 1e-10  # relative singular value below which constraint rows are redundant
 
@@ -207,6 +208,16 @@ def _relative_leak(x: np.ndarray, q: np.ndarray, side: str) -> float:
     return float(np.abs(q @ x if side == "left" else x @ q).max() / scale)
 
 
+def carries_attachments(body: Attachments) -> bool:
+    """Whether the body's attachment motions A have full row rank (its modes can move every attachment motion on
+    its own): the condition under which :func:`recover` finds its couplings exactly."""
+    a = body.motion
+    if a.shape[0] > a.shape[1]:
+        return False
+    sv = np.linalg.svd(a / np.linalg.norm(a, axis=1)[:, None], compute_uv=False)
+    return bool(sv[-1] >= 1e-8 * sv[0])
+
+
 def recover(system: LinearSystem, bodies: list[Attachments]) -> Coupled:
     """The couplings of every flexible body in attachment space (module docstring), exact where each A has full
     row rank; raises ValueError where it has not. Requires the bodies' elastic coordinates to carry no mass
@@ -218,8 +229,7 @@ def recover(system: LinearSystem, bodies: list[Attachments]) -> Coupled:
     pinv, leak, slices, start = [], 0.0, [], 0
     for b in bodies:
         a = b.motion
-        sv = np.linalg.svd(a / np.linalg.norm(a, axis=1)[:, None], compute_uv=False)
-        if sv[-1] < 1e-8 * sv[0] or a.shape[0] > a.shape[1]:
+        if not carries_attachments(b):
             raise ValueError(f"{b.component}: attachment motions A {a.shape} lack full row rank")
         p = a.T @ np.linalg.inv(a @ a.T)  # A^+ (m, n_a)
         q = np.eye(a.shape[1]) - p @ a

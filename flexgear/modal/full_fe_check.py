@@ -8,7 +8,9 @@ At zero speed (no spin terms) three sets of undamped natural frequencies f = sqr
   the reference are recovered from this linearisation (flexgear.modal.full_fe.recover), and its frequencies
   recomputed from the recovered couplings (``recovery``: their largest relative difference) check that step;
 - ``full``: every flexible body replaced by its full FE model (flexgear.modal.full_fe), with the same bearings,
-  joints and tangent mesh springs at the static deflection of the all-modes operating point.
+  joints and tangent mesh springs at the static deflection of the all-modes operating point. A body with fewer
+  modes than attachment motions (a short shaft whose basis holds few modes below the cutoff) cannot give its
+  couplings back from the linearisation; it stays reduced in every set (``kept_reduced``).
 
 Modes are paired in ascending order (both sets hold the same count below ``f_max``: the reduced bodies are
 Ritz approximations, each frequency an upper bound of the full model's in the same order).
@@ -26,6 +28,7 @@ from flexgear.modal.full_fe import (
     assembled,
     attachments,
     body_fe_model,
+    carries_attachments,
     eigenvalues,
     full_flexibility,
     linear_system,
@@ -63,6 +66,7 @@ class FullFEComparison:
     unpaired: np.ndarray | None = None
     unpaired_bodies: list[str] = dataclasses.field(default_factory=list)
     model_frequencies: np.ndarray | None = None
+    kept_reduced: list[str] = dataclasses.field(default_factory=list)
 
     @property
     def error(self) -> np.ndarray:
@@ -88,6 +92,8 @@ class FullFEComparison:
         if self.model_frequencies is not None and np.isnan(self.model).any():
             lines.append(f"the model has {len(self.model_frequencies)} modes below f_max, the all-modes one "
                          f"{len(self.all_modes)} [Hz]: " + " ".join(f"{f:.1f}" for f in self.model_frequencies))
+        if self.kept_reduced:
+            lines.append(f"left reduced (fewer modes than attachment motions): {', '.join(self.kept_reduced)}")
         if self.unpaired is not None and len(self.unpaired):
             lines.append(f"{len(self.unpaired)} full-FE assembly modes below f_max without a reduced partner [Hz, "
                          "body]: " + ", ".join(f"{f:.0f} {b}" for f, b in zip(self.unpaired, self.unpaired_bodies,
@@ -149,7 +155,8 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     seconds["linearise"] = time.perf_counter() - t
     t = time.perf_counter()
     system = linear_system(variant, 0.0)
-    bodies = attachments(system)
+    every = attachments(system)
+    bodies = [b for b in every if carries_attachments(b)]
     coupled = recover(system, bodies)
     s_all = _frequencies(all_model, s_max)
     s_rec, x_rec = eigenvalues(*assembled(coupled, [reduced_flexibility(b) for b in bodies])[:2], s_max=s_max)
@@ -190,7 +197,8 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     hz = [np.sqrt(s) / (2 * np.pi) for s in (s_model, s_all, s_full[pair])]
     owners = _owners(coupled, flex, [b.component for b in bodies], x_full[:, unpaired])
     return FullFEComparison(variant.name, f_max, *hz, recovery, coupled.leak, change, seconds, done, mac,
-                            np.sqrt(s_full[unpaired]) / (2 * np.pi), owners, model_hz)
+                            np.sqrt(s_full[unpaired]) / (2 * np.pi), owners, model_hz,
+                            [b.component for b in every if not carries_attachments(b)])
 
 
 def _owners(coupled, flex: list, names: list[str], x: np.ndarray) -> list[str]:
