@@ -20,12 +20,14 @@ RECOVERY = 1e-7  # couplings recovered exactly: frequencies back to round-off of
 RITZ_SLACK = 1e-7  # relative: an all-modes frequency may sit this far below the full FE one (solver precision)
 
 
-def _check(result) -> None:
+def _check(result, kept_reduced: list[str]) -> None:
+    assert result.kept_reduced == kept_reduced
     assert result.leak < 1e-9
     assert result.recovery < RECOVERY
     assert len(result.full) > 0
     assert len(result.unpaired) == 0  # every mode of the full assembly below f_max has its reduced partner
-    assert np.all(result.basis_error > -RITZ_SLACK)
+    # Ritz: in ascending order each all-modes frequency at or above the full assembly's
+    assert np.all(np.sort(result.all_modes) >= np.sort(result.full) * (1 - RITZ_SLACK))
     assert np.abs(result.error).max() < TOLERANCE
 
 
@@ -34,14 +36,15 @@ def test_flexible_planets_against_full_fe():
     """Model 2 (five flexible planets on their bearings), modes below 2 kHz: the planets' first free-free mode
     lies near 9 kHz, so a light case; the bearing modes near 1.6 kHz feel the planets' flexibility."""
     result = compare_full_fe(load_variant(VARIANTS / "model2.toml"), f_max_hz=2000.0)
-    _check(result)
+    _check(result, [])
 
 
 @pytest.mark.heavy
-@pytest.mark.xfail(strict=True, reason="the tied ring and output shaft's basis ([reduction_assumed] "
-                   "fixed_interface_modes) converges its 12 lowest free-free modes, not its spectrum up to 3x the "
-                   "mesh frequency: its full FE model has modes there that the reduced body lacks")
 def test_model7_against_full_fe():
-    """Model 7 (every component flexible, coarse mesh), every mode below 3x the mesh frequency."""
+    """Model 7 (every component flexible, coarse mesh), every mode below 3x the mesh frequency, with full FE models
+    of the sun, the planets and the tied ring and output shaft. The input shaft stays reduced in both: its basis
+    (every fixed-interface mode below [reduction_assumed] fixed_interface_cutoff_hz) has fewer modes than its two
+    seats have attachment motions, so its couplings cannot be recovered from the linearisation; its own free-free
+    modes against full FE: benchmarks/bench_convergence.py --band."""
     result = compare_full_fe(load_variant(VARIANTS / "model7.toml"))
-    _check(result)
+    _check(result, ["input_shaft"])

@@ -12,8 +12,8 @@ At zero speed (no spin terms) three sets of undamped natural frequencies f = sqr
   modes than attachment motions (a short shaft whose basis holds few modes below the cutoff) cannot give its
   couplings back from the linearisation; it stays reduced in every set (``kept_reduced``).
 
-Modes are paired in ascending order (both sets hold the same count below ``f_max``: the reduced bodies are
-Ritz approximations, each frequency an upper bound of the full model's in the same order).
+Modes are paired by shape and frequency together (:func:`_pairs`); the reduced bodies are Ritz approximations, each
+frequency an upper bound of the full model's in the same order.
 """
 
 from __future__ import annotations
@@ -118,15 +118,24 @@ def _frequencies(model, s_max: float) -> np.ndarray:
     return w2[(w2 > 0.0) & (w2 <= s_max)]
 
 
-def _pairs(x_red: np.ndarray, x_full: np.ndarray, common: slice) -> tuple[np.ndarray, np.ndarray]:
-    """For each reduced mode, the full mode of the most similar shape on the ``common`` coordinates (r and the
-    attachment motions a, the same in both problems): (indices, MAC), one full mode per reduced mode at most."""
+PAIRING_FREQUENCY_SCALE = 0.01
+"""Relative frequency distance that weighs as much as a full loss of shape similarity in the pairing (:func:`_pairs`):
+two modes 1 % apart cost as much as two with MAC 0."""
+
+
+def _pairs(x_red: np.ndarray, x_full: np.ndarray, common: slice, s_red: np.ndarray,
+           s_full: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """For each reduced mode, its full partner: the assignment of least total (1 - MAC) + |ln(f_red / f_full)| /
+    :data:`PAIRING_FREQUENCY_SCALE`, the MAC on the ``common`` coordinates (r and the attachment motions a, the same
+    in both problems), one full mode per reduced mode at most. The shape alone is ambiguous where a body's modes
+    barely move the attachments (a thin ring's), the frequency alone where modes cluster. Returns (indices, MAC)."""
     from scipy.optimize import linear_sum_assignment
 
     a = x_red[common] / np.maximum(np.linalg.norm(x_red[common], axis=0), 1e-300)
     b = x_full[common] / np.maximum(np.linalg.norm(x_full[common], axis=0), 1e-300)
     mac = (a.T @ b) ** 2
-    rows, cols = linear_sum_assignment(-mac)
+    distance = np.abs(0.5 * np.log(np.maximum(s_red, 1e-300)[:, None] / np.maximum(s_full, 1e-300)[None, :]))
+    rows, cols = linear_sum_assignment((1.0 - mac) + distance / PAIRING_FREQUENCY_SCALE)
     out = np.full(a.shape[1], -1)
     out[rows] = cols
     return out, mac[np.arange(a.shape[1]), out]
@@ -192,7 +201,7 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
         s_model = np.full(len(s_all), np.nan)
     n_common = len(coupled.rest) + coupled.c_r.shape[0] + coupled.n_attachments
     common_rows = np.r_[0:len(coupled.rest), len(coupled.rest) + coupled.c_r.shape[0]:n_common]
-    pair, mac = _pairs(x_rec, x_full, common_rows)
+    pair, mac = _pairs(x_rec, x_full, common_rows, s_rec, s_full)
     unpaired = np.setdiff1d(np.flatnonzero(s_full <= s_max), pair)
     hz = [np.sqrt(s) / (2 * np.pi) for s in (s_model, s_all, s_full[pair])]
     owners = _owners(coupled, flex, [b.component for b in bodies], x_full[:, unpaired])
