@@ -39,7 +39,7 @@ def wheel_body(spec, mesh: fg.GearMesh, modes: int = 12) -> fg.ReducedBody:
     solid = Cylinder(Pnt(0, 0, -h / 2), Z, r=r_out, h=h) - Cylinder(Pnt(0, 0, -h / 2), Z, r=BORE_M, h=h)
     fe = fg.fe_model(ngs.Mesh(OCCGeometry(solid).GenerateMesh(maxh=0.008)), spec.material_assumed, order=1)
     bore = np.flatnonzero(np.abs(np.hypot(fe.nodes[:, 0], fe.nodes[:, 1]) - BORE_M) < 1e-6)
-    return fg.reduce(fe, [fg.interface(fe, bore, "bore")], 20, n_compare=0, keep_modes=modes)
+    return fg.reduce(fe, [fg.interface(fe, bore, "bore")], 20, n_compare=0).truncated(modes)
 
 
 def build(mbs, spec):
