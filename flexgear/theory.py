@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.spec import GearboxSpec
 
-__all__ = ["Theory", "theory", "gear_set_theory"]
+__all__ = ["Theory", "theory", "gear_set_theory", "mesh_frequency_hz"]
 
 
 @dataclass(frozen=True)
@@ -46,6 +46,14 @@ class Theory:
 def theory(spec: GearboxSpec) -> Theory:
     """Theoretical values for the spec's load case at full speed and load (after the ramps)."""
     return gear_set_theory(spec, gear_set_geometry(spec))
+
+
+def mesh_frequency_hz(spec: GearboxSpec, speed_rpm: float) -> float:
+    """f_m = z_s |n_sun - n_carrier| / 60 [Hz] (module docstring) at the input speed ``speed_rpm`` [rpm]: the carrier
+    fixed for the star, turning at z_s / (z_s + z_r) of the input for the planetary arrangement."""
+    g = spec.gears
+    r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
 
 
 def gear_set_theory(spec: GearboxSpec, geo: GearSetGeometry) -> Theory:

@@ -13,6 +13,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from flexgear.theory import mesh_frequency_hz
+
 __all__ = ["Response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS", "RPM"]
 
 DEFAULT_HARMONICS = 10
@@ -206,14 +208,6 @@ def waveform_peak(amplitudes: np.ndarray, mean: float = 0.0) -> float:
     h = np.arange(1, x.size + 1)
     phi = np.linspace(0.0, 2.0 * math.pi, WAVEFORM_SAMPLES_PER_HARMONIC * max(x.size, 1), endpoint=False)
     return float(mean + (np.exp(1j * np.outer(phi, h)) @ x).real.max())
-
-
-def mesh_frequency_hz(spec: Any, speed_rpm: float) -> float:
-    """f_mesh = z_sun (n_in - n_carrier) / 60 [Hz] at the input speed ``speed_rpm`` (carrier speed from the
-    arrangement: fixed for the star, z_s / (z_s + z_r) of the input for the planetary)."""
-    g = spec.gears
-    r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
-    return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
 
 
 def _excited(spec: Any, harmonics: int) -> Any:

@@ -17,8 +17,8 @@ import numpy as np
 from numba import njit
 
 __all__ = ["impact_normal_force", "linear_normal_force", "backlash_linear_force", "series_value", "tooth_friction",
-           "mesh_friction_forces", "periodic_values", "ramp_state", "interpolated_columns", "turn_columns",
-           "mesh_step", "bound_entry", "padded_sparse_rows"]
+           "mesh_friction_forces", "periodic_values", "ramp_state", "interpolated_columns", "grid_position",
+           "turn_columns", "mesh_step", "bound_entry", "padded_sparse_rows"]
 
 TANH_SATURATION = 19.1
 """|x| beyond which tanh(x) rounds to +-1 in double precision (1 - tanh(19.1) = 5e-17 < 2^-54)."""
@@ -150,16 +150,20 @@ def interpolated_columns(matrix, theta, tables, rows, first, n_modes, signs, psi
     coefficients c(alpha) at alpha = psi_j - spin_j theta, linearly interpolated on the periodic grid
     ``tables[j]`` (n_grid, width), times signs_j, go to row rows_j, columns first_j .. first_j + n_modes_j.
     """
-    n_grid = tables.shape[1]
-    two_pi = 2.0 * math.pi
     for j in range(rows.shape[0]):
-        a = ((psi[j] - spin[j] * theta) % two_pi) * (n_grid / two_pi)
-        fl = math.floor(a)
-        w = a - fl
-        i0 = int(fl) % n_grid
-        i1 = (i0 + 1) % n_grid
+        i0, i1, w = grid_position(psi[j] - spin[j] * theta, tables.shape[1])
         for m in range(n_modes[j]):
             matrix[rows[j], first[j] + m] = signs[j] * ((1.0 - w) * tables[j, i0, m] + w * tables[j, i1, m])
+
+
+@njit(cache=True)
+def grid_position(alpha, n_grid):  # pragma: no cover - compiled
+    """Where angle ``alpha`` [rad] falls on a periodic grid of ``n_grid`` equal steps over one turn: the two
+    neighbouring grid indices and the linear-interpolation weight of the second."""
+    a = (alpha % (2.0 * math.pi)) * (n_grid / (2.0 * math.pi))
+    fl = math.floor(a)
+    i0 = int(fl) % n_grid
+    return i0, (i0 + 1) % n_grid, a - fl
 
 
 @njit(cache=True)

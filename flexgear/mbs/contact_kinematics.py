@@ -30,7 +30,7 @@ import numpy as np
 from numba import njit
 
 from flexgear.fe.attachment import LoadCircle, circle_band, fourier_basis, local_directions
-from flexgear.laws.compiled import bound_entry, ramp_state
+from flexgear.laws.compiled import bound_entry, grid_position, ramp_state
 from flexgear.laws.ramps import drive_angle
 
 __all__ = ["ModalColumn", "modal_contact_coefficients", "modal_contact_fourier", "ContactKinematics", "PreStepChain"]
@@ -87,14 +87,8 @@ def interpolated_entries(buffer, t, ramp_time, drive_speed, tables, dest, n_mode
     the STEP ramp (``ramp_time`` [s]), coefficient m of column set j going to ``buffer[dest[j, m]]`` (-1: to no
     block)."""
     theta = drive_speed * ramp_state(t, ramp_time)[0]
-    n_grid = tables.shape[1]
-    two_pi = 2.0 * math.pi
     for j in range(dest.shape[0]):
-        a = ((psi[j] - spin[j] * theta) % two_pi) * (n_grid / two_pi)
-        fl = math.floor(a)
-        w = a - fl
-        i0 = int(fl) % n_grid
-        i1 = (i0 + 1) % n_grid
+        i0, i1, w = grid_position(psi[j] - spin[j] * theta, tables.shape[1])
         for m in range(n_modes[j]):
             k = dest[j, m]
             if k >= 0:

@@ -60,7 +60,8 @@ import numpy as np
 import pandas as pd
 
 from flexgear.modal import LinearModel, Modes
-from flexgear.schema import GearboxSpec, Variant
+from flexgear.schema import Variant
+from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["Campbell", "campbell", "excited_kinds", "mesh_frequency_hz", "track", "MESH_ORDERS", "MAX_DAMPING_RATIO",
            "MAC_MIN"]
@@ -74,13 +75,6 @@ MAX_DAMPING_RATIO = 1.0 / math.sqrt(2.0)
 MAC_MIN = 0.3
 """Lowest MAC that continues a line between neighbouring speeds (module docstring: the members of a degenerate
 pair reach 1/2, less where the speed step perturbs the pair's subspace)."""
-
-
-def mesh_frequency_hz(spec: GearboxSpec, speed_rpm: float) -> float:
-    """Mesh frequency f_m [Hz] at the input speed ``speed_rpm`` [rpm] (flexgear.theory.theory's formula)."""
-    from flexgear.theory import theory
-
-    return theory(spec.with_fields("load_case", input_speed_rpm=float(speed_rpm))).mesh_frequency
 
 
 SYMMETRIC_KINDS = ("rotational", "translational", "planet")
