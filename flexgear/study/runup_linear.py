@@ -29,10 +29,11 @@ no resonance. The output is y = a^T M^-1 (u - K z - (D + G) z'): the modes' part
 Load along the ramp. The impact law's tangent stiffness 1.5 k delta_0^0.5 follows the mesh load, which rises with
 the ramp: with ``along_ramp`` the model is linearised at several times of the ramp (:data:`RAMP_POINTS`), each at
 the run's instantaneous speed and with the load torque scaled by s(t) there (the static mesh forces are
-proportional to the torque: the model's static mesh force then equals the run's mean mesh force) (the drive's inertia torque included); the matrices are held piecewise constant between the
-midpoints of those times and the physical state is carried across each switch (x = V eta). The force f_h stays
-the operating point's (the load enters once, through s(t)). Only the orders 1..H are tracked: a linear model
-responds at the harmonics it is driven with, the higher orders hold only the switches' small transients.
+proportional to the torque: the model's static mesh force then equals the run's mean mesh force, the drive's
+inertia torque included); the matrices are held piecewise constant between the midpoints of those times and
+the physical state is carried across each switch (x = V eta). The force f_h stays the operating point's (the
+load enters once, through s(t)). Only the orders 1..H are tracked: a linear model responds at the harmonics it is
+driven with, the higher orders hold only the switches' small transients.
 """
 
 from __future__ import annotations
