@@ -51,6 +51,7 @@ from flexgear.results import RunResult
 from flexgear.study.runup import (
     DEFAULT_HOP_S,
     DEFAULT_WINDOW_S,
+    MIN_MESH_CYCLES,
     ORDERS,
     RPM_PER_DEG_PER_S,
     mesh_excitation,
@@ -218,7 +219,7 @@ def linear_runup(result: RunResult, variant: Any, along_ramp: bool = False, harm
     f_static = float(ops[0].f0.sum())
     envelope = raw / f_static
     if along_ramp:
-        t_lo = float(t[np.searchsorted(n, 8.0 / (per_rpm * window_s))])  # the tracks' first resolved speed
+        t_lo = float(t[np.searchsorted(n, MIN_MESH_CYCLES / (per_rpm * window_s))])  # the first resolved speed
         times = np.linspace(t_lo, ramp, RAMP_POINTS)
         at = np.searchsorted(t, times)
         systems = [dataclasses.replace(sy, forces=nominal[0].forces)  # F_0 C_h s(t): the load once, in s(t)
