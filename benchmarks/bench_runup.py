@@ -1,6 +1,7 @@
 """Run-up order map of a saved run against its variant's Campbell diagram: the strongest ridges and their predictions.
 
-    python benchmarks/bench_runup.py [RUN_DIR] [VARIANT_FILE]   (default: results/full/model1, model1.toml)
+    python benchmarks/bench_runup.py [RUN_DIR] [VARIANT_FILE] [--frictionless]
+                                                  (default: results/full/model1, model1.toml)
 
 Prints, per bearing, the three strongest ridges (speed, order, prominence) with the matched crossing of the same
 order (one the order excites, flexgear.modal.campbell: mesh phasing) and the ridge's error against it and against
@@ -11,7 +12,12 @@ check: the ridge's complex order track A_k(t) (the demodulated sum before the mo
 fitted by least squares as sum_j c_j a_j(t) + b_0 + b_1 (n - n_ridge) / n_ridge, a_j the swept single-mode tracks of
 the excited crossings of the order (one per degenerate pair; complex c_j, b_0, b_1 free): the relative residual with
 and without the matched mode (a weak mode on the others' off-resonant response peaks where their phases agree, not
-at its own resonance: the fit holds it at its swept prediction); and the CPU times.
+at its own resonance: the fit holds it at its swept prediction); the nearest ridge of the same order in the
+linearised model's own run-up, all modes together under the run's speed history and mesh load
+(flexgear.study.runup_linear.linear_runup: at the load case's operating point, and along the ramp with the
+load-dependent tangent stiffness), and that run-up's own strongest ridges; a summary of the three strongest ridges
+of both bearings against it; with --frictionless, the variant run again without tooth friction (which the
+linearised model leaves out) and its ridges against the linear run-up; and the CPU times.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ from flexgear.modal import campbell, linearize, modes
 from flexgear.results import load_result
 from flexgear.spec import load_variant
 from flexgear.study.runup import DEFAULT_HOP_S, DEFAULT_WINDOW_S, _blackman_harris, mesh_excitation, mesh_phase, runup
+from flexgear.study.runup_linear import RAMP_POINTS, linear_runup, match_linear
 
 ROOT = Path(__file__).resolve().parents[1]
 PAIR_RTOL = 5e-3
@@ -89,21 +96,36 @@ def interference(result, side: str, ridge, crossings, per_rpm: float) -> tuple[f
 
 
 def main() -> None:
-    run_dir = Path(sys.argv[1]) if len(sys.argv) > 1 else ROOT / "results" / "full" / "model1"
-    variant = load_variant(sys.argv[2] if len(sys.argv) > 2 else ROOT / "model_variants" / "model1.toml")
+    args = [a for a in sys.argv[1:] if not a.startswith("--")]
+    run_dir = Path(args[0]) if args else ROOT / "results" / "full" / "model1"
+    variant = load_variant(args[1] if len(args) > 1 else ROOT / "model_variants" / "model1.toml")
     result = load_result(run_dir)
     t0 = time.process_time()
     c = campbell(variant, np.linspace(0.0, variant.gearbox.load_case.input_speed_rpm, 13))
     print(f"Campbell of {variant.name}, 13 speeds: {time.process_time() - t0:.1f} s CPU")
+    t0 = time.process_time()
+    linear = linear_runup(result, variant)
+    print(f"linear run-up at the operating point ({linear.harmonics} mesh harmonics): "
+          f"{time.process_time() - t0:.1f} s CPU")
+    t0 = time.process_time()
+    ramp = linear_runup(result, variant, along_ramp=True)
+    print(f"linear run-up along the ramp ({RAMP_POINTS} linearisations): {time.process_time() - t0:.1f} s CPU")
+    top = []
     for side in ("output", "input"):
         t0 = time.process_time()
-        ru = runup(result, side, campbell=c)
+        ru = runup(result, side, campbell=c, linear=linear)
+        column = f"{side}_bearing_accel_x_m_per_s2"
+        on_ramp = match_linear(ru.ridges.head(3), ramp.ridges[column])
         print(f"{run_dir.name} {side} bearing: {time.process_time() - t0:.2f} s CPU, {len(ru.ridges)} ridges")
-        for _, r in ru.ridges.head(3).iterrows():
+        for j, (_, r) in enumerate(ru.ridges.head(3).iterrows()):
+            top.append((side, r, on_ramp.iloc[j]))
             print(f"  {r['order']:.0f}x ridge at {r['speed_rpm']:7.1f} rpm, t = {r['time_s']:.4f} s "
                   f"({r['prominence_db']:.1f} dB): crossing {r['crossing_rpm']:7.1f} rpm ({r['kind']}, "
                   f"{r['mode_hz']:.1f} Hz), error {r['error_pct']:+.2f} %; swept prediction "
                   f"{r['swept_rpm']:7.1f} rpm, error {r['swept_error_pct']:+.2f} %")
+            print(f"      nearest {r['order']:.0f}x ridge of the linear run-up {r['linear_rpm']:7.1f} rpm, error "
+                  f"{r['linear_error_pct']:+.2f} %; along the ramp {on_ramp.iloc[j]['linear_rpm']:7.1f} rpm, error "
+                  f"{on_ramp.iloc[j]['linear_error_pct']:+.2f} %")
             if r["mode_hz"] == r["mode_hz"]:
                 f, n_op = operating_point_crossing(variant, r, ru.map.mesh_hz_per_rpm)
                 print(f"      mode at the ridge's operating point: {f:.2f} Hz, crossing {n_op:7.1f} rpm "
@@ -111,6 +133,38 @@ def main() -> None:
                 res, res0, count = interference(result, side, r, c.crossings, ru.map.mesh_hz_per_rpm)
                 print(f"      complex track fitted by the {count} excited modes' swept tracks: residual "
                       f"{100 * res:.2f} % with the matched mode, {100 * res0:.1f} % without it")
+        for name, lin in (("operating point", linear), ("along the ramp", ramp)):
+            own = ", ".join(f"{q['order']:.0f}x {q['speed_rpm']:.1f} rpm ({q['prominence_db']:.1f} dB, "
+                            f"{q['amplitude']:.3g} m/s^2)" for _, q in lin.ridges[column].head(3).iterrows())
+            print(f"  linear run-up ({name}), its strongest ridges: {own or 'none'}")
+    top.sort(key=lambda x: -x[1]["prominence_db"])
+    print("the three strongest ridges against the linear run-up (operating point | along the ramp):")
+    for side, r, q in top[:3]:
+        print(f"  {side} {r['order']:.0f}x {r['speed_rpm']:7.1f} rpm ({r['prominence_db']:.1f} dB): "
+              f"{r['linear_rpm']:7.1f} rpm {r['linear_error_pct']:+.2f} % | {q['linear_rpm']:7.1f} rpm "
+              f"{q['linear_error_pct']:+.2f} %")
+    within = sum(abs(r["linear_error_pct"]) <= 3.0 for _, r, _ in top[:3])
+    print(f"  {within} of {min(3, len(top))} within 3 % of the linear run-up's ridges")
+    if "--frictionless" in sys.argv:
+        frictionless(variant, linear)
+
+
+def frictionless(variant, linear) -> None:
+    """The variant run again without tooth friction (the linearised model leaves it out, flexgear.modal.linear):
+    its strongest ridges against the linear run-up."""
+    import dataclasses
+
+    from flexgear.mbs.run import run_variant
+
+    t0 = time.process_time()
+    free = run_variant(dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("contact",
+                                                                                        friction_coefficient=0.0)))
+    print(f"{variant.name} without tooth friction: {time.process_time() - t0:.1f} s CPU")
+    for side in ("output", "input"):
+        for _, r in runup(free, side, linear=linear).ridges.head(3).iterrows():
+            print(f"  {side} {r['order']:.0f}x ridge at {r['speed_rpm']:7.1f} rpm ({r['prominence_db']:.1f} dB, "
+                  f"{r['amplitude']:.3g} m/s^2): linear run-up {r['linear_rpm']:7.1f} rpm, error "
+                  f"{r['linear_error_pct']:+.2f} %")
 
 
 if __name__ == "__main__":

@@ -14,6 +14,7 @@ from flexgear.laws.ramps import step
 from flexgear.study.runup import (
     match_crossings,
     mesh_excitation,
+    mesh_phase,
     order_tracks,
     ridges,
     spectrogram,
@@ -142,3 +143,62 @@ def test_ridges_match_excited_crossings_by_their_swept_prediction():
     ridge = pd.DataFrame({"speed_rpm": [float(swept["swept_rpm"].iloc[0])], "order": [1]})
     matched = match_crossings(ridge, swept, on="swept_rpm")
     assert matched["mode"].iloc[0] == 1 and matched["swept_error_pct"].iloc[0] == pytest.approx(0.0)
+
+
+def test_linear_runup_of_one_mode_is_the_swept_prediction():
+    """The linear run-up of a one-mode system (unit mass, forced by s(t) Re(e^{i 2 pi phi})) is swept_peak's own
+    signal: both integrate the same ODE exactly for the piecewise-linear forcing, so they coincide to round-off;
+    split into segments of the same system, with the state carried across, it is unchanged."""
+    from flexgear.study.runup_linear import LinearSystem, linear_response, match_linear
+
+    t, n, load = _fast_runup()
+    f, z = 955.0, 0.073
+    w = 2 * math.pi * f
+    one = LinearSystem(np.eye(1), np.array([[2 * z * w]]), np.array([[w * w]]), np.ones((1, 1), complex), np.eye(1))
+    phase = mesh_phase(t, n, PER_RPM)
+    y = linear_response(t, phase, load, [one])[0]
+    reference = _driven(t, n, load, f, z, 1)
+    assert np.abs(y - reference).max() <= 1e-9 * np.abs(reference).max()
+    split = linear_response(t, phase, load, [one] * 3, [0, t.size // 3, 2 * t.size // 3])[0]
+    assert np.abs(split - y).max() <= 1e-9 * np.abs(y).max()
+    found = ridges(order_tracks(t, y, n, PER_RPM, orders=(1,), ramp_end_s=STUDY_RAMP))
+    assert found["speed_rpm"].iloc[0] == pytest.approx(swept_peak(t, n, PER_RPM, 1, f, z, excitation=load), rel=1e-12)
+    assert match_linear(found, found)["linear_error_pct"].iloc[0] == 0.0
+
+
+def test_linear_runup_at_constant_speed_is_the_harmonic_solve():
+    """At a constant speed the linear run-up of a gyroscopic, non-proportionally damped system with two contacts
+    settles to the harmonic-response stage's own steady solution (flexgear.harmonic.base._solve) at each mesh
+    harmonic: its order track equals the bearing acceleration's |Y_h| to within the first-order hold's attenuation
+    of the forcing the modes see, (2 pi h f_m dt)^2 / 12 of the modes' part Y_h - a^T M^-1 f_h of the output (the
+    direct part a^T M^-1 u is exact at the samples), plus the track window's side lobes (-92 dB) of the other
+    harmonics."""
+    from flexgear.harmonic.base import ACCEL_INDICATORS, _Operating, _solve, excitation
+    from flexgear.study.runup import SIDE_LOBE_DB
+    from flexgear.study.runup_linear import LinearSystem, linear_response
+
+    mass = np.diag([1.0, 2.0, 1.5])
+    k = np.array([[6.0, -2.0, 0.0], [-2.0, 9.0, -3.0], [0.0, -3.0, 7.0]]) * 4e7  # modes of 700-1700 Hz
+    damping = 3e-5 * k + 40.0 * np.diag([1.0, 0.0, 2.0])  # not proportional
+    gyro = 300.0 * np.array([[0.0, 1.0, 0.0], [-1.0, 0.0, 0.5], [0.0, -0.5, 0.0]])
+    rows = np.array([[1.0, -0.5, 0.0], [0.0, 0.3, -1.0]])
+    coef = np.array([[0.05 - 0.02j, 0.01 + 0.004j], [0.03 + 0.04j, -0.006 + 0.002j]])  # C_h, h = 1, 2
+    accel = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.0, 0.5]])
+    f_m, harmonics = 1000.0, 2
+    op = _Operating(mass, damping + gyro, k, rows, np.full(2, 1e8), np.zeros(2), np.array([900.0, 1100.0]), coef,
+                    np.arange(2), ("outer_mesh_force_1_n", "inner_mesh_force_1_n"), accel, np.zeros(3),
+                    2 * math.pi * f_m)
+    steady = _solve(op, harmonics)
+    system = LinearSystem(mass, damping + gyro, k, excitation(op, harmonics)[1], accel)
+    t = np.arange(0.0, 0.2, DT)  # > 30 time constants 1 / (zeta omega) of the slowest decaying mode
+    n = np.full(t.size, f_m / PER_RPM)
+    y = linear_response(t, mesh_phase(t, n, PER_RPM), np.ones(t.size), [system])
+    direct = accel @ np.linalg.solve(mass, system.forces.T)  # (4, H): a^T M^-1 f_h
+    for i, name in enumerate(ACCEL_INDICATORS):
+        amp = np.abs(steady[name])
+        tracks = order_tracks(t, y[i], n, PER_RPM, orders=(1, 2))
+        for h in (1, 2):
+            a = tracks[(tracks["order"] == h) & (tracks["time_s"] > 0.15)]["amplitude"].to_numpy()
+            modal = abs(steady[name][h - 1] - direct[i, h - 1]) / amp[h - 1]
+            tol = (2 * math.pi * h * f_m * DT) ** 2 / 12 * modal + 10 ** (SIDE_LOBE_DB / 20) * amp.sum() / amp[h - 1]
+            assert np.abs(a / amp[h - 1] - 1.0).max() <= tol, (name, h)

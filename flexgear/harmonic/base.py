@@ -15,7 +15,8 @@ import pandas as pd
 
 from flexgear.theory import mesh_frequency_hz
 
-__all__ = ["Response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS", "RPM"]
+__all__ = ["Response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS", "RPM", "ACCEL_INDICATORS",
+           "excitation"]
 
 DEFAULT_HARMONICS = 10
 """Mesh harmonics h = 1..H of the excitation and response."""
@@ -127,6 +128,16 @@ class _Operating:
 
 
 _ACCEL = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
+ACCEL_INDICATORS = _ACCEL
+"""The bearing accelerations, in the order of the rows of ``_Operating.accel`` (q'' of each is accel[k] @ z'')."""
+
+
+def excitation(op: _Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+    """The excitation at mesh harmonics h = 1..``harmonics`` (flexgear.harmonic.response): (F_h = F_0 C_h of every
+    contact (n_c, H) [N], the generalised forces -g^T F_h summed over the contacts (H, n) [N or N m per
+    coordinate]); the time force is Re sum_h (-g^T F_h) e^{i 2 pi h phi} for the mesh phase phi [cycles]."""
+    excite = op.f0[:, None] * op.coef[:, :harmonics]  # (n_c, H): F_0 C_h
+    return excite, -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
 
 
 def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
@@ -134,8 +145,7 @@ def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
     h = np.arange(1, harmonics + 1)
     w = h * op.omega_mesh
     n = op.mass.shape[0]
-    excite = op.f0[:, None] * op.coef  # (n_c, H): F_0 C_h
-    f = -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
+    excite, f = excitation(op, harmonics)
     if op.solver is not None:
         x = op.solver(w, -excite.T)
     else:

@@ -67,7 +67,7 @@ from flexgear.harmonic.base import (
 from flexgear.harmonic.reduced import MODAL_CUTOFF_RATIO
 
 __all__ = ["Response", "harmonic_response", "linearize_same_angle", "mesh_frequency_hz", "INDICATOR_UNITS",
-           "DEFAULT_HARMONICS", "LINEARIZATIONS"]
+           "DEFAULT_HARMONICS", "LINEARIZATIONS", "frozen_operating"]
 
 
 def _lagrange(nodes: np.ndarray, x: float) -> np.ndarray:
@@ -217,6 +217,26 @@ def _check_contacts(lm: Any, names: list[str]) -> None:
 
 def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.ndarray, harmonics: int,
                t0: float, spin: bool = False, modal_cutoff_ratio: float | None = None) -> Response:
+    operating = _mbs_operating(variant, nodes, models, harmonics, spin, modal_cutoff_ratio)
+    return _sweep(operating, speeds, harmonics, variant.name, mesh_frequency_hz(variant.gearbox, 1.0), t0)
+
+
+def frozen_operating(models: Sequence[Any], harmonics: int = DEFAULT_HARMONICS) -> list[_Operating]:
+    """The linear problem (flexgear.harmonic.base._Operating: M, D + G, K, the contacts' excitation F_h and the
+    outputs' rows) of each flexgear.modal.linear.LinearModel of ``models`` at its own speed and operating point,
+    all on the first model's independent coordinates (the matrices of each frozen at its linearisation)."""
+    ref = models[0]
+    variant = dataclasses.replace(ref.variant, gearbox=_excited(ref.variant.gearbox, harmonics))
+    out = []
+    for lm in [ref] + [_in_coordinates(m, ref) for m in models[1:]]:
+        out.append(_mbs_operating(variant, np.array([lm.speed_rpm]), [lm], harmonics)(float(lm.speed_rpm)))
+    return out
+
+
+def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics: int, spin: bool = False,
+                   modal_cutoff_ratio: float | None = None) -> Any:
+    """The linear problem at any speed [rpm] (a callable returning flexgear.harmonic.base._Operating) from the
+    linearisations ``models`` at ``nodes`` [rpm] (Lagrange interpolation, or the spin fit where ``spin``)."""
     from flexgear.geometry.involute import gear_set_geometry
     from flexgear.laws.contact import normal_force
     from flexgear.mbs.gearbox import mesh_contacts
@@ -278,9 +298,7 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
         return f0, kt, cc
 
     if spin:
-        return _sweep(_spin_operating(models, nodes, selectors, law_terms, coef, mesh, mesh_names, spec,
-                                      modal_cutoff_ratio),
-                      speeds, harmonics, variant.name, mesh_frequency_hz(spec, 1.0), t0)
+        return _spin_operating(models, nodes, selectors, law_terms, coef, mesh, mesh_names, spec, modal_cutoff_ratio)
     parts = [(m.mass, m.damping + m.gyroscopic, m.stiffness, *selectors(m)) for m in models]
     cache: dict[tuple[float, ...], tuple] = {}
 
@@ -297,7 +315,7 @@ def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.nd
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
         return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh)
 
-    return _sweep(operating, speeds, harmonics, variant.name, mesh_frequency_hz(spec, 1.0), t0)
+    return operating
 
 
 def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_terms: Any, coef: np.ndarray,

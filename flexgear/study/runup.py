@@ -50,7 +50,8 @@ excites (flexgear.modal.campbell: mesh phasing), each with its swept prediction 
 the line's damping ratio at the crossing): the ridge is matched with the nearest n_swept, swept_error =
 (n_ridge - n_swept) / n_swept, next to the error against the crossing itself. The Campbell diagram's operating point
 is the full load torque; the modes along the ramp differ where the mesh stiffness matters (the impact law's tangent
-1.5 k delta^0.5 follows the load), which flexgear.modal.linearize at the ridge's speed and time t* shows.
+1.5 k delta^0.5 follows the load), which flexgear.modal.linearize at the ridge's speed and time t* shows. The
+reference with all modes together is the linearised model's own run-up (flexgear.study.runup_linear, ``linear``).
 """
 
 from __future__ import annotations
@@ -266,10 +267,11 @@ SWEPT_SEARCH = 0.25
 """Relative speed range around a crossing in which :func:`swept_peak` takes its track's maximum [-]."""
 
 
-def mesh_excitation(signals: pd.DataFrame, window_s: float = DEFAULT_WINDOW_S) -> np.ndarray | None:
+def mesh_excitation(signals: pd.DataFrame, window_s: float = DEFAULT_WINDOW_S,
+                    reference_n: float | None = None) -> np.ndarray | None:
     """Amplitude s(t) of the mesh excitation along a run (module docstring): the sum of its recorded mesh forces
     (the columns named ``*mesh_force*`` [N]) averaged over a window of ``window_s`` [s], divided by its largest
-    value [-]; None where the run recorded no mesh force."""
+    value (or by ``reference_n`` [N] where given) [-]; None where the run recorded no mesh force."""
     from scipy.ndimage import uniform_filter1d
 
     cols = [c for c in signals.columns if "mesh_force" in c]
@@ -278,7 +280,7 @@ def mesh_excitation(signals: pd.DataFrame, window_s: float = DEFAULT_WINDOW_S) -
     t = signals["time_s"].to_numpy()
     m = max(int(round(window_s / _uniform_step(t))), 1) | 1  # odd: centred
     f = uniform_filter1d(np.abs(signals[cols].to_numpy(float)).sum(axis=1), m, mode="nearest")
-    top = float(f.max())
+    top = float(f.max()) if reference_n is None else float(reference_n)
     return f / top if top > 0.0 else None
 
 
@@ -389,12 +391,14 @@ class RunUp:
 
 def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: Any = None,
           window_s: float = DEFAULT_WINDOW_S, hop_s: float = DEFAULT_HOP_S,
-          orders: Sequence[int] = ORDERS) -> RunUp:
+          orders: Sequence[int] = ORDERS, linear: Any = None) -> RunUp:
     """The run-up of a saved run (module docstring) from the ``side`` ("input"/"output") bearing acceleration
     along ``axis`` ("x"/"y"); the instantaneous speed is the recorded input speed, the ramp's end the run's
     ``ramp_time_s``, the mesh frequency per rpm the run's theory values (mesh frequency / nominal input speed).
     ``campbell``: a flexgear.modal.campbell.Campbell whose crossings the ridges are matched with (module
-    docstring: by their swept predictions under the run's mesh excitation)."""
+    docstring: by their swept predictions under the run's mesh excitation). ``linear``: a
+    flexgear.study.runup_linear.LinearRunUp of the same run, whose ridges of the same signal the ridges are matched
+    with (linear_rpm, linear_error_pct: flexgear.study.runup_linear.match_linear)."""
     if not result.ok or result.signals is None:
         raise ValueError(f"run {result.name!r} has no signals")
     s = result.signals
@@ -421,4 +425,8 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
             found = match_crossings(found, crossings, on="swept_rpm")
         else:
             found = match_crossings(found, crossings)
+    if linear is not None:
+        from flexgear.study.runup_linear import match_linear  # it builds on this module
+
+        found = match_linear(found, linear.ridges[column])
     return RunUp(result.name, mp, tracks, found, ramp, tuple(orders))
