@@ -103,7 +103,8 @@ def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
 def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
     """(load circle of order 0, angles of the contacts on it [rad]) per contact band of a gear.
 
-    Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
+    From the design's mesh contact geometry (flexgear.design ``meshes``), meshes as
+    flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
     pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it; planet 1
     (at angle 0) meets the sun at angle pi and the ring at 0 about its own centre.
     """

@@ -310,7 +310,7 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
     until_settled = t_end_s == "settled" or (t_end_s is None and lc.end == "settled")
     t_end = lc.end_time_s if (t_end_s is None or until_settled) else float(t_end_s)
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
-    # the design and the run's metadata, once, before the model is built from the design
+    # the design and the run's metadata, made once at the start; the model below is built from this design
     gb = variant.gearbox
     d = design(gb)
     run_key, spec_data = spec_hash(variant, t_end), as_dict(gb)
