@@ -1,10 +1,12 @@
 """The gearbox's design: what a spec fixes for every later stage, derived from it once.
 
-A :class:`Design` holds the spec and what the geometry stage makes of it: the gear set (profile-shifted gears
-and meshes, flexgear.geometry.involute.gear_set_geometry), the theoretical values (flexgear.theory), the Table 2
-bearings at their seats (flexgear.geometry.supports), the gears' tooth profiles and, on demand, each component's
-layout and exact mass properties (flexgear.geometry.layout). The FE, contact-law, multibody and lumped stages take
-the design and read these from it; what they cache on disk stays keyed by the spec it carries.
+A :class:`Design` holds the spec and what the geometry stage makes of it, all made in :func:`design`: the gear
+set (profile-shifted gears and meshes, flexgear.geometry.involute.gear_set_geometry), the theoretical values
+(flexgear.theory), the gears' tooth profiles, every component's layout and exact mass properties
+(flexgear.geometry.layout; the mass properties cached on disk), the Table 2 bearings at their seats
+(flexgear.geometry.supports) and each mesh's contact geometry (helix halves, tooth normals and contact-line
+series, flexgear.geometry.contact_lines). The FE, contact-law, multibody and lumped stages take the design and
+read these from it; what they cache on disk stays keyed by the spec it carries.
 
 :func:`design` makes it, once per spec content (flexgear.spec.spec_hash: file paths excluded).
 """
@@ -12,8 +14,8 @@ the design and read these from it; what they cache on disk stays keyed by the sp
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
-from functools import cached_property
 
+from flexgear.geometry.contact_lines import MeshContactGeometry, mesh_contact_geometry
 from flexgear.geometry.elements import BearingElement
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
 from flexgear.geometry.layout import (
@@ -26,40 +28,42 @@ from flexgear.geometry.layout import (
 from flexgear.geometry.massprops import MassProperties
 from flexgear.geometry.profile import ToothProfile
 from flexgear.geometry.supports import seat_supports
-from flexgear.spec import GearboxSpec, spec_hash
-from flexgear.theory import Theory, gear_set_theory
+from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
+from flexgear.theory import Theory, theory
 
 __all__ = ["Design", "design", "as_design"]
 
 
 @dataclass(frozen=True, eq=False)
 class Design:
-    """A spec and its gear set and theory; bearings, profiles, layouts and mass properties derived on first use."""
+    """A spec and everything the later stages take from its geometry (SI units).
+
+    ``gears``: the gear set; ``theory``: its theoretical values; ``profiles``: tooth profiles of sun, planet and
+    ring (flexgear.geometry.layout.tooth_profiles); ``layouts``: every geometry component's prisms in its frame
+    (flexgear.spec.GEOMETRY_COMPONENTS); ``masses``: each one's mass [kg], centre of mass [m] and inertia about
+    it [kg m^2] from the exact section integrals (flexgear.geometry.layout.component_mass_properties, cached on
+    disk under the same key); ``supports``: the Table 2 bearings at their seats
+    (flexgear.geometry.supports.gearbox_supports); ``meshes``: the contact geometry of the sun-planet ("outer",
+    sun = gear 1 of hand +1 in the +z half) and the planet-ring ("inner", planet = gear 1 of hand -1) mesh, with
+    ``[contact_assumed] stiffness_harmonics`` harmonics in the contact-line series.
+    """
 
     spec: GearboxSpec
     gears: GearSetGeometry
     theory: Theory
-
-    @cached_property
-    def profiles(self) -> dict[str, ToothProfile]:
-        """Tooth profiles of sun, planet and ring (flexgear.geometry.layout.tooth_profiles)."""
-        return tooth_profiles(self.gears, self.spec.gears_assumed.root_fillet_coefficient)
-
-    @cached_property
-    def supports(self) -> dict[str, BearingElement]:
-        """The Table 2 bearings at their seats (flexgear.geometry.supports.gearbox_supports)."""
-        return seat_supports(self.spec, self.layout("input_shaft"), self.layout("output_shaft"))
+    profiles: dict[str, ToothProfile]
+    layouts: dict[str, ComponentLayout]
+    masses: dict[str, MassProperties]
+    supports: dict[str, BearingElement]
+    meshes: dict[str, MeshContactGeometry]
 
     def layout(self, component: str) -> ComponentLayout:
-        """The prisms of ``component`` in its frame (flexgear.geometry.layout.component_layout)."""
-        return gear_set_layout(self.spec, self.gears, component)
+        """The prisms of ``component`` in its frame (``layouts[component]``)."""
+        return self.layouts[component]
 
     def mass_properties(self, component: str) -> MassProperties:
-        """Mass [kg], centre of mass [m], inertia [kg m^2] of ``component`` from the exact section integrals
-        (flexgear.geometry.layout.component_mass_properties, cached on disk under the same key)."""
-        rho = self.spec.material_assumed.density_kg_m3
-        return cached_mass_properties(self.spec, component,
-                                      lambda: layout_mass_properties(self.layout(component), self.profiles, rho))
+        """The exact mass properties of ``component`` (``masses[component]``: kg, m, kg m^2)."""
+        return self.masses[component]
 
 
 _DESIGNS: dict[str, Design] = {}
@@ -72,8 +76,19 @@ def design(spec: GearboxSpec) -> Design:
     key = spec_hash(spec)
     made = _DESIGNS.get(key)
     if made is None:
-        geo = gear_set_geometry(spec)
-        made = Design(spec, geo, gear_set_theory(spec, geo))
+        th = theory(spec)
+        geo = gear_set_geometry(spec)  # the gear set the theory was made of (cached per gear tables)
+        profiles = tooth_profiles(geo, spec.gears_assumed.root_fillet_coefficient)
+        layouts = {c: gear_set_layout(spec, geo, c) for c in GEOMETRY_COMPONENTS}
+        rho = spec.material_assumed.density_kg_m3
+        masses = {c: cached_mass_properties(spec, c, lambda c=c: layout_mass_properties(layouts[c], profiles, rho))
+                  for c in GEOMETRY_COMPONENTS}
+        supports = seat_supports(spec, layouts["input_shaft"], layouts["output_shaft"])
+        harmonics = spec.contact_assumed.stiffness_harmonics
+        meshes = {kind: mesh_contact_geometry(mesh, geo.helix_layout, geo.helix_face_width, geo.half_gap, hand,
+                                              harmonics)
+                  for kind, mesh, hand in (("outer", geo.sun_planet, 1), ("inner", geo.planet_ring, -1))}
+        made = Design(spec, geo, th, profiles, layouts, masses, supports, meshes)
         if len(_DESIGNS) >= _MAX_DESIGNS:
             _DESIGNS.pop(next(iter(_DESIGNS)))
         _DESIGNS[key] = made

@@ -42,7 +42,7 @@ def bolt_axes(spec: GearboxSpec | Design) -> tuple[np.ndarray, float, float]:
     Hole k at polar angle 2 pi k / n on the ring flange's hole circle (flexgear.geometry.layout); z_j is the
     flange's +z face, where the output shaft's web lies on it. ``spec``: a spec or its design (flexgear.design).
     """
-    flange = next(p for p in as_design(spec).layout("ring").prisms if p.section.holes)
+    flange = next(p for p in as_design(spec).layouts["ring"].prisms if p.section.holes)
     return flange.section.hole_centres(), flange.section.hole_radius, flange.z1
 
 

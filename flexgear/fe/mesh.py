@@ -143,7 +143,7 @@ def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = 
         from flexgear.geometry.solids import component_solid
 
         t0 = time.perf_counter()
-        shape = component_solid(d.layout(component))
+        shape = component_solid(d.layouts[component])
         tmp = _private_temporary(path, ".brep")
         shape.WriteBrep(str(tmp))
         tmp.replace(path)
@@ -166,7 +166,7 @@ def _refine_teeth(geo, d: Design, component: str, size: float, mp) -> None:
     ``mp.RestrictH`` along them (a face's ``maxh`` property would cover both, but only when set
     before the OCCGeometry is built, which costs a second build of it: 2.5 s for the ring).
     """
-    layout = d.layout(component)
+    layout = d.layouts[component]
     bands = []
     if layout.gear is not None:
         g = layout.gear
@@ -216,7 +216,7 @@ def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
     """Named boundary node sets of ``component`` of design ``d`` (indices into ``nodes``, among ``boundary``)."""
-    spec, layout = d.spec, d.layout(component)
+    spec, layout = d.spec, d.layouts[component]
     p = nodes[boundary]
     r = np.hypot(p[:, 0], p[:, 1])
     z = p[:, 2]
@@ -251,18 +251,11 @@ def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndar
         outer = on_cylinder(tube.section.outer)
         if component == "input_shaft":
             out["bearing_seat"] = boundary[outer & (z < tube.z0 + width + tol)]
-            sun = d.layout("sun").z_range
+            sun = d.layouts["sun"].z_range
             out["gear_seat"] = boundary[outer & (z > sun[0] - tol)]
         else:
             out["bearing_seat"] = boundary[outer & (z > tube.z1 - width - tol)]
     return {k: np.unique(v) for k, v in out.items()}
-
-
-def _paths(spec: GearboxSpec, component: str, level: str, order: int) -> dict[str, Path]:
-    settings = spec.meshing_assumed[level]
-    key = geometry_hash(spec, component, settings, order, _GRADING, _MESH_VERSION)
-    stem = cache_dir() / f"mesh-{component}-{level}-o{order}-{key}"
-    return {"npz": stem.with_suffix(".npz"), "vol": stem.with_suffix(".vol.gz"), "json": stem.with_suffix(".json")}
 
 
 def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coarse", order: int | None = None,
@@ -281,10 +274,19 @@ def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coa
 def _mesh(d: Design, component: str, level: str, order: int, progress: bool) -> ComponentMesh:
     """The cached mesh (:func:`_cached_mesh`), or the one built and stored (:func:`_build_mesh`) when it is
     missing or cannot be read, by one process at a time (the lock of its JSON summary)."""
-    paths = _paths(d.spec, component, level, order)
     brep = component_brep(d, component, progress)
-    return load_or_build(paths["json"], lambda: _cached_mesh(paths, component, level, order, brep),
-                         lambda: _build_mesh(d, component, level, order, progress)[0])
+    # the cache entry: keyed by the geometry, the level's settings, the order and the meshing procedure
+    key = geometry_hash(d.spec, component, d.spec.meshing_assumed[level], order, _GRADING, _MESH_VERSION)
+    stem = cache_dir() / f"mesh-{component}-{level}-o{order}-{key}"
+    paths = {"npz": stem.with_suffix(".npz"), "vol": stem.with_suffix(".vol.gz"), "json": stem.with_suffix(".json")}
+
+    def load() -> ComponentMesh | None:
+        return _cached_mesh(paths, component, level, order, brep)
+
+    def build() -> ComponentMesh:
+        return _build_mesh(d, component, level, order, paths, brep, progress)[0]
+
+    return load_or_build(paths["json"], load, build)
 
 
 def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int, brep: Path) -> ComponentMesh | None:
@@ -310,16 +312,16 @@ def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int,
                          build_time, paths["vol"], brep)
 
 
-def _build_mesh(d: Design, component: str, level: str, order: int, progress: bool):
-    """Mesh ``component`` (cache miss), store it; (ComponentMesh, its Netgen mesh with the OCC geometry).
+def _build_mesh(d: Design, component: str, level: str, order: int, paths: dict[str, Path], brep: Path,
+                progress: bool):
+    """Mesh ``component`` (cache miss), store it at ``paths`` (its cache entry, :func:`_mesh`); (ComponentMesh, its
+    Netgen mesh with the OCC geometry). ``brep``: the component's solid (:func:`component_brep`).
 
     Netgen meshes once per component and level: a second-order mesh is the first-order mesh (the cached
     one, or meshed and stored here) raised by ``SecondOrder()``, edge nodes on the true surfaces, the same
     topology the reduction's FE model is built on (flexgear.fe.fem raises the order the same way).
     """
     spec = d.spec
-    paths = _paths(spec, component, level, order)
-    brep = component_brep(d, component, progress)
     paths["json"].unlink(missing_ok=True)  # written last: until then readers find no entry, not a mixed one
     t0 = time.perf_counter()
     if order == 1:

@@ -35,7 +35,6 @@ from flexgear.design import Design, as_design
 from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.bolted import clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
-from flexgear.geometry.involute import helix_halves, tooth_normal_local
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
@@ -73,11 +72,11 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
         return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
     if component == "ring":
         return [patch_union(fe, d, BOLT_PATCHES)]
-    tube = [p for p in d.layout(component).prisms if p.name == "tube"][0]
+    tube = [p for p in d.layouts[component].prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
     if component == "input_shaft":
-        sun = d.layout("sun").prisms
+        sun = d.layouts["sun"].prisms
         z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
         joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
@@ -104,26 +103,26 @@ def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
 def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarray]]:
     """(load circle of order 0, angles of the contacts on it [rad]) per contact band of a gear.
 
-    Meshes as flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
+    From the design's mesh contact geometry (flexgear.design ``meshes``), meshes as
+    flexgear.mbs.gearbox.mesh_contacts builds them: sun-planet with the sun (gear 1) of hand +1
     pushing in the drive sense, planet-ring with the planet (gear 1) of hand -1 against it; planet 1
     (at angle 0) meets the sun at angle pi and the ring at 0 about its own centre.
     """
     if component not in ("sun", "planet", "ring"):
         return []
     geo, spec = d.gears, d.spec
-    sigma = math.copysign(1.0, spec.load_case.input_speed_rad_s)
+    sigma = int(math.copysign(1.0, spec.load_case.input_speed_rad_s))
     planets = np.asarray(geo.planet_angles, float)
-    # (mesh, hand of gear 1, drive sign, is this component gear 1, contact angles on this component)
-    meshes = {"sun": [(geo.sun_planet, 1, sigma, True, planets)],
-              "planet": [(geo.sun_planet, 1, sigma, False, np.array([math.pi])),
-                         (geo.planet_ring, -1, -sigma, True, np.array([0.0]))],
-              "ring": [(geo.planet_ring, -1, -sigma, False, planets)]}[component]
-    width = geo.helix_face_width
+    outer, inner = d.meshes["outer"], d.meshes["inner"]
+    # (mesh contact geometry, drive sign, is this component gear 1, contact angles on this component)
+    meshes = {"sun": [(outer, sigma, True, planets)],
+              "planet": [(outer, sigma, False, np.array([math.pi])), (inner, -sigma, True, np.array([0.0]))],
+              "ring": [(inner, -sigma, False, planets)]}[component]
     out = []
-    for mesh, hand, drive, first, angles in meshes:
+    for contact, drive, first, angles in meshes:
+        mesh, width = contact.mesh, contact.helix_width
         radius = mesh.operating_pitch_radii[0 if first else 1]
-        for half in helix_halves(geo.helix_layout, width, geo.half_gap, hand):
-            n_r, n_t, n_z = tooth_normal_local(mesh, drive, half.hand)
+        for half, (n_r, n_t, n_z) in zip(contact.halves, contact.normals[drive], strict=True):
             direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
             circle = LoadCircle(radius, half.z - width / 2, half.z + width / 2, 0, direction,
                                 spec.gears.normal_module_m)
@@ -160,7 +159,7 @@ def joint_point(spec: GearboxSpec | Design, gear: str) -> np.ndarray:
     Sun-input shaft: on the axis, mid-way along the sun. Ring-output shaft: on the axis, in the plane
     where the ring's flange meets the shaft's web.
     """
-    prisms = as_design(spec).layout(gear).prisms
+    prisms = as_design(spec).layouts[gear].prisms
     if gear == "sun":
         return np.array([0.0, 0.0, 0.5 * (min(p.z0 for p in prisms) + max(p.z1 for p in prisms))])
     if gear == "ring":
@@ -260,8 +259,6 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
     # the bolt patches' union, its kind and clamped disc enter the key of the bodies that have it
     extra = [(BOLT_PATCHES, "union", _BOLT_PATCH_KIND, spec.joints_assumed.bolt_clamp_diameter_mm)] if patches else []
     max_hz = red.fixed_interface_cutoff_hz
-    key = geometry_hash(spec, name, mesh_settings, max_hz, _INTERFACE_KIND, _WHOLE_BASIS,
-                        [c.key() for c in circles], _REDUCTION_VERSION, *extra)
 
     def build() -> ReducedBody:
         from flexgear.fe.fem import fe_model
@@ -278,6 +275,8 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
         return reduce(fe, itfs, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
                       rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES), max_hz=max_hz)
 
+    key = geometry_hash(spec, name, mesh_settings, max_hz, _INTERFACE_KIND, _WHOLE_BASIS,
+                        [c.key() for c in circles], _REDUCTION_VERSION, *extra)
     return f"{name}-{level}-{key}", build
 
 

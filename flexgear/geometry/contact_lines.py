@@ -1,6 +1,7 @@
 """Contact lines of a helical mesh in its field of action: the mesh-stiffness series (eq. 11-12), the closed-form
 integrals of the lines' length, signed length and first moment, and the friction direction and lever series that
-both models take from them (flexgear.mbs.contacts, flexgear.lumped.model).
+both models take from them (flexgear.mbs.contacts, flexgear.lumped.model); :class:`MeshContactGeometry` gathers a
+mesh's helix halves, their tooth normals and these series, made once per design (flexgear.design).
 """
 
 from __future__ import annotations
@@ -10,10 +11,10 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from flexgear.geometry.involute import GearMesh
+from flexgear.geometry.involute import GearMesh, HelixHalf, helix_halves, tooth_normal_local
 
 __all__ = ["mesh_stiffness_harmonics", "PeriodicSeries", "SPUR_OVERLAP_RATIO", "contact_line_integrals",
-           "contact_line_distribution", "contact_line_series"]
+           "contact_line_distribution", "contact_line_series", "MeshContactGeometry", "mesh_contact_geometry"]
 
 
 def mesh_stiffness_harmonics(eps_alpha: float, eps_beta: float, harmonics: int) -> np.ndarray:
@@ -135,3 +136,35 @@ def contact_line_series(mesh: GearMesh, face_width: float, harmonics: int, sampl
     phases = np.arange(samples) / samples
     _, kappa, lever = contact_line_distribution(eps_a, eps_b, mesh.approach_length / mesh.base_pitch, phases)
     return stiffness, PeriodicSeries.fit(kappa, harmonics), PeriodicSeries.fit(lever * mesh.base_pitch, harmonics)
+
+
+Normal = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class MeshContactGeometry:
+    """What the contacts of one mesh take from the geometry: its helix halves, their tooth normals, its series.
+
+    ``halves``: the helix halves with the hand of gear 1 in each (flexgear.geometry.involute.helix_halves);
+    ``normals``: for a drive sign of +1 and -1 (gear 1 pushing gear 2 counter-clockwise / clockwise about +z),
+    each half's tooth normal (force on gear 2) at the pitch point in gear 1's local (radial, tangential, axial)
+    frame (flexgear.geometry.involute.tooth_normal_local); ``stiffness``, ``sliding``, ``lever`` [m]: the
+    series of :func:`contact_line_series` over one helix of ``helix_width`` [m].
+    """
+
+    mesh: GearMesh
+    helix_width: float
+    halves: tuple[HelixHalf, ...]
+    normals: dict[int, tuple[Normal, ...]]
+    stiffness: PeriodicSeries
+    sliding: PeriodicSeries
+    lever: PeriodicSeries
+
+
+def mesh_contact_geometry(mesh: GearMesh, helix_layout: str, helix_width: float, half_gap: float, hand: int,
+                          harmonics: int) -> MeshContactGeometry:
+    """:class:`MeshContactGeometry` of ``mesh``: ``helix_layout`` "single" or "double", ``helix_width`` [m] of one
+    helix, ``half_gap`` [m] between the halves, ``hand`` of gear 1 in the +z half, ``harmonics`` of the series."""
+    halves = tuple(helix_halves(helix_layout, helix_width, half_gap, hand))
+    normals = {s: tuple(tooth_normal_local(mesh, s, h.hand) for h in halves) for s in (1, -1)}
+    return MeshContactGeometry(mesh, helix_width, halves, normals, *contact_line_series(mesh, helix_width, harmonics))

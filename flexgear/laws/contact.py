@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 
 from flexgear.design import Design, as_design
+from flexgear.geometry.contact_lines import MeshContactGeometry
 from flexgear.spec import Contact, GearboxSpec
 
 __all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "friction_forces",
-           "mesh_damping", "mesh_laws"]
+           "mesh_damping", "mesh_laws", "half_laws"]
 
 LAWS = ("impact", "iso6336")
 
@@ -81,7 +82,7 @@ def mesh_laws(spec: GearboxSpec | Design) -> dict[str, ContactLaw]:
     b = ga.face_width_m
     f_t = abs(d.theory.input_torque) / (geo.planet_count * geo.sun.reference_radius)  # either flank
     line_load = ca.application_factor * f_t / (b * 1e3)
-    mass = {c: d.mass_properties(c).mass for c in ("sun", "planet", "ring")}
+    mass = {c: d.masses[c].mass for c in ("sun", "planet", "ring")}
     out = {}
     for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"),
                                ("inner", geo.planet_ring, "planet", "ring")):
@@ -92,6 +93,15 @@ def mesh_laws(spec: GearboxSpec | Design) -> dict[str, ContactLaw]:
         k = iso.normal_stiffness_n_per_m(b, gear1.base_helix_angle)
         out[kind] = ContactLaw(k, 1.0, mesh_damping(k, mass[g1], mass[g2], ca.mesh_damping_ratio), 0.0, "iso6336")
     return out
+
+
+def half_laws(geometry: MeshContactGeometry, contact: Contact, law: ContactLaw | None = None) -> list[ContactLaw]:
+    """The normal law of each helix half of a mesh (``geometry``, flexgear.geometry.contact_lines): ``law`` (whole
+    face width, :func:`mesh_laws`; default the study's impact law from ``contact``) scaled to the half's share of
+    the face width."""
+    if law is None:
+        return [ContactLaw.from_contact(contact, half.share) for half in geometry.halves]
+    return [law.share(half.share) for half in geometry.halves]
 
 
 def impact_force(delta: Any, delta_t: Any, law: ContactLaw, factor: Any = 1.0, m: Any = np) -> Any:

@@ -152,7 +152,7 @@ class LumpedParameters:
         spec, geo = d.spec, d.gears
         la = spec.lumped_assumed
         names = GEOMETRY_COMPONENTS
-        props = {c: d.mass_properties(c) for c in names}
+        props = {c: d.masses[c] for c in names}
         star = spec.gears.arrangement == "star"
         supports = d.supports
 

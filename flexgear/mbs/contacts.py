@@ -27,10 +27,10 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.geometry.contact_lines import PeriodicSeries, contact_line_series
-from flexgear.geometry.involute import GearMesh, tooth_normal_local
-from flexgear.geometry.pair import _EZ, helix_halves
-from flexgear.laws.contact import ContactLaw, friction_forces, normal_force
+from flexgear.geometry.contact_lines import MeshContactGeometry, PeriodicSeries, mesh_contact_geometry
+from flexgear.geometry.involute import GearMesh
+from flexgear.geometry.pair import _EZ
+from flexgear.laws.contact import ContactLaw, friction_forces, half_laws, normal_force
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body, normal_lever, resting_node
 from flexgear.mbs.elements import _keep_alive
@@ -44,6 +44,8 @@ __all__ = [
     "MeshFriction",
     "StiffnessSchedule",
     "add_gear_contacts",
+    "pair_contacts",
+    "mesh_pair_contacts",
 ]
 
 
@@ -362,7 +364,26 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
     by default z1 (spin1 - carrier_spin) drive_sign / (2 pi) mesh cycles per drive angle theta.
     ``law``: the whole-face-width normal law (flexgear.laws.contact.mesh_laws; default the study's impact law
     from ``contact``), shared by the halves in proportion to their face width. Names: ``f"{name}_half{k}"``.
+    The mesh's contact geometry is made here (flexgear.geometry.contact_lines.mesh_contact_geometry); a gearbox's
+    design holds it made already (:func:`mesh_pair_contacts`).
     """
+    helix_width = mesh.gear1.face_width / (2 if helix_layout == "double" else 1)
+    geometry = mesh_contact_geometry(mesh, helix_layout, helix_width, half_gap, hand,
+                                     contact_assumed.stiffness_harmonics)
+    return mesh_pair_contacts(name, body1, body2, geometry, centre1, centre2, contact, contact_assumed,
+                              half_laws(geometry, contact, law), drive_sign=drive_sign, spins=spins,
+                              carrier_spin=carrier_spin, phase_offset=phase_offset,
+                              phase_per_drive_angle=phase_per_drive_angle)
+
+
+def mesh_pair_contacts(name: str, body1: str, body2: str, geometry: MeshContactGeometry, centre1, centre2,
+                       contact: Contact, contact_assumed: ContactAssumed, laws: list[ContactLaw], *,
+                       drive_sign: float = 1.0, spins: tuple[float, float] | None = None, carrier_spin: float = 0.0,
+                       phase_offset: float = 0.0, phase_per_drive_angle: float | None = None) -> list[GearContact]:
+    """:func:`pair_contacts` of a mesh whose contact geometry (helix halves, tooth normals, contact-line series with
+    ``[contact_assumed] stiffness_harmonics`` harmonics) is given as ``geometry`` and whose halves' normal laws are
+    ``laws`` (:func:`half_laws`); the other arguments as there."""
+    mesh = geometry.mesh
     g1, g2 = mesh.gear1, mesh.gear2
     c1, c2 = np.asarray(centre1, float), np.asarray(centre2, float)
     d = (c2 - c1) * [1.0, 1.0, 0.0]
@@ -375,25 +396,23 @@ def pair_contacts(name: str, body1: str, body2: str, mesh: GearMesh, centre1, ce
     r_w1 = mesh.operating_pitch_radii[0]
     alpha = mesh.operating_pressure_angle
     t_dir = math.sin(alpha) * e + s * math.cos(alpha) * np.cross(_EZ, e)
-    helix_width = g1.face_width / (2 if helix_layout == "double" else 1)
-    n_harm = contact_assumed.stiffness_harmonics
-    stiffness, sliding, lever = contact_line_series(mesh, helix_width, n_harm)
+    helix_width = geometry.helix_width
+    stiffness, sliding, lever = geometry.stiffness, geometry.sliding, geometry.lever
     if contact_assumed.stiffness_variation == "constant":
+        n_harm = contact_assumed.stiffness_harmonics
         stiffness = PeriodicSeries(1.0, np.zeros(n_harm), np.zeros(n_harm))
     if spins is None:
         spins = (1.0, g1.teeth / g2.teeth if mesh.internal else -g1.teeth / g2.teeth)
     if phase_per_drive_angle is None:
         phase_per_drive_angle = g1.teeth * (spins[0] - carrier_spin) * s / (2 * math.pi)
     out = []
-    for k, half in enumerate(helix_halves(helix_layout, helix_width, half_gap, hand), start=1):
-        n_r, n_t, n_z = tooth_normal_local(mesh, s, half.hand)
+    halves = zip(geometry.halves, geometry.normals[int(s)], laws, strict=True)
+    for k, (half, (n_r, n_t, n_z), law) in enumerate(halves, start=1):
         normal = n_r * e + n_t * np.cross(_EZ, e) + n_z * _EZ
         point = c1 + r_w1 * e + [0.0, 0.0, half.z]
         grad1, grad2 = contact_gradients(c1, c2, point, normal, t_dir)
         out.append(GearContact(
-            f"{name}_half{k}", body1, body2, grad1, grad2,
-            ContactLaw.from_contact(contact, half.share) if law is None else law.share(half.share),
-            stiffness, sliding, lever, contact.friction_coefficient,
+            f"{name}_half{k}", body1, body2, grad1, grad2, law, stiffness, sliding, lever, contact.friction_coefficient,
             contact_assumed.friction_regularisation_m_per_s, phase_offset, phase_per_drive_angle,
             point, normal, (float(spins[0]), float(spins[1])), helix_width))
     return out

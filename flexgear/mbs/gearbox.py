@@ -20,14 +20,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.design import Design, as_design
+from flexgear.fe.reduced import component_mass_properties
 from flexgear.fe.ring_shaft import TIED_PAIR
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.involute import GearSetGeometry
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
-from flexgear.laws.contact import mesh_laws
+from flexgear.laws.contact import half_laws, mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
-from flexgear.mbs.contacts import GearContact, MeshFriction, pair_contacts
+from flexgear.mbs.contacts import GearContact, MeshFriction, mesh_pair_contacts
 from flexgear.mbs.elements import (
     add_interface_joint,
     add_load_torque,
@@ -87,7 +88,8 @@ def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
 def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[GearContact]:
     """Gear contacts of every planet, mesh and helix half, in the order (planet, outer/inner, half).
 
-    Built with the generic :func:`flexgear.geometry.layout.pair.pair_contacts`. Sun-planet: gear 1 = sun, pushing
+    Built with :func:`flexgear.mbs.contacts.mesh_pair_contacts` from the design's mesh contact geometry
+    (flexgear.design ``meshes``). Sun-planet: gear 1 = sun, pushing
     in the drive sense; planet-ring: gear 1 = planet, pushing against the drive sense. The halves'
     hands (flexgear.geometry.layout.pair convention, gear 1 in the +z half): sun +1, planet -1, so that the
     planet's axial forces from sun and ring cancel. Mesh phase of planet i:
@@ -100,20 +102,21 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
     zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
     sigma = 1.0 if drive_sign >= 0 else -1.0
     spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
-    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, helix_layout=geo.helix_layout,
-                  half_gap=geo.half_gap, phase_per_drive_angle=zs / (2 * math.pi))
-    laws = mesh_laws(d)
+    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, phase_per_drive_angle=zs / (2 * math.pi))
+    outer, inner = d.meshes["outer"], d.meshes["inner"]
+    laws = mesh_laws(d)  # whole face width, then each helix half's share
+    outer_laws = half_laws(outer, spec.contact, laws["outer"])
+    inner_laws = half_laws(inner, spec.contact, laws["inner"])
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
         phase = zs * psi / (2 * math.pi)
-        contacts += pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", geo.sun_planet, np.zeros(3),
-                                  c_planet, hand=1, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
-                                  phase_offset=phase, law=laws["outer"], **common)
-        contacts += pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", geo.planet_ring, c_planet,
-                                  np.zeros(3), hand=-1, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
-                                  phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, law=laws["inner"],
-                                  **common)
+        contacts += mesh_pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", outer, np.zeros(3), c_planet,
+                                       laws=outer_laws, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
+                                       phase_offset=phase, **common)
+        contacts += mesh_pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", inner, c_planet, np.zeros(3),
+                                       laws=inner_laws, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
+                                       phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
     return contacts
 
 
@@ -127,21 +130,16 @@ def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
     return reduced_body(spec, component, level, progress=True)
 
 
-def _default_mass_source(d: Design, component: str, level: str) -> MassProperties:
-    from flexgear.fe.reduced import component_mass_properties
-
-    return component_mass_properties(d, component, level, progress=True)
-
-
 def _mass_source(variant: Variant, d: Design, reduced: ReducedSource, default_bodies: bool) -> MassSource:
     """Mass properties of rigid components: the reduced body's (twins identical) or the exact geometry's (of the
     variant's design ``d``). With the default reduced bodies (``default_bodies``) a rigid twin reads only its body's
     mass properties."""
-    if variant.rigid_mass_properties == "exact":
-        return lambda spec, component: d.mass_properties(component)
-    if default_bodies:
-        return lambda spec, component: _default_mass_source(d, component, variant.mesh_level)
-    return lambda spec, component: reduced(spec, component, variant.mesh_level).props
+    level = variant.mesh_level
+    if variant.rigid_mass_properties == "mesh":
+        if default_bodies:
+            return lambda spec, component: component_mass_properties(d, component, level, progress=True)
+        return lambda spec, component: reduced(spec, component, level).props
+    return lambda spec, component: d.masses[component]  # "exact"
 
 
 GEARS = ("sun", "planet", "ring")

@@ -23,7 +23,7 @@ import traceback
 import numpy as np
 import pandas as pd
 
-from flexgear.design import Design, design
+from flexgear.design import design
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
 from flexgear.mbs.newton import JacobianEconomy
@@ -113,13 +113,6 @@ def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], signals: pd
             cols = [c for c in w.columns if c.startswith(f"{kind}_deflection_{part}_")]
             out[f"{key}_{kind}"] = float(w[cols].to_numpy().mean() / total[:, rows].mean())
     return out
-
-
-def _meta(variant: Variant, d: Design, t_end: float) -> dict:
-    gb = variant.gearbox
-    return run_metadata(variant.name, "exudyn", spec_hash(variant, t_end), t_end, gb.load_case,
-                        gb.gears.planet_count, variant.components, d.theory,
-                        source=str(variant.source), spec=as_dict(gb))
 
 
 class RunGuard:
@@ -317,8 +310,12 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
     until_settled = t_end_s == "settled" or (t_end_s is None and lc.end == "settled")
     t_end = lc.end_time_s if (t_end_s is None or until_settled) else float(t_end_s)
     budget = variant.gearbox.solver_assumed.wall_time_budget_s if time_budget_s is None else float(time_budget_s)
-    d = design(variant.gearbox)
-    meta = _meta(variant, d, t_end)
+    # the design and the run's metadata, made once at the start; the model below is built from this design
+    gb = variant.gearbox
+    d = design(gb)
+    run_key, spec_data = spec_hash(variant, t_end), as_dict(gb)
+    meta = run_metadata(variant.name, "exudyn", run_key, t_end, gb.load_case, gb.gears.planet_count,
+                        variant.components, d.theory, source=str(variant.source), spec=spec_data)
     wall0, cpu0 = time.perf_counter(), time.process_time()
     extra: dict[str, pd.DataFrame] = {}
     # small BLAS calls only (mode-shape fits, post-processing): threads contend on a shared machine

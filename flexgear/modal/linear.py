@@ -234,7 +234,7 @@ def _mass_parts(variant: Variant, model, mbs) -> dict[int, list[tuple[str, np.nd
             continue
         shaft = "input_shaft" if gear == "sun" else "output_shaft"
         if variant.rigid_mass_properties == "exact":
-            props = {c: model.design.mass_properties(c) for c in (gear, shaft)}
+            props = {c: model.design.masses[c] for c in (gear, shaft)}
         else:
             from flexgear.fe.reduced import component_mass_properties as mesh_props
 
