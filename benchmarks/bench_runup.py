@@ -16,8 +16,9 @@ at its own resonance: the fit holds it at its swept prediction); the nearest rid
 linearised model's own run-up, all modes together under the run's speed history and mesh load
 (flexgear.study.runup_linear.linear_runup: at the load case's operating point, and along the ramp with the
 load-dependent tangent stiffness), and that run-up's own strongest ridges; a summary of the three strongest ridges
-of both bearings against it; with --frictionless, the variant run again without tooth friction (which the
-linearised model leaves out) and its ridges against the linear run-up; and the CPU times.
+of both bearings against it (the linear run-up's excitation includes tooth friction's first-order term,
+flexgear.harmonic.friction); with --frictionless, the variant run again without tooth friction and its ridges
+against the linear run-up of the same frictionless variant; and the CPU times.
 """
 
 from __future__ import annotations
@@ -146,20 +147,21 @@ def main() -> None:
     within = sum(abs(r["linear_error_pct"]) <= 3.0 for _, r, _ in top[:3])
     print(f"  {within} of {min(3, len(top))} within 3 % of the linear run-up's ridges")
     if "--frictionless" in sys.argv:
-        frictionless(variant, linear)
+        frictionless(variant)
 
 
-def frictionless(variant, linear) -> None:
-    """The variant run again without tooth friction (the linearised model leaves it out, flexgear.modal.linear):
-    its strongest ridges against the linear run-up."""
+def frictionless(variant) -> None:
+    """The variant run again without tooth friction: its strongest ridges against the linear run-up of the same
+    frictionless variant (no friction excitation)."""
     import dataclasses
 
     from flexgear.mbs.run import run_variant
 
     t0 = time.process_time()
-    free = run_variant(dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("contact",
-                                                                                        friction_coefficient=0.0)))
+    smooth = dataclasses.replace(variant, gearbox=variant.gearbox.with_fields("contact", friction_coefficient=0.0))
+    free = run_variant(smooth)
     print(f"{variant.name} without tooth friction: {time.process_time() - t0:.1f} s CPU")
+    linear = linear_runup(free, smooth)
     for side in ("output", "input"):
         for _, r in runup(free, side, linear=linear).ridges.head(3).iterrows():
             print(f"  {side} {r['order']:.0f}x ridge at {r['speed_rpm']:7.1f} rpm ({r['prominence_db']:.1f} dB, "

@@ -17,6 +17,10 @@
     terms the frequency domain leaves out: the central members' 2x mesh acceleration vanishes in both domains.
 (5) The diagnostics of the checks (flexgear.study.harmonic_check): a line at exactly one frequency told from a
     sideband; K_v of a signal's mesh-periodic part, without a slow tone added to it.
+(6) Tooth friction's excitation (flexgear.harmonic.friction) is the multibody model's own friction force (the
+    compiled per-step kernel flexgear.laws.compiled.mesh_friction_forces) at a fixed deflection over one mesh
+    cycle, Fourier-analysed: both are trigonometric polynomials of degree 2 H sampled more than 3 H times per cycle,
+    so the coefficients h <= H agree to round-off, for either mesh and either drive sense.
 """
 
 import dataclasses
@@ -199,3 +203,44 @@ def test_periodic_peak_factor_leaves_out_a_slow_tone():
     kv = periodic_peak_factor(forces, dt, f_mesh, harmonics=3)
     assert kv - 1.0 == pytest.approx(peak - 1.0, rel=2e-3)
     assert forces[:, 1].max() / forces[:, 1].mean() - 1.0 > kv - 1.0 + 0.5 * 0.46 / mean  # the raw peak has the tone
+
+
+FRICTION_CYCLE_SAMPLES = 64
+"""Samples of the time-domain friction force over one mesh cycle in (6): > 3 H for the model's H = 3 (exact DFT)."""
+
+
+@pytest.mark.parametrize("drive_sign", [1.0, -1.0])
+def test_friction_excitation_is_the_time_models_friction_over_a_mesh_cycle(gearbox, drive_sign):
+    from flexgear.harmonic.base import _excited
+    from flexgear.harmonic.friction import friction_harmonics
+    from flexgear.laws.compiled import mesh_friction_forces
+    from flexgear.mbs.gearbox import mesh_contacts
+
+    harmonics = gearbox.contact_assumed.stiffness_harmonics
+    spec = _excited(gearbox, harmonics)
+    speed = drive_sign * spec.load_case.input_speed_rad_s
+    contacts = mesh_contacts(spec, drive_sign)
+    delta0 = 1e-5  # a fixed deflection [m]: any loaded one
+    k = np.arange(FRICTION_CYCLE_SAMPLES)
+    chosen = [next(c for c in contacts if c.name.startswith(kind) and c.phase_offset % 1.0 != 0.0)
+              for kind in ("outer", "inner")]  # off the reference phase: the planet's own phase shift enters
+    for c in chosen:
+        law = c.law
+        rows = [np.concatenate([c.gradient1[r], c.gradient2[r]])[None] for r in (1, 2)]  # sliding, spin
+        q_t = np.zeros(12)
+        q_t[5], q_t[11] = (s * speed for s in c.spin_per_drive_angle)
+        series = np.ascontiguousarray([[x.packed()] for x in (c.stiffness, c.sliding, c.lever)])
+        theta = np.sign(speed) * k / (FRICTION_CYCLE_SAMPLES * c.phase_per_drive_angle)  # mesh phase k / N
+        forces = np.array([mesh_friction_forces(
+            np.array([c.phase_per_drive_angle * th - c.phase_offset]), np.array([delta0]), np.zeros(1), q_t,
+            np.array([law.stiffness]), np.array([law.exponent]), np.array([law.damping_max]),
+            np.array([law.penetration_depth]), series, np.array([c.friction_coefficient]),
+            np.array([c.friction_regularisation]), *rows, law.kind == "iso6336") for th in theta])
+        h = np.arange(1, harmonics + 1)
+        timed = 2.0 / k.size * np.exp(-2j * np.pi * np.outer(h, k) / k.size) @ forces  # (H, 12) at +h f_mesh
+        s_h, l_h = friction_harmonics([c], np.array([delta0]), speed, harmonics)[:, 0]
+        series_force = -(np.outer(s_h, rows[0][0]) + np.outer(l_h, rows[1][0]))
+        scale = np.abs(forces).max()
+        assert scale > 0.0 and np.abs(timed[0]).max() > 1e-3 * scale  # a first harmonic to compare
+        # round-off: sums of N = 64 terms of size <= scale, N eps ~ 1.4e-14 of it; 1e-12 leaves a margin
+        np.testing.assert_allclose(series_force, timed, rtol=0.0, atol=1e-12 * scale)

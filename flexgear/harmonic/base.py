@@ -108,7 +108,10 @@ class _Operating:
     index of each contact's mesh in ``mesh_names``; ``accel`` (4, n): input x, y and output x, y translation
     per coordinate; ``te`` (n,): transmission error per coordinate; ``omega_mesh`` [rad/s]; ``solver``: None
     (a dense complex solve of the full matrices) or a callable (omegas (H,) [rad/s], c (H, n_c)) -> X (H, n)
-    solving the same problem for the force rows^T c_h (flexgear.harmonic.reduced.ModalSolver.solve).
+    solving the same problem for the force rows^T c_h (flexgear.harmonic.reduced.ModalSolver.solve), or, with
+    friction, for [rows; friction_rows]^T [c_h; -friction_h]. ``friction_rows`` (2 n_c, n), ``friction``
+    (2 n_c, H) complex [N, N m]: the tooth-friction excitation (flexgear.harmonic.friction: the sliding and
+    relative-spin rows and their forces at +h f_mesh); None: no friction.
     """
 
     mass: np.ndarray
@@ -125,6 +128,8 @@ class _Operating:
     te: np.ndarray
     omega_mesh: float
     solver: Callable[[np.ndarray, np.ndarray], np.ndarray] | None = None
+    friction_rows: np.ndarray | None = None
+    friction: np.ndarray | None = None
 
 
 _ACCEL = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
@@ -134,10 +139,14 @@ ACCEL_INDICATORS = _ACCEL
 
 def excitation(op: _Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     """The excitation at mesh harmonics h = 1..``harmonics`` (flexgear.harmonic.response): (F_h = F_0 C_h of every
-    contact (n_c, H) [N], the generalised forces -g^T F_h summed over the contacts (H, n) [N or N m per
-    coordinate]); the time force is Re sum_h (-g^T F_h) e^{i 2 pi h phi} for the mesh phase phi [cycles]."""
+    contact (n_c, H) [N], the generalised forces f_h = -g^T F_h - a^T S_h - b^T L_h summed over the contacts (H, n)
+    [N or N m per coordinate], the friction terms where ``op.friction`` is set, flexgear.harmonic.friction); the time
+    force is Re sum_h f_h e^{i 2 pi h phi} for the mesh phase phi [cycles]."""
     excite = op.f0[:, None] * op.coef[:, :harmonics]  # (n_c, H): F_0 C_h
-    return excite, -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
+    force = -(op.rows.T @ excite).T  # (H, n): generalised force -g F_h
+    if op.friction is not None:
+        force = force - (op.friction_rows.T @ op.friction[:, :harmonics]).T
+    return excite, force
 
 
 def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
@@ -147,7 +156,8 @@ def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
     n = op.mass.shape[0]
     excite, f = excitation(op, harmonics)
     if op.solver is not None:
-        x = op.solver(w, -excite.T)
+        c = -excite.T if op.friction is None else np.hstack([-excite.T, -op.friction[:, :harmonics].T])
+        x = op.solver(w, c)
     else:
         a = (op.stiffness[None] - (w**2)[:, None, None] * op.mass[None]
              + 1j * w[:, None, None] * op.damping[None])  # (H, n, n)

@@ -15,7 +15,10 @@ F_h = F_0 C_h = Delta k_h delta_0 (linear law) with C_h the complex Fourier coef
 along the mesh's line of action (the generalised force -g F_h, g = d delta / dz). The products of the stiffness
 variation with the response (parametric terms, x_delta (s - 1)) are dropped: the result is exact to first order in
 the variation c_h and fails near the parametric instabilities (2 f_n / k = h f_mesh, combination resonances) and
-where the teeth lose contact (|F_dyn| comparable to F_0: the law's kink is not linearised).
+where the teeth lose contact (|F_dyn| comparable to F_0: the law's kink is not linearised). Tooth friction, as the
+time model applies it (the spec's friction coefficient; none at mu = 0), adds its own first-order excitation: the
+Fourier series of its generalised force at the static mesh loads, -(a^T S_h + b^T L_h) on the contacts' sliding and
+relative-spin rows (flexgear.harmonic.friction); it does not enter the mesh forces' direct term.
 
 Response at each speed of the grid and each harmonic h = 1..H, omega = 2 pi h f_mesh(speed):
 
@@ -238,6 +241,7 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
     """The linear problem at any speed [rpm] (a callable returning flexgear.harmonic.base._Operating) from the
     linearisations ``models`` at ``nodes`` [rpm] (Lagrange interpolation, or the spin fit where ``spin``)."""
     from flexgear.geometry.involute import gear_set_geometry
+    from flexgear.harmonic.friction import friction_harmonics, friction_rows
     from flexgear.laws.contact import normal_force
     from flexgear.mbs.gearbox import mesh_contacts
     from flexgear.theory import theory
@@ -257,6 +261,15 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
     offset = -np.array([c.phase_offset for c in contacts])
     coef = _series_coefficients(cos_c, sin_c, offset, np.sign(rate))
     means = np.array([c.stiffness.mean for c in contacts])
+    rubbing = any(c.friction_coefficient > 0.0 for c in contacts)
+
+    def rubbed(delta0: np.ndarray, speed_rpm: float) -> np.ndarray | None:
+        """Tooth friction's forces (2 n_c, H) at the law deflections ``delta0`` and ``speed_rpm`` (rows: the
+        contacts' sliding, then relative spin; flexgear.harmonic.friction); None without friction."""
+        if not rubbing:
+            return None
+        forces = friction_harmonics(contacts, delta0, speed_rpm * math.copysign(RPM, lc.input_speed_rad_s), harmonics)
+        return forces.reshape(2 * len(contacts), harmonics)
 
     def selectors(lm: Any) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         """Contact deflections, bearing-node translations and output spin per z; static deflections. Where a
@@ -298,8 +311,11 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
         return f0, kt, cc
 
     if spin:
-        return _spin_operating(models, nodes, selectors, law_terms, coef, mesh, mesh_names, spec, modal_cutoff_ratio)
-    parts = [(m.mass, m.damping + m.gyroscopic, m.stiffness, *selectors(m)) for m in models]
+        rows = friction_rows(models[0], contacts) if rubbing else None
+        return _spin_operating(models, nodes, selectors, law_terms, coef, mesh, mesh_names, spec, modal_cutoff_ratio,
+                               (rows, rubbed))
+    parts = [(m.mass, m.damping + m.gyroscopic, m.stiffness, *selectors(m),
+              friction_rows(m, contacts) if rubbing else 0.0) for m in models]
     cache: dict[tuple[float, ...], tuple] = {}
 
     def operating(speed_rpm: float) -> _Operating:
@@ -308,21 +324,23 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
         key = tuple(np.round(w, 15))
         if key not in cache:
             used = [(wk, part) for wk, part in zip(w, parts, strict=True) if wk != 0.0]
-            mixed = [sum(wk * part[i] for wk, part in used) for i in range(7)]
+            mixed = [sum(wk * part[i] for wk, part in used) for i in range(8)]
             cache.clear()
-            cache[key] = (*mixed[:6], *law_terms(mixed[6]))
-        mass, damp, stiff, g, acc, te, f0, kt, cc = cache[key]
+            cache[key] = (*mixed[:6], *law_terms(mixed[6]), mixed[6], mixed[7] if rubbing else None)
+        mass, damp, stiff, g, acc, te, f0, kt, cc, delta0, fr = cache[key]
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
-        return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh)
+        return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh,
+                          friction_rows=fr, friction=rubbed(delta0, speed_rpm))
 
     return operating
 
 
 def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_terms: Any, coef: np.ndarray,
                     mesh: np.ndarray, mesh_names: tuple[str, ...], spec: Any,
-                    modal_cutoff_ratio: float | None) -> Any:
+                    modal_cutoff_ratio: float | None, friction: tuple[np.ndarray | None, Any]) -> Any:
     """The operating point at each speed from the spin fit (flexgear.harmonic.reduced eq. 1) of the two
-    linearisations ``models`` at ``nodes`` [rpm]; solved on the modal basis unless ``modal_cutoff_ratio`` is None."""
+    linearisations ``models`` at ``nodes`` [rpm]; solved on the modal basis unless ``modal_cutoff_ratio`` is None.
+    ``friction``: (the friction rows (2 n_c, n) or None, their forces at (deflections, speed [rpm]))."""
     from flexgear.harmonic.reduced import ModalSolver, fit_spin
 
     a, b = models
@@ -338,14 +356,17 @@ def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_te
                 "delta": sel[3]}
 
     fit = fit_spin(nodes[0] * RPM, nodes[1] * RPM, terms(a, sel_a), terms(b, sel_b))
-    modal = None if modal_cutoff_ratio is None else ModalSolver(fit, rows.T, modal_cutoff_ratio)
+    rubs, rubbed = friction
+    directions = rows.T if rubs is None else np.hstack([rows.T, rubs.T])
+    modal = None if modal_cutoff_ratio is None else ModalSolver(fit, directions, modal_cutoff_ratio)
 
     def operating(speed_rpm: float) -> _Operating:
         w = speed_rpm * RPM
-        f0, kt, cc = law_terms(fit.static_deflections(w))
+        delta0 = fit.static_deflections(w)
+        f0, kt, cc = law_terms(delta0)
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
         solver = None if modal is None else (lambda om, c: modal.solve(w, om, c))
         return _Operating(fit.mass, fit.damping + fit.gyroscopic(w), fit.stiffness(w), rows, kt, cc, f0, coef, mesh,
-                          mesh_names, acc, te, omega_mesh, solver)
+                          mesh_names, acc, te, omega_mesh, solver, rubs, rubbed(delta0, speed_rpm))
 
     return operating

@@ -2,15 +2,17 @@
 
 Equations. The variant linearised at an operating point (flexgear.modal.linear.linearize: M, D, G, K over the
 independent coordinates z) and excited at mesh harmonics h = 1..H as the harmonic-response stage does
-(flexgear.harmonic.base.excitation: F_h = F_0 C_h per contact, the generalised force f_h = -g^T F_h) is driven
-along a run's own speed history:
+(flexgear.harmonic.base.excitation: F_h = F_0 C_h per contact, the generalised force f_h = -g^T F_h, plus tooth
+friction's first-order term -(a^T S_h + b^T L_h) on the contacts' sliding and relative-spin rows where the variant's
+friction coefficient is above zero, flexgear.harmonic.friction) is driven along a run's own speed history:
 
     M z'' + (D + G) z' + K z = s(t) Re sum_h f_h e^{i 2 pi h phi(t)},
 
 phi the run's mesh phase (flexgear.study.runup.mesh_phase) and s(t) the run's mean mesh force relative to the
 operating point's: the window-averaged sum of the recorded mesh forces divided by the sum of the static contact
 forces F_0 (flexgear.study.runup.mesh_excitation with that reference), so that F_0 s(t) C_h is the stiffness
-variation's force at the run's own load (first order in the variation, as flexgear.harmonic.response). The
+variation's force at the run's own load (first order in the variation, as flexgear.harmonic.response; friction,
+mu times the normal force, scales with the load alike; its sign of sliding is the operating point's). The
 output is a bearing acceleration y = a^T z'' (flexgear.harmonic.base.ACCEL_INDICATORS: the frame translation of the
 member carrying the bearing), the same signal the time run records.
 
