@@ -4,8 +4,9 @@
                                                   (default: results/full/model1, model1.toml)
 
 Prints, per bearing, the three strongest ridges (speed, order, prominence) with the matched crossing of the same
-order (one the order excites, flexgear.modal.campbell: mesh phasing) and the ridge's error against it and against
-the crossing's swept prediction under the run's own speed history and mesh load (flexgear.study.runup.swept_peak);
+order (one the order excites, flexgear.modal.campbell_diagram: mesh phasing) and the ridge's error against it and
+against the crossing's swept prediction under the run's own speed history and mesh load
+(flexgear.study.runup.swept_peak);
 then the matched mode linearised at the ridge's own operating point (its instantaneous speed and time t* in the
 ramps of speed and load, flexgear.modal.linearize) and the crossing that mode makes there; then an interference
 check: the ridge's complex order track A_k(t) (the demodulated sum before the modulus) over +-15 % of its speed

@@ -47,7 +47,8 @@ _LAZY = {
     # the study's gearbox
     "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox", "run_variant": "mbs.run",
     # modal analysis at the operating point
-    "linearize": "modal.linear", "LinearModel": "modal.linear", "modes": "modal.modes", "Modes": "modal.modes",
+    "linearize": "modal.linear", "LinearModel": "modal.linear",
+    "modes": "modal.eigenmodes", "Modes": "modal.eigenmodes",
     "period_modes": "modal.period",
 }
 

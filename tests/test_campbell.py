@@ -1,4 +1,4 @@
-"""Campbell diagram of model 1 (all rigid; flexgear.modal.campbell) over a coarse speed grid.
+"""Campbell diagram of model 1 (all rigid; flexgear.modal.campbell_diagram) over a coarse speed grid.
 
 - At zero speed the diagram is the modal analysis at rest.
 - A crossing lies where a mode's frequency equals k f_m: the mode computed afresh at the crossing's speed is there
@@ -23,7 +23,7 @@ import pytest
 from conftest import VARIANTS
 
 from flexgear.modal import campbell, linearize, mesh_frequency_hz, modes, resonant
-from flexgear.modal.campbell import excited_kinds
+from flexgear.modal.campbell_diagram import excited_kinds
 
 SPEEDS_RPM = np.linspace(0.0, 6000.0, 7)
 

@@ -10,8 +10,8 @@ linearisation, the dense solve and the Campbell diagram.
     (f / f_k)^6 < 9 % of itself, and their share is small: within 1 % of each indicator's largest amplitude over
     the speeds and harmonics (a harmonic the planets' phasing cancels holds only round-off of the others).
 (3) Resonance: lightly damped (damping ratios about 1 %, the peak shifts by order zeta^2 = 1e-4 from the undamped
-    crossing), each crossing of the Campbell diagram (flexgear.modal.campbell) of model 1 at 1x-3x mesh that carries
-    a prominent peak of the mesh-force and bearing-acceleration curves has that peak within 1 % of its speed.
+    crossing), each crossing of the Campbell diagram (flexgear.modal.campbell_diagram) of model 1 at 1x-3x mesh that
+    carries a prominent peak of the mesh-force and bearing-acceleration curves has that peak within 1 % of its speed.
 """
 
 import dataclasses

@@ -21,7 +21,7 @@ import numpy as np
 import pytest
 
 from flexgear.modal import linearize, modes
-from flexgear.modal.modes import CENTRAL
+from flexgear.modal.eigenmodes import CENTRAL
 
 F_MAX = 10e3  # Hz
 IN_PLANE = ("u_x", "u_y", "phi_z")

@@ -2,14 +2,15 @@
 peaks against the Campbell crossings of those modes.
 
 Modes at an input speed n. The linearised lumped model (flexgear.harmonic.lumped.lumped_linear: M, D + G, K over the
-free coordinates z) in state space, as flexgear.modal.modes does for the multibody model,
+free coordinates z) in state space, as flexgear.modal.eigenmodes does for the multibody model,
 
     A = [0, I; -M^-1 K, -M^-1 (D + G)],    A V = V diag(lambda),    V = (psi; lambda psi),
 
 natural frequency f = |lambda| / (2 pi) [Hz], damping ratio zeta = -Re(lambda) / |lambda|; a mode is a root with
-Im(lambda) > 0 and its conjugate. The Campbell diagram (flexgear.modal.campbell.Campbell) holds the modes with
-zeta < flexgear.modal.campbell.MAX_DAMPING_RATIO at each speed of a grid, tracked between speeds by the mass-weighted
-MAC of their shapes psi (flexgear.modal.campbell.track) and crossed with the mesh orders k f_mesh(n) by the same
+Im(lambda) > 0 and its conjugate. The Campbell diagram (flexgear.modal.campbell_diagram.Campbell) holds the modes with
+zeta < flexgear.modal.campbell_diagram.MAX_DAMPING_RATIO at each speed of a grid, tracked between speeds by the
+mass-weighted MAC of their shapes psi (flexgear.modal.campbell_diagram.track) and crossed with the mesh orders k
+f_mesh(n) by the same
 linear interpolation. Kinds: flexgear.lumped.modal.classify_mode on |psi|.
 
 Modal contributions. The steady response X at omega to a force F has the state s = (X, i omega X) with
@@ -42,7 +43,7 @@ import pandas as pd
 
 from flexgear.harmonic.base import _ACCEL, DEFAULT_HARMONICS, Response, _Operating, _sweep
 from flexgear.harmonic.lumped import LumpedLinear, lumped_linear
-from flexgear.modal.campbell import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, _crossings, track
+from flexgear.modal.campbell_diagram import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, _crossings, track
 
 __all__ = ["lumped_campbell", "mode_contributions", "response_peaks", "peak_crossings", "PEAK_FRACTION",
            "MULTIPLET_RTOL", "CANCELLED"]

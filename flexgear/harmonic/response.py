@@ -94,7 +94,7 @@ eq. 1 of flexgear.harmonic.reduced; one half keeps Omega_a^2 - Omega_b^2 large."
 def linearize_same_angle(variant: Any, speed_rpm: float, reference_rpm: float) -> Any:
     """flexgear.modal.linear.linearize at ``speed_rpm`` [rpm] with the gears at the angles and with the dynamic modes
     of ``reference_rpm``: t* = T/2 + theta_ref / omega, theta_ref = omega_ref T / 2 (the STEP ramp over T: the
-    same angles at every speed, flexgear.modal.campbell), and the gears' dynamic cut-off ([reduction_assumed]
+    same angles at every speed, flexgear.modal.campbell_diagram), and the gears' dynamic cut-off ([reduction_assumed]
     dynamic_cutoff_mesh_orders x f_mesh) at reference_rpm's mesh frequency, so that every speed has the same
     coordinates (the time model's cut-off follows its own speed: above the reference speed's mesh orders it keeps
     fewer dynamic modes than this linearisation)."""

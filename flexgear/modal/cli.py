@@ -3,11 +3,11 @@
 ``flexgear modes VARIANT [--speed-rpm R] [--f-max-hz F] [--samples J] [--out DIR]`` linearises the variant at its
 operating point over one revolution of its flexible gears (flexgear.modal.period), prints one line per mode
 (mean frequency, damping ratio, kind, spread over the revolution, multiplet and its split, the components holding
-most kinetic and strain energy) and writes DIR/<variant>/modes.csv (flexgear.modal.modes.Modes.table: mode,
+most kinetic and strain energy) and writes DIR/<variant>/modes.csv (flexgear.modal.eigenmodes.Modes.table: mode,
 frequency_hz, damping_ratio, kind, spread_pct, multiplicity, split_pct, kinetic_<component>, strain_<component>).
 
-``flexgear campbell VARIANT [--speeds-rpm 0:6000:500] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell) writes
-DIR/<variant>/campbell.csv (speed_rpm, mode, frequency_hz, damping_ratio, kind), crossings.csv (speed_rpm, order,
+``flexgear campbell VARIANT [--speeds-rpm 0:6000:500] [--f-max-hz F] [--out DIR]`` (flexgear.modal.campbell_diagram)
+writes DIR/<variant>/campbell.csv (speed_rpm, mode, frequency_hz, damping_ratio, kind), crossings.csv (speed_rpm, order,
 mode, kind, frequency_hz) and campbell.png.
 
 ``flexgear modal-screening VARIANT [--f-band-hz F] [--threshold S] [--out DIR]`` (flexgear.modal.screening; VARIANT

@@ -10,7 +10,7 @@ theta_g = Omega_g (t* - T/2) (flexgear.laws.ramps.drive_angle, T the ramp time),
     t*_j = T + j P / J,  j = 0 ... J - 1,    P = 2 pi / min_g |Omega_g|
 
 over one revolution of the slowest-turning flexible gear (the others turn at least once in P) covers every angle
-of every flexible gear. The k-th mode (ascending |lambda|, flexgear.modal.modes) is followed through the samples by
+of every flexible gear. The k-th mode (ascending |lambda|, flexgear.modal.eigenmodes) is followed through the samples by
 its rank: the k-th eigenvalue is a continuous function of the angles, and where two close modes exchange their
 shapes between samples (the pairs of a slightly broken cyclic symmetry, whose shapes are not unique) their
 frequencies still belong to the k-th and (k+1)-th curves. The ranks are matched as the assignment of least
@@ -27,8 +27,8 @@ import math
 
 import numpy as np
 
+from flexgear.modal.eigenmodes import Modes, modes
 from flexgear.modal.linear import LinearModel, linearize
-from flexgear.modal.modes import Modes, modes
 from flexgear.spec import Variant
 
 __all__ = ["period_modes", "period_samples", "is_gear", "DEFAULT_SAMPLES", "NO_CONTINUATION"]

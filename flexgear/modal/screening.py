@@ -3,10 +3,10 @@
 The all-flexible variant (Table 3's model 7) is linearised at its operating point (flexgear.modal.linear) and its
 modes are taken within the excitation band of the load case, 0 < f <= f_band = 10 f_m (f_m the mesh frequency at
 the operating speed, flexgear.theory; the mesh excitation's harmonics 1x to 10x), leaving out roots without a
-resonance peak (damping ratio zeta >= 1/sqrt(2), flexgear.modal.campbell).
+resonance peak (damping ratio zeta >= 1/sqrt(2), flexgear.modal.campbell_diagram).
 
 Elastic share. For a component c and a mode j, s_cj is the share of the mode's strain energy in c's own elastic
-coordinates (flexgear.modal.modes: column ``strain_<c>_elastic``; the planets' shares are added into one component,
+coordinates (flexgear.modal.eigenmodes: column ``strain_<c>_elastic``; the planets' shares are added into one component,
 ``planets``, as in Table 3; a component that is rigid in the variant has none: s_cj = 0).
 
 Weight. A mode matters as much as the mesh excitation can amplify it: a harmonic force at k f_m drives mode j (a

@@ -3,8 +3,8 @@
 Computed once per report from the saved runs' variant files (no time-domain run): the selected variant and the
 reference (the all-flexible model 7 when the matrix used it) linearised at their operating point
 (flexgear.modal.linear) and their modes within the excitation band (10 mesh harmonics at the load case's speed,
-flexgear.modal.modes); the selected variant's Campbell diagram over :data:`CAMPBELL_POINTS` speeds from rest to the
-nominal speed (flexgear.modal.campbell); the run-up order map of the selected and the reference run
+flexgear.modal.eigenmodes); the selected variant's Campbell diagram over :data:`CAMPBELL_POINTS` speeds from rest to the
+nominal speed (flexgear.modal.campbell_diagram); the run-up order map of the selected and the reference run
 (flexgear.study.runup: the load case's STEP ramp of the input speed read as a run-up; also the selected variant's
 run of another results folder whose ramp is slower, where the orders are resolved further down); the steady
 harmonic response over the speed range (flexgear.harmonic) of the selected variant, the reference and the lumped model.

@@ -2,8 +2,8 @@
 
 During the ramp the input speed n(t) [rpm] rises from 0 to its nominal value (flexgear.laws.ramps, STEP), so the
 mesh harmonics k f_m(n) sweep through the natural frequencies: where the order k line of a Campbell diagram
-crosses a mode (flexgear.modal.campbell), the bearing acceleration's k-th mesh order swells to a ridge. This module
-computes, from a saved run's signals (flexgear.results):
+crosses a mode (flexgear.modal.campbell_diagram), the bearing acceleration's k-th mesh order swells to a ridge. This
+module computes, from a saved run's signals (flexgear.results):
 
 Spectrogram (for the picture). Short-time Fourier transform of a bearing acceleration y(t) with a Hann window of
 length L [s], hop h [s]; each column is drawn at the instantaneous input speed of its window's centre. Amplitude
@@ -26,7 +26,7 @@ its neighbourhood (the peak prominence of the track in dB) and :data:`MIN_SNR_DB
 larger of the noise floor (the median amplitude of the spectrogram's bins between the first and the highest order:
 most bins hold no order) and the leakage floor (the strongest order's track times the window's side-lobe level,
 :data:`SIDE_LOBE_DB`: what a strong order leaks into the others' tracks). Ridges are ranked by prominence. Each
-is compared with a predicted crossing of the same order (flexgear.modal.campbell.Campbell.crossings; below):
+is compared with a predicted crossing of the same order (flexgear.modal.campbell_diagram.Campbell.crossings; below):
 error = (n_ridge - n_crossing) / n_crossing.
 
 The ridge of a crossing need not lie exactly at it. A damped mode's steady response peak is shifted by the trend
@@ -46,8 +46,9 @@ F = k delta^p, so s(t) ~ F(t) = sum_c F_c(t), the sum of the recorded mesh force
 also accelerates the driven members, whose inertia torque J alpha(t) the meshes carry on top of it.
 
 Ridges against predictions. :func:`runup` compares each ridge with the crossings of its order that the order
-excites (flexgear.modal.campbell: mesh phasing), each with its swept prediction n_swept (:func:`swept_crossings`,
-the line's damping ratio at the crossing): the ridge is matched with the nearest n_swept, swept_error =
+excites (flexgear.modal.campbell_diagram: mesh phasing), each with its swept prediction n_swept
+(:func:`swept_crossings`, the line's damping ratio at the crossing): the ridge is matched with the nearest n_swept,
+swept_error =
 (n_ridge - n_swept) / n_swept, next to the error against the crossing itself. The Campbell diagram's operating point
 is the full load torque; the modes along the ramp differ where the mesh stiffness matters (the impact law's tangent
 1.5 k delta^0.5 follows the load), which flexgear.modal.linearize at the ridge's speed and time t* shows. The
@@ -320,8 +321,8 @@ def swept_crossings(crossings: pd.DataFrame, time_s: np.ndarray, speed_rpm: np.n
                     speed_range_rpm: tuple[float, float], orders: Sequence[int],
                     excitation: np.ndarray | None = None, window_s: float = DEFAULT_WINDOW_S,
                     hop_s: float = DEFAULT_HOP_S) -> pd.DataFrame:
-    """The ``crossings`` (flexgear.modal.campbell: speed_rpm, order, frequency_hz, damping_ratio, excited) of the
-    ``orders`` whose crossing speed lies within ``speed_range_rpm`` [rpm], each with swept_rpm, its ridge under the
+    """The ``crossings`` (flexgear.modal.campbell_diagram: speed_rpm, order, frequency_hz, damping_ratio, excited) of
+    the ``orders`` whose crossing speed lies within ``speed_range_rpm`` [rpm], each with swept_rpm, its ridge under the
     run's own sweep (:func:`swept_peak` with the line's damping ratio and ``excitation``); only the excited ones
     where the column is given."""
     lo, hi = speed_range_rpm
@@ -351,8 +352,8 @@ class RunUp:
              f_min_hz: float = F_MIN_HZ) -> Any:
         """The map over the input speed [rpm] during the ramp, frequency [Hz] on a log axis from ``f_min_hz``,
         amplitude in dB (``db_range`` below the map's top level); the mesh orders (white dashed), the Campbell
-        lines of ``campbell`` (flexgear.modal.campbell.Campbell, black), the region where the tracks do not resolve
-        the orders (hatched) and the ``ridges`` strongest ridges (red circles). Returns ``ax``."""
+        lines of ``campbell`` (flexgear.modal.campbell_diagram.Campbell, black), the region where the tracks do not
+        resolve the orders (hatched) and the ``ridges`` strongest ridges (red circles). Returns ``ax``."""
         mp = self.map
         rising = (mp.time_s <= self.ramp_end_s) & np.concatenate([[True], np.diff(mp.speed_rpm) > 0])
         n, a = mp.speed_rpm[rising], mp.amplitude[:, rising]
@@ -395,7 +396,7 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
     """The run-up of a saved run (module docstring) from the ``side`` ("input"/"output") bearing acceleration
     along ``axis`` ("x"/"y"); the instantaneous speed is the recorded input speed, the ramp's end the run's
     ``ramp_time_s``, the mesh frequency per rpm the run's theory values (mesh frequency / nominal input speed).
-    ``campbell``: a flexgear.modal.campbell.Campbell whose crossings the ridges are matched with (module
+    ``campbell``: a flexgear.modal.campbell_diagram.Campbell whose crossings the ridges are matched with (module
     docstring: by their swept predictions under the run's mesh excitation). ``linear``: a
     flexgear.study.runup_linear.LinearRunUp of the same run, whose ridges of the same signal the ridges are matched
     with (linear_rpm, linear_error_pct: flexgear.study.runup_linear.match_linear)."""

@@ -2,7 +2,7 @@
 
 At each input speed n [rpm] of a grid the variant is linearised at its operating point (flexgear.modal.linear:
 mean mesh stiffness, spin softening and gyroscopic terms of that speed) and its modes are computed up to a band
-f_max [Hz] (flexgear.modal.modes). Roots with a damping ratio zeta >= 1/sqrt(2) are left out: a mode without a
+f_max [Hz] (flexgear.modal.eigenmodes). Roots with a damping ratio zeta >= 1/sqrt(2) are left out: a mode without a
 resonance peak (the amplification 1/sqrt((1 - r^2)^2 + (2 zeta r)^2) has its maximum at r = 0 for zeta >= 1/sqrt(2))
 cannot resonate at a crossing; at speed these are the overdamped roots that the gyroscopic coupling makes
 complex by a small imaginary part.
