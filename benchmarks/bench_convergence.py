@@ -193,9 +193,10 @@ def _patch_reference(fe, itfs, rigid: tuple[str, ...], f_max_hz: float) -> np.nd
                       shape=(fe.n_dof, idofs.size + 6 * len(patches)))
     k, m = (t.T @ fe.K @ t).tocsc(), (t.T @ fe.M @ t).tocsc()
 
-    def eigen(n: int) -> tuple[np.ndarray, np.ndarray]:
-        lam, vec = sla.eigsh(k, k=n + 6, M=m, sigma=-1.0, which="LM", tol=1e-10)
-        order = np.argsort(lam)[6:]  # the six rigid-body modes
+    def eigen(n: int, found: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:  # the n pairs beyond ``found``
+        j = 0 if found is None else found.shape[1]
+        lam, vec = sla.eigsh(k, k=j + n + 6, M=m, sigma=-1.0, which="LM", tol=1e-10)
+        order = np.argsort(lam)[6 + j:]  # past the six rigid-body modes and those found
         return lam[order], vec[:, order]
 
     lam = lowest_eigenpairs(eigen, max_hz=f_max_hz)[0]
@@ -221,7 +222,8 @@ def band(spec, body: str, level: str, cutoff_orders: list[float], band_orders: f
     if rigid:  # the reference holds the rigid patches rigid too
         full = _patch_reference(fe, itfs, rigid, 1.02 * f_band)
     else:
-        full = np.sqrt(np.maximum(lowest_eigenpairs(lambda k: free.eigen(fe, k, m), max_hz=1.02 * f_band)[0], 0.0))
+        full = np.sqrt(np.maximum(lowest_eigenpairs(lambda k, found: free.eigen(fe, k, m, found),
+                                                     max_hz=1.02 * f_band)[0], 0.0))
         full /= 2 * np.pi
     full = full[full < f_band]
     parts = reduction_basis(fe, itfs, None, "rbe3", circles, solver=solver, rigid=rigid,

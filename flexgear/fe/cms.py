@@ -51,7 +51,7 @@ from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import FEModel, rigid_body_modes
 from flexgear.fe.invariants import EPS as _EPS
 from flexgear.fe.invariants import ffrf_invariants
-from flexgear.fe.spectrum import lowest_eigenpairs
+from flexgear.fe.spectrum import lowest_eigenpairs, shift_invert_pairs
 from flexgear.geometry.massprops import MassProperties
 
 __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights", "reduce", "reduction_basis",
@@ -198,13 +198,13 @@ class _Constrained:
         u[s.free] += y - self.z @ lam
         return u
 
-    def eigen(self, fe: FEModel, k: int, m: sp.spmatrix | sla.LinearOperator) -> tuple[np.ndarray, np.ndarray]:
-        """Lowest k eigenpairs of K phi = omega^2 M phi on {C phi = 0} (shift-invert at 0, ARPACK)."""
-        op = sla.LinearOperator((self.s.n, self.s.n), matvec=lambda f: self.solve(f)[:, 0], dtype=float)
+    def eigen(self, fe: FEModel, k: int, m: sp.spmatrix | sla.LinearOperator, found: np.ndarray | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:
+        """Lowest k eigenpairs of K phi = omega^2 M phi on {C phi = 0} beyond the eigenvectors ``found``
+        (flexgear.fe.spectrum.shift_invert_pairs)."""
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
         k = min(k, self.s.n - self.p - 2)
-        lam, vec = sla.eigsh(fe.K, k=k, M=m, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
-        return np.sort(lam), vec[:, np.argsort(lam)]
+        return shift_invert_pairs(lambda f: self.solve(f)[:, 0], m, k, v0, found)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
@@ -354,13 +354,11 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     static[idofs, :ub.shape[1]] = solve(-np.asarray(fe.K[bdofs][:, idofs].T @ ub))
     if soft:
         static[idofs, ub.shape[1]:] = solve(None, np.eye(c.shape[0]))
-    op = sla.LinearOperator((len(idofs),) * 2, matvec=lambda f: solve(f[:, None])[:, 0], dtype=float)
     m_ii = fe.mass_operator(np.setdiff1d(np.arange(fe.n_nodes), bnodes))  # rows and columns idofs
     v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
 
-    def eigen(k: int) -> tuple[np.ndarray, np.ndarray]:  # shift-invert about 0 reads K_ii only through OPinv
-        lam, vec = sla.eigsh(op, k=k, M=m_ii, sigma=0.0, OPinv=op, which="LM", v0=v0, tol=1e-10)
-        return np.sort(lam), vec[:, np.argsort(lam)]
+    def eigen(k: int, found: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:  # reads K_ii only through solve
+        return shift_invert_pairs(lambda f: solve(f[:, None])[:, 0], m_ii, k, v0, found)
 
     vec = lowest_eigenpairs(eigen, n_modes, max_hz, limit=len(idofs) - c.shape[0] - 2)[1]
     fixed = np.zeros((fe.n_dof, vec.shape[1]))
@@ -400,7 +398,8 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int | None, kin
     con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(None, np.eye(con.p))
     m = fe.mass_operator()
-    vec = lowest_eigenpairs(lambda k: con.eigen(fe, k, m), n_modes, max_hz, limit=con.s.n - con.p - 2)[1]
+    vec = lowest_eigenpairs(lambda k, found: con.eigen(fe, k, m, found), n_modes, max_hz,
+                            limit=con.s.n - con.p - 2)[1]
     fixed = vec if vec.shape[1] else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns
     return BasisParts(static, fixed, attached, solver)
