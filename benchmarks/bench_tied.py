@@ -37,6 +37,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ("ring", "output_shaft", "tied")
 BASELINE_CASES = ("ring", "output_shaft")
+"""A baseline's bodies (the per-bolt code has no tied pair; a baseline with flexgear/fe/ring_shaft.py builds it too)."""
 
 
 def _builder(spec, case: str, level: str):
@@ -76,7 +77,8 @@ def _child_json(args: list[str], root: Path) -> dict:
 
 def build_section(level: str, baseline: Path | None) -> list[dict]:
     rows = []
-    runs = [(ROOT, "current", CASES)] + ([(baseline, "baseline", BASELINE_CASES)] if baseline else [])
+    old = CASES if baseline and (baseline / "flexgear" / "fe" / "ring_shaft.py").exists() else BASELINE_CASES
+    runs = [(ROOT, "current", CASES)] + ([(baseline, "baseline", old)] if baseline else [])
     for root, label, cases in runs:
         for case in cases:
             row = {"code": label, **_child_json(["--child", case, "--level", level], root)}
