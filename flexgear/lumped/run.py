@@ -6,8 +6,8 @@ star arrangement, where they reduce to eq. 1-9 with N planets):
     m (x'' + 2 Omega J x' + Omega' J rho - Omega^2 rho) = F_bearing + F_mesh + F_friction      (translations)
     I (theta'' + Omega')                                = T_support + T_mesh + T_friction + T_load  (spins)
 
-with rho = nominal centre + x. Each mesh m (flexgear.lumped.run.model) has the normal deflection
-delta = G_m . q and the normal force (eq. 1-13)
+with rho = nominal centre + x. Each mesh m (:func:`build_lumped_model`) has the normal deflection delta = G_m . q
+and the normal force (eq. 1-13)
 
     F_n = k_m(t) f(delta) + c_m delta'   (damping only while the teeth touch)
     k_m(t) = k_mean (1 + sum_n c_n cos(2 pi n (phi_m - (eps_alpha + eps_beta)/2)))   (eq. 11-12)
@@ -30,9 +30,8 @@ regularised as tanh(omega_1 p_bt / v_reg). The stiffness series and the friction
 model's compiled ones (flexgear.laws.compiled.series_value, tooth_friction). The input spin follows the STEP
 speed ramp exactly (prescribed); the load torque is the STEP load ramp on the output member (Table 5).
 
-Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps
-per recorded step), the right-hand side compiled with numba. The highest natural frequency of the
-study's set (~8 kHz) gives omega h << 2.8, well inside RK4's stability region.
+Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps per recorded
+step), the right-hand side compiled with numba; at the study's highest frequency (~8 kHz) omega h << 2.8 (RK4's limit).
 """
 
 from __future__ import annotations
