@@ -101,7 +101,7 @@ class ScreeningSettings:
     selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
     weights: IndicatorWeights
     reference_indicators: ReferenceIndicators
-    # settled window (flexgear.study.indicators.settled_start): blocks of whole mesh cycles, tolerances in %
+    # settled window (flexgear.settling.settled_start): blocks of whole mesh cycles, tolerances in %
     settle_block_mesh_cycles: int = _num(1, 100000, integer=True)
     settle_final_blocks: int = _num(1, 1000, integer=True)
     settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)

@@ -1,6 +1,6 @@
 """Natural frequencies and mode shapes of the linearised lumped model (mean mesh stiffness).
 
-The undamped eigenproblem K phi = omega^2 M phi of :func:`flexgear.lumped.run.model.assemble` with the
+The undamped eigenproblem K phi = omega^2 M phi of :func:`flexgear.lumped.model.assemble` with the
 mean mesh stiffness of eq. 10 (gyroscopic and centripetal terms of a rotating carrier neglected, as
 in Lin & Parker 1999). Each mode is classified by where its kinetic energy sits (mass-normalised
 shape, energy share e = m phi^2 per coordinate):

@@ -91,7 +91,7 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
     Built with :func:`flexgear.mbs.contacts.mesh_pair_contacts` from the design's mesh contact geometry
     (flexgear.design ``meshes``). Sun-planet: gear 1 = sun, pushing
     in the drive sense; planet-ring: gear 1 = planet, pushing against the drive sense. The halves'
-    hands (flexgear.geometry.layout.pair convention, gear 1 in the +z half): sun +1, planet -1, so that the
+    hands (flexgear.geometry.pair convention, gear 1 in the +z half): sun +1, planet -1, so that the
     planet's axial forces from sun and ring cancel. Mesh phase of planet i:
     phi = z_s theta_drive / (2 pi) - z_s psi_i / (2 pi) (sequential phasing), plus the configured
     outer-inner phase on the planet-ring mesh. ``spec``: a spec or its design (flexgear.design).

@@ -61,7 +61,7 @@ class Recorder:
         return self.add(f"{name}_force", "n", [self._object(s, "Force") for s in springs], 0)
 
     def drive_torque(self, name: str, drive: int) -> str:
-        """Torque [N m] the speed drive (flexgear.mbs.contacts.add_speed_drive) applies: ``{name}_torque_nm``."""
+        """Torque [N m] the speed drive (flexgear.mbs.elements.add_speed_drive) applies: ``{name}_torque_nm``."""
         return self.add(f"{name}_torque", "nm", [self._object(drive, "Force")], 0, scale=-1.0)
 
     def acceleration(self, name: str, body: Body) -> tuple[str, str]:

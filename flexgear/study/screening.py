@@ -97,7 +97,7 @@ def analysis_window(meta: dict, t_first: float, t_last: float, settings: Screeni
                     signals: pd.DataFrame | None = None) -> Window:
     """The window of a run per ``settings.window`` (see gearbox.toml ``[screening]``).
 
-    ``"settled"`` needs the run's ``signals`` (flexgear.study.indicators.settled_start); a run that
+    ``"settled"`` needs the run's ``signals`` (flexgear.settling.settled_start); a run that
     does not settle is screened after its ramps and marked not steady.
     """
     if settings.window == "settled" and signals is not None:
