@@ -29,7 +29,7 @@ from flexgear.geometry.massprops import MassProperties
 from flexgear.geometry.profile import ToothProfile
 from flexgear.geometry.supports import seat_supports
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
-from flexgear.theory import Theory, theory
+from flexgear.theory import Theory, gear_set_theory
 
 __all__ = ["Design", "design", "as_design"]
 
@@ -76,8 +76,8 @@ def design(spec: GearboxSpec) -> Design:
     key = spec_hash(spec)
     made = _DESIGNS.get(key)
     if made is None:
-        th = theory(spec)
-        geo = gear_set_geometry(spec)  # the gear set the theory was made of (cached per gear tables)
+        geo = gear_set_geometry(spec)
+        th = gear_set_theory(spec, geo)
         profiles = tooth_profiles(geo, spec.gears_assumed.root_fillet_coefficient)
         layouts = {c: gear_set_layout(spec, geo, c) for c in GEOMETRY_COMPONENTS}
         rho = spec.material_assumed.density_kg_m3
