@@ -336,12 +336,24 @@ def assembled(coupled: Coupled, flexibilities: list[Flexibility], scale: float |
     return t0, t1, remainder
 
 
+CLUSTER_RTOL = 1e-3
+"""Roots of the linear pencil closer than this (relative, in s = omega^2) are refined together as one cluster: near-
+equal roots (the five planets' local modes) share their subspace, and refining each alone can carry two of them to
+the same root."""
+
+
 def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = np.inf, newton: int = 4,
                 refine: int = 1) -> tuple[np.ndarray, np.ndarray]:
     """Roots s <= ``s_max`` of T(s) = T_0 - s T_1 + remainder(s) (ascending, s = omega^2 [1/s^2]): the linear
-    pencil's real positive eigenvalues, each then moved to the root of its Rayleigh functional x^T T(s) x = 0 (T
-    symmetric: the error is of second order in the remainder's effect on the eigenvector), ``refine`` times more
-    after an inverse-iteration step x <- T(s)^-1 T'(s) x. Returns (s, x (n, modes) unit vectors)."""
+    pencil's real positive eigenvalues, then refined for the remainder cluster by cluster (roots within
+    :data:`CLUSTER_RTOL`; a single root is a cluster of one). On the cluster's vectors X the remainder is linearised
+    at the cluster's mean root s_c, h(s) ~ h(s_c) + (s - s_c) h'(s_c), and the projected pencil
+
+        X^T (T_0 + h(s_c) - s_c h'(s_c)) X y = s X^T (T_1 - h'(s_c)) X y
+
+    gives the cluster's roots (for one vector: Newton's step on its Rayleigh functional x^T T(s) x = 0; T symmetric,
+    so the error is of second order in the vectors'), ``newton`` times; then ``refine`` times more after an
+    inverse-iteration step X <- T(s_c)^-1 T'(s_c) X. Returns (s, x (n, modes) unit vectors)."""
     from scipy.linalg import eig
 
     sigma = 0.0 if not np.isfinite(s_max) else 0.5 * s_max
@@ -355,17 +367,25 @@ def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = n
     s, x = s[order], x[:, order]
     if remainder is None:
         return s[s <= s_max], x[:, s <= s_max]
-    for i in range(len(s)):
-        v = x[:, i]
+    starts = np.flatnonzero(np.concatenate([[True], s[1:] > s[:-1] * (1.0 + CLUSTER_RTOL)]))
+    for cluster in np.split(np.arange(len(s)), starts[1:]):
+        basis = np.linalg.qr(x[:, cluster])[0]  # orthonormal, spans the cluster's vectors
         for step in range(refine + 1):
             for _ in range(newton):
-                h, dh = remainder(s[i])
-                s[i] -= (v @ (t0 - s[i] * t1 + h) @ v) / (v @ (dh - t1) @ v)
+                s_c = float(np.mean(s[cluster]))
+                h, dh = remainder(s_c)
+                a, b = basis.T @ (t0 + h - s_c * dh) @ basis, basis.T @ (t1 - dh) @ basis
+                roots, y = eig(0.5 * (a + a.T), 0.5 * (b + b.T))
+                order = np.argsort(roots.real)
+                s[cluster], y = roots.real[order], y[:, order].real
+            ritz = basis @ y
             if step < refine:
-                h, dh = remainder(s[i])
-                v = np.linalg.solve(t0 - s[i] * t1 + h, (dh - t1) @ v)
-                v /= np.linalg.norm(v)
-        x[:, i] = v
+                h, dh = remainder(s_c)
+                try:
+                    basis = np.linalg.qr(np.linalg.solve(t0 - s_c * t1 + h, (dh - t1) @ ritz))[0]
+                except np.linalg.LinAlgError:  # T(s_c) singular in working precision: s_c is a root, keep them
+                    pass
+        x[:, cluster] = ritz / np.linalg.norm(ritz, axis=0)
     order = np.argsort(s)
     s, x = s[order], x[:, order]
     return s[s <= s_max], x[:, s <= s_max]
