@@ -24,6 +24,7 @@ against the linear run-up of the same frictionless variant; and the CPU times.
 
 from __future__ import annotations
 
+import dataclasses
 import sys
 import time
 from pathlib import Path
@@ -115,8 +116,9 @@ def main() -> None:
     top = []
     for side in ("output", "input"):
         t0 = time.process_time()
-        ru = runup(result, side, campbell=c, linear=linear)
         column = f"{side}_bearing_accel_x_m_per_s2"
+        ru = runup(result, side, campbell=c)
+        ru = dataclasses.replace(ru, ridges=match_linear(ru.ridges, linear.ridges[column]))
         on_ramp = match_linear(ru.ridges.head(3), ramp.ridges[column])
         print(f"{run_dir.name} {side} bearing: {time.process_time() - t0:.2f} s CPU, {len(ru.ridges)} ridges")
         for j, (_, r) in enumerate(ru.ridges.head(3).iterrows()):
@@ -154,7 +156,6 @@ def main() -> None:
 def frictionless(variant) -> None:
     """The variant run again without tooth friction: its strongest ridges against the linear run-up of the same
     frictionless variant (no friction excitation)."""
-    import dataclasses
 
     from flexgear.mbs.run import run_variant
 
@@ -164,7 +165,8 @@ def frictionless(variant) -> None:
     print(f"{variant.name} without tooth friction: {time.process_time() - t0:.1f} s CPU")
     linear = linear_runup(free, smooth)
     for side in ("output", "input"):
-        for _, r in runup(free, side, linear=linear).ridges.head(3).iterrows():
+        column = f"{side}_bearing_accel_x_m_per_s2"
+        for _, r in match_linear(runup(free, side).ridges, linear.ridges[column]).head(3).iterrows():
             print(f"  {side} {r['order']:.0f}x ridge at {r['speed_rpm']:7.1f} rpm ({r['prominence_db']:.1f} dB, "
                   f"{r['amplitude']:.3g} m/s^2): linear run-up {r['linear_rpm']:7.1f} rpm, error "
                   f"{r['linear_error_pct']:+.2f} %")

@@ -52,7 +52,7 @@ swept_error =
 (n_ridge - n_swept) / n_swept, next to the error against the crossing itself. The Campbell diagram's operating point
 is the full load torque; the modes along the ramp differ where the mesh stiffness matters (the impact law's tangent
 1.5 k delta^0.5 follows the load), which flexgear.modal.linearize at the ridge's speed and time t* shows. The
-reference with all modes together is the linearised model's own run-up (flexgear.study.runup_linear, ``linear``).
+reference with all modes together is the linearised model's own run-up (flexgear.study.runup_linear).
 """
 
 from __future__ import annotations
@@ -392,14 +392,13 @@ class RunUp:
 
 def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: Any = None,
           window_s: float = DEFAULT_WINDOW_S, hop_s: float = DEFAULT_HOP_S,
-          orders: Sequence[int] = ORDERS, linear: Any = None) -> RunUp:
+          orders: Sequence[int] = ORDERS) -> RunUp:
     """The run-up of a saved run (module docstring) from the ``side`` ("input"/"output") bearing acceleration
     along ``axis`` ("x"/"y"); the instantaneous speed is the recorded input speed, the ramp's end the run's
     ``ramp_time_s``, the mesh frequency per rpm the run's theory values (mesh frequency / nominal input speed).
     ``campbell``: a flexgear.modal.campbell_diagram.Campbell whose crossings the ridges are matched with (module
-    docstring: by their swept predictions under the run's mesh excitation). ``linear``: a
-    flexgear.study.runup_linear.LinearRunUp of the same run, whose ridges of the same signal the ridges are matched
-    with (linear_rpm, linear_error_pct: flexgear.study.runup_linear.match_linear)."""
+    docstring: by their swept predictions under the run's mesh excitation); the ridges against the linearised
+    model's own run-up: flexgear.study.runup_linear.match_linear."""
     if not result.ok or result.signals is None:
         raise ValueError(f"run {result.name!r} has no signals")
     s = result.signals
@@ -426,8 +425,4 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
             found = match_crossings(found, crossings, on="swept_rpm")
         else:
             found = match_crossings(found, crossings)
-    if linear is not None:
-        from flexgear.study.runup_linear import match_linear  # it builds on this module
-
-        found = match_linear(found, linear.ridges[column])
     return RunUp(result.name, mp, tracks, found, ramp, tuple(orders))
