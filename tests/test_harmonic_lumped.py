@@ -11,6 +11,7 @@ Campbell diagram (flexgear.harmonic.peaks, flexgear.study.harmonic_check).
     ((h z_s +- 1) / N an integer), planet modes at 2x (neither h z_s / N nor (h z_s +- 1) / N).
 (3) At the study's damping, the peaks of the modes whose damping shift zeta^2 is at most a quarter of the 1 %
     (damping ratio <= :data:`LIGHT`) within 1 % of their crossings.
+(4) The tooth-friction excitation is the Fourier series of the time model's friction force (to round-off).
 """
 
 
@@ -96,3 +97,85 @@ def test_modal_contributions_add_up_to_the_response(iso_spec):
     force = lumped_harmonic_response(iso_spec, [speed], 3).complex(mesh).loc[speed, h]
     response_part = force - op.f0[0] * op.coef[0, h - 1]
     assert parts.contribution.sum() == pytest.approx(response_part, rel=1e-8)
+
+
+def test_friction_excitation_is_the_time_models_friction_force_series(gearbox):
+    """(4) The lumped tooth-friction excitation (flexgear.harmonic.lumped_friction) is the Fourier series of the time
+    model's own friction generalised force: the compiled right-hand side with mu minus that with mu = 0, times the
+    masses, at the static deflection over one mesh cycle of the rigid running (the kernel's friction path, nothing
+    else differs). Integrated exactly up to round-off: Gauss-Legendre on every interval between the tables' nodes
+    of all meshes, where the integrand is a straight line times a trigonometric polynomial of degree
+    H_s + H <= 8 over at most 1/64 of a cycle (4-point error ~ (2 pi 8 / 64)^8 / 8! ~ 1e-8 relative to the
+    interval's share 1/64 ... below 1e-13 of the total). The series leaves the ring's static rotation out of the
+    ring meshes' phase, as the stiffness excitation does; the time model's phase has it: the comparison adds it.
+    At mu = 0 the excitation is the stiffness excitation alone, unchanged."""
+    from dataclasses import replace
+
+    from flexgear.harmonic.base import RPM, _excited, excitation
+    from flexgear.harmonic.lumped import lumped_linear
+    from flexgear.harmonic.lumped_friction import nominal_spin_rates
+    from flexgear.lumped.run import _T_RAMP, _W_IN, build_lumped_model, lumped_rhs
+
+    harm = 4
+    spec = gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.06)
+    spec = spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
+    spec = spec.with_fields("lumped_assumed", friction_table_points=64)
+    dry = spec.with_fields("contact", friction_coefficient=0.0)
+    model = build_lumped_model(_excited(spec, harm))
+    w = float(model.fp[_W_IN])  # the time model's prescribed input speed [rad/s]
+    speed = w / RPM
+    lin = lumped_linear(spec, harm)
+    op, op0 = lin.operating(speed), lumped_linear(dry, harm).operating(speed)
+    assert op0.friction is None
+    for a, b in zip(excitation(op0, harm), excitation(replace(op, friction=None, friction_rows=None), harm),
+                    strict=True):
+        np.testing.assert_array_equal(a, b)
+    series = excitation(op, harm)[1] - excitation(op0, harm)[1]  # (H, n_f)
+
+    rhs, rhs0 = lumped_rhs(model), lumped_rhs(build_lumped_model(_excited(dry, harm)))
+    free, s = model.free, model.system
+    mass = s.mass[free]
+    assert np.all(mass > 0.0)
+    pos = {int(j): k for k, j in enumerate(free)}
+    r = nominal_spin_rates(model)
+    np.testing.assert_allclose(s.mesh_G @ r, 0.0, atol=1e-12)
+    rate = model.phase_coef * r[model.phase_index]  # mesh cycles per rad of input, all one sense here
+    np.testing.assert_allclose(np.abs(rate), abs(rate[0]), rtol=1e-12)
+    sense = np.sign(rate)
+    static_phase = np.array([model.phase_coef[m] * lin.static[pos[int(i)]] if int(i) in pos else 0.0
+                             for m, i in enumerate(model.phase_index)])
+    t0 = model.fp[_T_RAMP]  # the ramp done: input angle w (t - t_ramp / 2)
+    psi0 = abs(rate[0]) * w * 0.5 * t0  # global mesh phase at t0 [cycles]
+    phase0 = model.phase_coef * r[model.phase_index] * w * 0.5 * t0 + static_phase + model.phase_offset
+    npts = model.tables.shape[1]
+    nodes = np.arange(npts) / npts
+    breaks = np.unique(np.r_[0.0, 1.0, np.mod((nodes[None] - phase0[:, None]) * sense[:, None], 1.0).ravel()])
+    gx, gw = np.polynomial.legendre.leggauss(4)
+    coef = np.zeros((harm, free.size), complex)
+    peak, amp = np.zeros(free.size), 0.0
+    h = np.arange(1, harm + 1)
+    g_abs = np.abs(s.mesh_G)
+    delta0 = op.f0 / model.mesh_k
+    for lo, hi in zip(breaks[:-1], breaks[1:], strict=True):
+        for xi, wi in zip(0.5 * (lo + hi) + 0.5 * (hi - lo) * gx, 0.5 * (hi - lo) * gw, strict=True):
+            t = t0 + xi / (abs(rate[0]) * w)
+            th = t - 0.5 * t0
+            y = np.r_[lin.static + r[free] * w * th, r[free] * w]
+            force = (rhs(t, y)[free.size:] - rhs0(t, y)[free.size:]) * mass
+            coef += 2.0 * wi * np.exp(-2j * np.pi * h * (psi0 + xi))[:, None] * force[None]
+            peak = np.maximum(peak, np.abs(force))
+            q = np.zeros(s.n)
+            q[free], q[model.presc] = y[:free.size], model.presc_coef * w * th
+            amp = max(amp, float(np.max(g_abs @ np.abs(q) / delta0)))
+    # the series with the ring's static rotation in the ring meshes' phase (the time model's phase)
+    fr = op.friction * np.exp(2j * np.pi * h[None] * np.tile(static_phase * sense, 3)[:, None])
+    shifted = -(op.friction_rows.T @ fr).T
+    # round-off: the kernel's deflection G q at the running angle carries ~ eps sum |G_k q_k| (angles of tens of
+    # rad against deflections of um), relative eps * amp in F and in the friction force Q (linear in F); the
+    # difference of the two right-hand sides adds ~ eps per term of the ~20-term accelerations (each of order
+    # the mesh forces F_0, the arms below 1 m); the quadrature's weights sum to 1 (times 2): per coordinate
+    # 2 * 16 eps (amp max|Q| + 20 max F_0)
+    eps = np.finfo(float).eps
+    tol = 32 * eps * (amp * peak + 20.0 * op.f0.max())
+    assert np.abs(series).max() > 1e6 * tol.max()  # the friction excitation is there
+    assert np.all(np.abs(coef - shifted) <= tol[None]), np.abs(coef - shifted).max(0) / tol

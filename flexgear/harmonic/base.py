@@ -109,9 +109,10 @@ class _Operating:
     per coordinate; ``te`` (n,): transmission error per coordinate; ``omega_mesh`` [rad/s]; ``solver``: None
     (a dense complex solve of the full matrices) or a callable (omegas (H,) [rad/s], c (H, n_c)) -> X (H, n)
     solving the same problem for the force rows^T c_h (flexgear.harmonic.reduced.ModalSolver.solve), or, with
-    friction, for [rows; friction_rows]^T [c_h; -friction_h]. ``friction_rows`` (2 n_c, n), ``friction``
-    (2 n_c, H) complex [N, N m]: the tooth-friction excitation (flexgear.harmonic.friction: the sliding and
-    relative-spin rows and their forces at +h f_mesh); None: no friction.
+    friction, for [rows; friction_rows]^T [c_h; -friction_h]. ``friction_rows`` (n_r, n), ``friction``
+    (n_r, H) complex [N, N m]: the tooth-friction excitation -friction_rows^T friction_h (flexgear.harmonic.friction:
+    the sliding and relative-spin rows of the n_c contacts, n_r = 2 n_c; flexgear.harmonic.lumped_friction: the
+    translation and two spin rows of the lumped meshes, n_r = 3 n_m); None: no friction.
     """
 
     mass: np.ndarray

@@ -24,6 +24,7 @@ from flexgear.harmonic.base import (
     _sweep,
     mesh_frequency_hz,
 )
+from flexgear.harmonic.lumped_friction import lumped_friction
 
 __all__ = ["lumped_harmonic_response", "LumpedLinear", "lumped_linear"]
 
@@ -36,7 +37,8 @@ class LumpedLinear:
     D + G, K over the free coordinates, contact rows, excitation, outputs); ``labels``: the free coordinates'
     names (flexgear.lumped.model.LumpedSystem.labels); ``free``: their indices among all coordinates;
     ``system``: the assembled flexgear.lumped.model.LumpedSystem; ``per_rpm``: f_mesh per input rpm [Hz/rpm];
-    ``name``: the model's name in a :class:`~flexgear.harmonic.base.Response`.
+    ``name``: the model's name in a :class:`~flexgear.harmonic.base.Response`; ``static`` (n_f,): the static
+    equilibrium under the load [m, rad] the model is linearised about (input spin at zero).
     """
 
     operating: Callable[[float], _Operating]
@@ -45,6 +47,7 @@ class LumpedLinear:
     system: Any
     per_rpm: float
     name: str
+    static: np.ndarray | None = None
 
 
 def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS) -> Response:
@@ -59,12 +62,13 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     """The lumped model of ``spec`` (a flexgear.spec.GearboxSpec) linearised, with ``harmonics`` stiffness harmonics.
 
     The time model's equations (flexgear.lumped.run) linearised about the static equilibrium under the load
-    torque: input spin held (the prescribed drive), mean mesh stiffness, friction left out. The contact law is the
-    spec's (``[contact] law``): ISO 6336 (F = k delta, k_t = k, damping of eq. 13) or the impact law (F = k
-    delta^e, k_t = e F_0 / delta_0, damping c_max STEP(delta_0, 0, 0, d, 1)). The stiffness harmonics c_h
+    torque: input spin held (the prescribed drive), mean mesh stiffness, no friction in the static solution. The
+    contact law is the spec's (``[contact] law``): ISO 6336 (F = k delta, k_t = k, damping of eq. 13) or the impact
+    law (F = k delta^e, k_t = e F_0 / delta_0, damping c_max STEP(delta_0, 0, 0, d, 1)). The stiffness harmonics c_h
     (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model. A
     rotating carrier (planetary arrangement) adds its Coriolis, centripetal and bearing-damping terms; then the
-    bearing accelerations are in the carrier frame.
+    bearing accelerations are in the carrier frame. With mu > 0 the tooth friction at the static mesh forces adds
+    its first-order excitation (flexgear.harmonic.lumped_friction), phased as the stiffness excitation.
     """
     from flexgear.lumped.run import (
         _DEPTH,
@@ -127,6 +131,7 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     offset = model.phase_offset - model.phase_centre
     cos_c = np.asarray(model.harmonics, float)
     coef = _series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
+    friction = lumped_friction(model, free, f0, harmonics, np.sign(rate))  # None at mu = 0
 
     n_pl = p.planet_count
     names = tuple([_mesh_name("outer", i + 1) for i in range(n_pl)] + [_mesh_name("inner", i + 1) for i in range(n_pl)])
@@ -163,8 +168,11 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
                     kk[ix, iy] -= cg * om
                     kk[iy, ix] += cg * om
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
+        if friction is None:
+            return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
+                              omega_mesh)
         return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
-                          omega_mesh)
+                          omega_mesh, friction_rows=friction.rows, friction=friction.coefficients(w_in))
 
     return LumpedLinear(operating, tuple(s.labels[j] for j in free), free, s, mesh_frequency_hz(spec, 1.0),
-                        f"lumped ({Path(str(spec.source)).stem})")
+                        f"lumped ({Path(str(spec.source)).stem})", q)

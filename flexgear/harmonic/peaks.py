@@ -123,6 +123,8 @@ def _contributions(op: _Operating, roots: _Roots, indicator: str, harmonic: int)
     n = op.mass.shape[0]
     omega = harmonic * op.omega_mesh
     force = -(op.rows.T @ (op.f0 * op.coef[:, harmonic - 1]))  # generalised force -g F_0 C_h
+    if op.friction is not None:  # the tooth-friction excitation (flexgear.harmonic.base.excitation)
+        force = force - op.friction_rows.T @ op.friction[:, harmonic - 1]
     a_dyn = op.stiffness - omega**2 * op.mass + 1j * omega * op.damping
     x = np.linalg.solve(a_dyn, force)
     eta = np.linalg.solve(roots.vec, np.concatenate([x, 1j * omega * x]))
