@@ -32,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from flexgear.harmonic.base import _series_coefficients
+from flexgear.lumped.model import CENTRAL_MEMBERS
 
 __all__ = ["LumpedFriction", "lumped_friction", "nominal_spin_rates"]
 
@@ -73,7 +74,7 @@ def nominal_spin_rates(model: Any) -> np.ndarray:
     known = np.zeros(s.n, bool)
     known[model.presc] = True
     known[np.arange(s.n) % 3 != 2] = True
-    known[8] = True  # the carrier's spin: the frame
+    known[3 * CENTRAL_MEMBERS.index("carrier") + 2] = True  # the carrier's spin (x, y, theta per member): the frame
     unknown = np.flatnonzero(~known)
     G = s.mesh_G
     r[unknown] = np.linalg.lstsq(G[:, unknown], -G[:, known] @ r[known], rcond=None)[0]
