@@ -34,7 +34,11 @@ import numpy as np
 from flexgear.harmonic.base import _series_coefficients
 from flexgear.lumped.model import CENTRAL_MEMBERS
 
-__all__ = ["LumpedFriction", "lumped_friction", "nominal_spin_rates"]
+__all__ = ["LumpedFriction", "lumped_friction", "nominal_spin_rates", "CHECK_SAMPLES_PER_HARMONIC"]
+
+CHECK_SAMPLES_PER_HARMONIC = 64
+"""Samples per stiffness harmonic of the mesh cycle on which s(phi) F_0 is checked to stay positive (the time model
+drops friction where the normal force vanishes, which the first-order series cannot follow)."""
 
 
 @dataclass(frozen=True)
@@ -115,7 +119,8 @@ def lumped_friction(model: Any, free: np.ndarray, f0: np.ndarray, harmonics: int
     h = np.arange(1, harmonics + 1)
     rate = nominal_spin_rates(model)
     slip = np.zeros(nm)
-    fine = np.arange(64 * (model.harmonics.shape[1] + 1)) / (64 * (model.harmonics.shape[1] + 1))
+    samples = CHECK_SAMPLES_PER_HARMONIC * (model.harmonics.shape[1] + 1)
+    fine = np.arange(samples) / samples
     for m in range(nm):
         b1, b2 = _mesh_bodies(model, m)
         for b, sign in ((b1, -1.0), (b2, 1.0)):  # Q = f t (tau on 2 - tau on 1): row -(tau on 2 - tau on 1)
