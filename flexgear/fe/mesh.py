@@ -90,24 +90,15 @@ class ComponentMesh:
         return len(self.elements)
 
     def ngsolve_mesh(self):
-        """The NGSolve mesh with its OCC geometry attached, curved to the element order.
-
-        A first-order mesh this process has just built is taken from memory (:data:`_JUST_BUILT`), once;
-        otherwise the ``.vol.gz`` is loaded and the ``.brep`` re-attached.
-        """
+        """The NGSolve mesh with its OCC geometry attached, curved to the element order: the ``.vol.gz`` loaded
+        and the ``.brep`` re-attached, also right after a cold build, so that a model made from it is the same
+        whether the mesh was built in this process or read from the cache."""
         import ngsolve
 
-        ngmesh = _JUST_BUILT.pop(self.vol_path, None) if self.vol_path is not None else None
-        mesh = ngsolve.Mesh(ngmesh if ngmesh is not None else _load_netgen_mesh(self.vol_path, self.brep_path))
+        mesh = ngsolve.Mesh(_load_netgen_mesh(self.vol_path, self.brep_path))
         if self.order > 1:
             mesh.Curve(self.order)
         return mesh
-
-
-_JUST_BUILT: dict[Path, object] = {}
-"""The last first-order Netgen mesh this process built, by its ``.vol.gz`` path, OCC geometry attached (at
-most one entry): a cold build reduces the component it has just meshed without reloading the file and the
-solid (on the coarse ring 6 s and 4 s, more than Netgen's own meshing of the second order)."""
 
 
 def _load_netgen_mesh(vol: Path, brep: Path):
@@ -328,9 +319,7 @@ def _build_mesh(d: Design, component: str, level: str, order: int, paths: dict[s
         ngmesh = _netgen_mesh(brep, d, component, level)
     else:
         first = _mesh(d, component, level, 1, progress)
-        just_built = _JUST_BUILT.get(first.vol_path)
-        # the first-order one stays in _JUST_BUILT
-        ngmesh = just_built.Copy() if just_built is not None else _load_netgen_mesh(first.vol_path, brep)
+        ngmesh = _load_netgen_mesh(first.vol_path, brep)  # as stored: the same raised mesh cold or warm
         ngmesh.SecondOrder()
     nodes, elements, surface = _arrays(ngmesh, order)
     build = time.perf_counter() - t0
@@ -351,9 +340,6 @@ def _build_mesh(d: Design, component: str, level: str, order: int, paths: dict[s
     role = "" if order == spec.meshing_assumed[level].element_order else " (topology for the reduction)"
     _say(progress, f"  {component} ({level}): {mesh.n_elements} tetrahedra, {mesh.n_nodes} nodes, "
                    f"order {order}{role}, meshed in {build:.1f} s")
-    if order == 1:
-        _JUST_BUILT.clear()
-        _JUST_BUILT[paths["vol"]] = ngmesh
     return mesh, ngmesh
 
 
