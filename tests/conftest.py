@@ -11,7 +11,8 @@ worker first builds its share of the cache entries the suite uses (:data:`PREBUI
 cache is built by both workers at once instead of by one while the other waits. The FE models of
 :func:`coarse_fe` are built once per worker process, and the tests that use them are one unit of work: with
 ``--prebuild`` it goes to the worker that builds the tied ring and output shaft, whose FE models that build
-shares (:func:`_coarse_fe_model`), so that the run builds each of them once.
+shares (:func:`_coarse_fe_model`), so that the run builds each of them once. Each worker's BLAS and OpenMP
+thread pools get its share of the cores (:func:`pytest_configure`).
 """
 
 import ast
@@ -160,6 +161,25 @@ far, has a chain of its own, which starts with the two meshes it needs; the othe
 tied body is still being built.
 "name": the component's reduced body, "tied": the tied ring and output shaft, "mesh:name": the component's
 mesh at the level's element order."""
+
+
+_THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
+"""The environment variables that size the BLAS and OpenMP thread pools of a worker process."""
+
+
+def pytest_configure(config):
+    """Under pytest-xdist, each worker's BLAS and OpenMP pools get the worker's share of the cores (at least one):
+    with one worker per core, pools of one thread per core in every worker only contend for the cores. Set in
+    the controller before it starts the workers, which inherit its environment; a variable already set is
+    kept."""
+    import os
+
+    workers = getattr(config.option, "numprocesses", None)
+    if not isinstance(workers, int) or workers < 1 or hasattr(config, "workerinput"):
+        return
+    share = str(max(1, (os.cpu_count() or 1) // workers))
+    for name in _THREAD_VARIABLES:
+        os.environ.setdefault(name, share)
 
 
 def pytest_addoption(parser):
