@@ -12,7 +12,7 @@ cache is built by both workers at once instead of by one while the other waits. 
 :func:`coarse_fe` are built once per worker process, and the tests that use them are one unit of work: with
 ``--prebuild`` it goes to the worker that builds the tied ring and output shaft, whose FE models that build
 shares (:func:`_coarse_fe_model`), so that the run builds each of them once. Each worker's BLAS and OpenMP
-thread pools get its share of the cores (:func:`pytest_configure`).
+thread pools get its share of the cores, and its allocator keeps freed memory (:func:`pytest_configure`).
 """
 
 import ast
@@ -165,21 +165,26 @@ mesh at the level's element order."""
 
 _THREAD_VARIABLES = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS")
 """The environment variables that size the BLAS and OpenMP thread pools of a worker process."""
+WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": str(256 * 2**20), "MALLOC_TRIM_THRESHOLD_": str(512 * 2**20)}
+"""glibc's allocator in a worker process: arrays up to 256 MiB come from the heap, which keeps up to 512 MiB of
+freed memory for the next ones. (By default an array beyond the adaptive threshold, 128 KiB to 32 MiB, is mapped
+afresh and unmapped when freed, and every page of a fresh mapping is faulted in and zeroed by the kernel: the
+eigen solvers' and time runs' vectors, allocated over and over, made that a tenth of the suite's CPU time.)"""
 
 
 def pytest_configure(config):
     """Under pytest-xdist, each worker's BLAS and OpenMP pools get the worker's share of the cores (at least one):
-    with one worker per core, pools of one thread per core in every worker only contend for the cores. Set in
-    the controller before it starts the workers, which inherit its environment; a variable already set is
-    kept."""
+    with one worker per core, pools of one thread per core in every worker only contend for the cores; and the
+    workers' allocator keeps freed memory (:data:`WORKER_MALLOC`). Set in the controller before it starts the
+    workers, which inherit its environment; a variable already set is kept."""
     import os
 
     workers = getattr(config.option, "numprocesses", None)
     if not isinstance(workers, int) or workers < 1 or hasattr(config, "workerinput"):
         return
     share = str(max(1, (os.cpu_count() or 1) // workers))
-    for name in _THREAD_VARIABLES:
-        os.environ.setdefault(name, share)
+    for name, value in {**dict.fromkeys(_THREAD_VARIABLES, share), **WORKER_MALLOC}.items():
+        os.environ.setdefault(name, value)
 
 
 def pytest_addoption(parser):
