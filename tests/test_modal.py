@@ -140,3 +140,18 @@ def test_operating_point_and_impact_law_tangent(model1):
     np.testing.assert_allclose(force.sum(axis=1), theory(model1.gearbox).mesh_force, rtol=1e-5)
     np.testing.assert_allclose(np.diag(lm.full_stiffness)[rows], law.exponent * k_half * delta ** (law.exponent - 1),
                                rtol=1e-5)
+
+
+def test_state_space_roots_of_damped_oscillators():
+    """Two uncoupled oscillators m x'' + c x' + k x = 0: the roots -zeta omega +- i omega sqrt(1 - zeta^2), omega =
+    sqrt(k / m), zeta = c / (2 sqrt(k m)); each right vector (phi, lambda phi)."""
+    from flexgear.modal.eigenmodes import state_space_roots
+
+    m, c, k = np.diag([2.0, 0.5]), np.diag([40.0, 3.0]), np.diag([2.0e6, 8.0e5])
+    lam, vec = state_space_roots(m, c, k)
+    omega = np.sqrt(np.diag(k) / np.diag(m))
+    zeta = np.diag(c) / (2.0 * np.sqrt(np.diag(k) * np.diag(m)))
+    expected = np.concatenate([-zeta * omega + 1j * omega * np.sqrt(1 - zeta**2),
+                               -zeta * omega - 1j * omega * np.sqrt(1 - zeta**2)])
+    assert np.sort_complex(lam) == pytest.approx(np.sort_complex(expected), rel=1e-12)
+    assert np.allclose(vec[2:], vec[:2] * lam, rtol=1e-10, atol=1e-12 * np.abs(vec).max())

@@ -44,6 +44,7 @@ import pandas as pd
 from flexgear.harmonic.base import _ACCEL, DEFAULT_HARMONICS, Response, _Operating, _sweep
 from flexgear.harmonic.lumped import LumpedLinear, lumped_linear
 from flexgear.modal.campbell_diagram import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, _crossings, track
+from flexgear.modal.eigenmodes import state_space_roots
 
 __all__ = ["lumped_campbell", "mode_contributions", "response_peaks", "peak_crossings", "PEAK_FRACTION",
            "MULTIPLET_RTOL", "CANCELLED"]
@@ -82,10 +83,7 @@ class _Roots:
 
 
 def _roots(op: _Operating, max_damping_ratio: float = MAX_DAMPING_RATIO) -> _Roots:
-    n = op.mass.shape[0]
-    minv = np.linalg.inv(op.mass)
-    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ op.stiffness, -minv @ op.damping]])
-    lam, vec = np.linalg.eig(a)
+    lam, vec = state_space_roots(op.mass, op.damping, op.stiffness)
     scale = np.abs(lam).max()
     pair = np.array([int(np.argmin(np.abs(lam - lj.conjugate()))) for lj in lam])
     zeta = -lam.real / np.maximum(np.abs(lam), 1e-300)

@@ -47,7 +47,7 @@ import pandas as pd
 
 from flexgear.modal.linear import LinearModel
 
-__all__ = ["Modes", "modes", "CENTRAL", "PLANET_SHARE", "MOTION_SHARE"]
+__all__ = ["Modes", "modes", "state_space_roots", "CENTRAL", "PLANET_SHARE", "MOTION_SHARE"]
 
 CENTRAL = ("input_shaft", "sun", "ring", "output_shaft")
 """The central members of the star gearbox (carrier fixed)."""
@@ -114,9 +114,20 @@ class Modes:
         return self.model.basis @ self.shapes
 
 
+def state_space_roots(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarray
+                      ) -> tuple[np.ndarray, np.ndarray]:
+    """All 2n roots lambda and right eigenvectors (2n, 2n) of M z'' + D z' + K z = 0 in state space,
+    [0, I; -M^-1 K, -M^-1 D] x = lambda x with x = (phi, lambda phi) (module docstring); ``damping`` includes any
+    gyroscopic part. The roots come in the order LAPACK's dgeev returns them."""
+    n = mass.shape[0]
+    minv_k, minv_d = np.linalg.solve(mass, np.hstack([stiffness, damping])).reshape(n, 2, n).transpose(1, 0, 2)
+    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv_k, -minv_d]])
+    return np.linalg.eig(a)
+
+
 def _eigen(model: LinearModel) -> tuple[np.ndarray, np.ndarray]:
     """(roots lambda with Im > 0, ascending |lambda|; their shapes phi, mass-normalised)."""
-    from scipy.linalg import eig, eigh
+    from scipy.linalg import eigh
 
     m, d, k = model.mass, model.damping + model.gyroscopic, model.stiffness
     n = m.shape[0]
@@ -126,9 +137,7 @@ def _eigen(model: LinearModel) -> tuple[np.ndarray, np.ndarray]:
         lam = 1j * np.sqrt(np.maximum(w2, 0.0))
         phi = phi.astype(complex)
     else:
-        minv = np.linalg.solve(m, np.eye(n))
-        a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv @ k, -minv @ d]])
-        lam, x = eig(a)
+        lam, x = state_space_roots(m, d, k)
         pick = lam.imag > 1e-9 * np.abs(lam).max()
         lam, phi = lam[pick], x[:n, pick]
     order = np.argsort(np.abs(lam))

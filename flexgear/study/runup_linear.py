@@ -49,6 +49,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from flexgear.modal.eigenmodes import state_space_roots
 from flexgear.results import RunResult
 from flexgear.study.runup import (
     DEFAULT_HOP_S,
@@ -108,8 +109,7 @@ def _modal(system: LinearSystem) -> tuple[np.ndarray, ...]:
     n = m.shape[0]
     _, phi = eigh(0.5 * (k + k.T), m)  # Phi^T M Phi = I
     kt, ct = phi.T @ k @ phi, phi.T @ c @ phi
-    a = np.block([[np.zeros((n, n)), np.eye(n)], [-kt, -ct]])
-    lam, v = np.linalg.eig(a)
+    lam, v = state_space_roots(np.eye(n), ct, kt)
     vinv = np.linalg.inv(v)
     fm = system.forces @ phi  # (H, n): modal forces Phi^T f_h
     p = vinv[:, n:] @ fm.T
