@@ -198,19 +198,8 @@ def _prebuild(spec, task: str) -> None:
     from flexgear.fe.reduced import component_mass_properties
     from flexgear.fe.ring_shaft import tied_pair_mass_properties
 
-    if task == "tied":
-        from flexgear.fe import ring_shaft
-
-        build = ring_shaft.part_fe_model
-
-        def shared(part_spec, component, level="coarse", progress=False):
-            if part_spec is spec and level == "coarse":
-                return _coarse_fe_model(component, build)
-            return build(part_spec, component, level, progress)
-
-        with pytest.MonkeyPatch.context() as mp:  # the tied build's FE models are coarse_fe's
-            mp.setattr(ring_shaft, "part_fe_model", shared)
-            tied_pair_mass_properties(spec, "coarse")
+    if task == "tied":  # the tied build's FE models are coarse_fe's
+        tied_pair_mass_properties(spec, "coarse", fe_source=_coarse_fe_model)
     elif task.startswith("mesh:"):
         component_mesh(spec, task.removeprefix("mesh:"), "coarse")
     else:
@@ -245,13 +234,13 @@ _COARSE_FE: dict[str, object] = {}
 """The FE models of :func:`coarse_fe`, by component, of this process."""
 
 
-def _coarse_fe_model(name: str, build=None):
-    """The FE model of component ``name`` of gearbox.toml at the coarse level (flexgear.fe.ring_shaft.part_fe_model,
-    or ``build`` with its arguments), built once per process."""
+def _coarse_fe_model(name: str):
+    """The FE model of component ``name`` of gearbox.toml at the coarse level (flexgear.fe.ring_shaft.part_fe_model),
+    built once per process."""
     if name not in _COARSE_FE:
-        if build is None:
-            from flexgear.fe.ring_shaft import part_fe_model as build
-        _COARSE_FE[name] = build(load_gearbox(VARIANTS / "gearbox.toml"), name, "coarse")
+        from flexgear.fe.ring_shaft import part_fe_model
+
+        _COARSE_FE[name] = part_fe_model(load_gearbox(VARIANTS / "gearbox.toml"), name, "coarse")
     return _COARSE_FE[name]
 
 

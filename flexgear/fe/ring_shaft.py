@@ -105,12 +105,13 @@ def _tied_key(spec: GearboxSpec, level: str) -> str:
     return f"ring_output_shaft_tied-{level}-{key}"
 
 
-def _tied_build(spec: GearboxSpec, level: str, progress: bool) -> Callable[[], ReducedBody]:
+def _tied_build(spec: GearboxSpec, level: str, progress: bool,
+                fe_source: Callable[[str], FEModel] | None = None) -> Callable[[], ReducedBody]:
     def build() -> ReducedBody:
         if progress:
             say(f"  ring + output_shaft ({level}): building the tied pair's reduced body")
         t0 = time.perf_counter()
-        ring, shaft = pair_fe_models(spec, level, progress)
+        ring, shaft = pair_fe_models(spec, level, progress) if fe_source is None else map(fe_source, PAIR)
         tied = tied_pair(ring, shaft, spec)
         seat = tied.interface("ring", ring_seat(ring, spec))
         itfs = tied_pair_interfaces(tied, shaft, spec)
@@ -126,20 +127,25 @@ def _tied_build(spec: GearboxSpec, level: str, progress: bool) -> Callable[[], R
     return build
 
 
-def tied_pair_body(spec: GearboxSpec, level: str = "coarse", progress: bool = False) -> ReducedBody:
-    """The reduced body of the ring and the output shaft tied together (module docstring), cached."""
-    return cached_reduced_body(_tied_key(spec, level), _tied_build(spec, level, progress))
+def tied_pair_body(spec: GearboxSpec, level: str = "coarse", progress: bool = False,
+                   fe_source: Callable[[str], FEModel] | None = None) -> ReducedBody:
+    """The reduced body of the ring and the output shaft tied together (module docstring), cached.
+    ``fe_source(part)``: the part's FE model when the body must be built, exactly as :func:`part_fe_model` builds
+    it for ``spec`` and ``level`` (e.g. one the caller holds already); default :func:`part_fe_model`."""
+    return cached_reduced_body(_tied_key(spec, level), _tied_build(spec, level, progress, fe_source))
 
 
-def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress: bool = False) -> MassProperties:
+def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress: bool = False,
+                              fe_source: Callable[[str], FEModel] | None = None) -> MassProperties:
     """Mass properties of :func:`tied_pair_body` (of the tied FE model: the sum of the ring's and the shaft's),
-    read alone from the cache when the body is there, else from the body built and cached."""
+    read alone from the cache when the body is there, else from the body built (``fe_source``: as there) and
+    cached."""
     def read(path) -> MassProperties:
         with np.load(path, allow_pickle=False) as z:
             return MassProperties(float(z["mass"]), z["com"], z["inertia"])
 
     props = _read_cached(_tied_key(spec, level), read)
-    return props if props is not None else tied_pair_body(spec, level, progress).props
+    return props if props is not None else tied_pair_body(spec, level, progress, fe_source).props
 
 
 def tied_part_matrices(spec: GearboxSpec, level: str = "coarse", progress: bool = False
