@@ -57,3 +57,20 @@ def test_cold_build_schedules_every_component_and_checks_its_workers(gearbox):
     assert sorted(COLD_BUILD_ORDER) == sorted(GEOMETRY_COMPONENTS)
     with pytest.raises(ValueError, match="workers"):
         build_components(gearbox, "coarse", workers=0)
+
+
+def test_cholesky_solves_a_block_of_columns_in_one_call():
+    """The factorisation is CHOLMOD's own, called directly (a block of columns in one pass over the factor, not
+    CVXOPT's column-by-column binding): found and loaded, and its block solve equals its solves of each column."""
+    from flexgear.fe.cholesky import _cholmod
+
+    assert _cholmod() is not None
+    fe = fe_model(ring_mesh(0.004), STEEL, 1)
+    from flexgear.fe.cms import _FreeBodySolver
+
+    free = _FreeBodySolver(fe).free
+    chol = SparseCholesky(fe.K[free][:, free])
+    loads = np.random.default_rng(4).standard_normal((len(free), 9))
+    block = chol.solve(loads)
+    for j in range(loads.shape[1]):
+        np.testing.assert_allclose(block[:, j], chol.solve(loads[:, j]), rtol=0, atol=1e-12 * np.abs(block).max())

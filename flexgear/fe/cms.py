@@ -204,7 +204,7 @@ class _Constrained:
         (flexgear.fe.spectrum.shift_invert_pairs)."""
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
         k = min(k, self.s.n - self.p - 2)
-        return shift_invert_pairs(lambda f: self.solve(f)[:, 0], m, k, v0, found)
+        return shift_invert_pairs(lambda f: self.solve(f), m, k, v0, found)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
@@ -358,7 +358,7 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
 
     def eigen(k: int, found: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:  # reads K_ii only through solve
-        return shift_invert_pairs(lambda f: solve(f[:, None])[:, 0], m_ii, k, v0, found)
+        return shift_invert_pairs(solve, m_ii, k, v0, found)
 
     vec = lowest_eigenpairs(eigen, n_modes, max_hz, limit=len(idofs) - c.shape[0] - 2)[1]
     fixed = np.zeros((fe.n_dof, vec.shape[1]))

@@ -15,21 +15,29 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["ARPACK_TOLERANCE", "LANCZOS_EXTRA_MIN", "LANCZOS_EXTRA_SHARE", "lowest_eigenpairs", "shift_invert_pairs"]
+__all__ = ["LANCZOS_BLOCK", "LANCZOS_CHUNK", "LANCZOS_RESERVE", "LANCZOS_TOLERANCE",
+           "REORTHOGONALISE_BELOW", "lowest_eigenpairs", "shift_invert_pairs"]
 
-ARPACK_TOLERANCE = 1e-10
-"""Relative accuracy of the eigenvalues ARPACK returns (its ``tol``)."""
+LANCZOS_TOLERANCE = 1e-10
+"""Relative accuracy of the eigenvalues :func:`shift_invert_pairs` returns (a Ritz pair's residual over its
+eigenvalue, as ARPACK's ``tol``)."""
+LANCZOS_BLOCK = 8
+"""Vectors per block of :func:`shift_invert_pairs`: a block of columns is solved in one pass over the Cholesky
+factor (flexgear.fe.cholesky), and a block at least as large as a multiplicity finds all its eigenvectors
+(cyclic symmetry gives pairs)."""
+LANCZOS_RESERVE = 2.5
+"""Lanczos vectors foreseen per wanted pair (the projected matrix grows if convergence needs more)."""
+REORTHOGONALISE_BELOW = 0.5
+"""A second Gram-Schmidt pass when a column's M-norm squared fell below this share in the first (Daniel, Gragg,
+Kaufman & Stewart 1976: 1 / sqrt(2) of the norm)."""
+LANCZOS_CHUNK = 16
+"""Blocks per chunk of stored Lanczos vectors (the basis grows a chunk at a time, without copies)."""
 _FIRST_COUNT = 24
 """First count tried for a frequency limit (fewer than the lowest modes of a gear or a shaft below 6x its mesh)."""
 _DENSITY_EXPONENT = 1.5
 """Growth of the mode count N with frequency f assumed for the next guess, N ~ f^1.5 (between a plate's N ~ f and
 a solid's N ~ f^3, Weyl's law). The guess carries no margin: a guess that falls short costs one more call for the
 pairs still missing (the found ones deflated), a guess beyond the limit costs pairs that are thrown away."""
-LANCZOS_EXTRA_SHARE = 0.5
-LANCZOS_EXTRA_MIN = 20
-"""ARPACK's Lanczos basis for k pairs: k + max(LANCZOS_EXTRA_SHARE k, LANCZOS_EXTRA_MIN) vectors (its ``ncv``;
-scipy's default 2 k + 1). In shift-invert mode about 0 the wanted 1 / lambda are the largest and well separated, so
-the smaller basis converges them to the same tolerance in fewer operations per restart (O(n ncv^2))."""
 
 
 def lowest_eigenpairs(eigen: Callable[[int, np.ndarray | None], tuple[np.ndarray, np.ndarray]],
@@ -68,35 +76,129 @@ def lowest_eigenpairs(eigen: Callable[[int, np.ndarray | None], tuple[np.ndarray
 
 
 def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, v0: np.ndarray,
-                       found: np.ndarray | None = None, tol: float = ARPACK_TOLERANCE
-                       ) -> tuple[np.ndarray, np.ndarray]:
+                       found: np.ndarray | None = None, tol: float = LANCZOS_TOLERANCE,
+                       block: int = LANCZOS_BLOCK) -> tuple[np.ndarray, np.ndarray]:
     """The ``k`` lowest eigenpairs of K x = lambda M x beyond the M-orthonormal eigenvectors ``found`` (n, j):
-    ARPACK (Lanczos) in shift-invert mode about 0 on the deflated operator
+    block Lanczos in shift-invert mode about 0 on the deflated operator
 
         OP = (I - V V^T M) K^-1 M,   V = ``found``,
 
     which has the found pairs' eigenvalues 1 / lambda moved to 0 and every other pair unchanged (K^-1 M keeps the
-    M-orthogonal complement of its eigenvectors), so that its largest eigenvalues are the next lowest pairs.
-    ``solve(y)`` = K^-1 y (n,) [the problem's units]; ``mass`` M (n, n), anything with ``@``; ``v0`` (n,) the
-    start vector. Returns lambda ascending and M-orthonormal vectors (n, k).
+    M-orthogonal complement of its eigenvectors), so that its largest eigenvalues theta = 1 / lambda are the next
+    lowest pairs. OP is self-adjoint in the M inner product: blocks Q_j of ``block`` M-orthonormal vectors,
+    W = OP Q_j orthogonalised against every block before (twice, classical Gram-Schmidt) and M-orthonormalised,
+    W = Q_(j+1) B_(j+1) (Cholesky QR, twice), make T = Q^T M OP Q block tridiagonal; its eigenpairs (theta, s)
+    give the Ritz pairs (1 / theta, Q s), converged when the residual ||B_(j+1) s_last|| (M norm) is at most
+    ``tol`` theta, as ARPACK's test. A block of vectors costs one solve of ``block`` columns and dense products.
+
+    ``solve(y)`` = K^-1 y for y (n, c) [the problem's units]; ``mass`` M (n, n), anything with ``@`` on (n, c);
+    ``v0`` (n,) the first start vector (the others are seeded random). Returns lambda ascending and M-orthonormal
+    vectors (n, k).
     """
-    import scipy.sparse.linalg as sla
+    import scipy.linalg as la
 
     n = v0.size
-    if found is not None and found.shape[1]:
-        v = found
+    v = found if found is not None and found.shape[1] else None
+    free = n - (0 if v is None else v.shape[1])
+    if not 0 < k < free:
+        raise ValueError(f"shift_invert_pairs: k must lie in 1 ... {free - 1}, got {k}")
+    b = max(1, min(block, free // 2))
 
-        def project(y: np.ndarray) -> np.ndarray:
-            return y - v @ (v.T @ (mass @ y))
+    mv = None if v is None else np.asarray(mass @ v)
 
-        op_inv = sla.LinearOperator((n, n), matvec=lambda y: project(solve(y)), dtype=float)
-        v0 = project(v0)
-    else:
-        op_inv = sla.LinearOperator((n, n), matvec=solve, dtype=float)
-    ncv = min(n - 1, k + max(math.ceil(LANCZOS_EXTRA_SHARE * k), LANCZOS_EXTRA_MIN))
-    lam, vec = sla.eigsh(op_inv, k=k, M=mass, sigma=0.0, OPinv=op_inv, which="LM", v0=v0, ncv=ncv, tol=tol)
+    def op(mq: np.ndarray) -> np.ndarray:
+        """OP q from M q (n, c)."""
+        y = solve(mq).reshape(n, -1)
+        return y if v is None else y - v @ (mv.T @ y)
+
+    start = np.column_stack([v0, np.random.default_rng(0).standard_normal((n, b - 1))])
+    q, mq, _ = _m_orthonormal(op(np.asarray(mass @ start)), mass)
+    chunks: list[np.ndarray] = []  # the Lanczos vectors, in chunks of LANCZOS_CHUNK blocks (never copied)
+    t = np.zeros((_lanczos_columns(k, b) + b,) * 2)
+    m = 0
+    while True:
+        if m % (LANCZOS_CHUNK * b) == 0:
+            chunks.append(np.empty((n, LANCZOS_CHUNK * b)))
+        if m + 2 * b > t.shape[0]:
+            t = np.pad(t, ((0, t.shape[0]), (0, t.shape[0])))
+        j = m % (LANCZOS_CHUNK * b)
+        chunks[-1][:, j:j + b] = q
+        w = op(mq)
+        h = np.zeros((m + b, b))
+        mw = np.asarray(mass @ w)
+        for _ in range(2):  # full reorthogonalisation: classical Gram-Schmidt, a second pass where needed
+            before = np.einsum("ij,ij->j", w, mw)
+            for i, c in enumerate(_filled(chunks, m + b, LANCZOS_CHUNK * b)):
+                coef = c.T @ mw
+                w -= c @ coef
+                h[i * LANCZOS_CHUNK * b:i * LANCZOS_CHUNK * b + c.shape[1]] += coef
+            mw = np.asarray(mass @ w)
+            if np.all(np.einsum("ij,ij->j", w, mw) > REORTHOGONALISE_BELOW * before):
+                break  # no column lost more than this share of its M-norm squared: orthogonal to round-off
+        t[:m + b, m:m + b] = h
+        q, mq, r = _m_orthonormal(w, mass, mw)
+        t[m + b:m + 2 * b, m:m + b] = r
+        m += b
+        if m < k + b:
+            continue
+        theta, s_ = la.eigh(t[:m, :m], lower=False)  # T's upper triangle: the coefficients as computed
+        top = np.arange(m - k, m)  # the k largest theta: the lowest lambda
+        resid = np.linalg.norm(r @ s_[m - b:m, top], axis=0)
+        if np.all(resid <= tol * np.abs(theta[top])):
+            break
+        if m + b > free:
+            raise RuntimeError(f"shift_invert_pairs: {k} pairs not converged in {m} Lanczos vectors")
+    vec = sum(c @ s_[i * LANCZOS_CHUNK * b:i * LANCZOS_CHUNK * b + c.shape[1], top]
+              for i, c in enumerate(_filled(chunks, m, LANCZOS_CHUNK * b)))
+    lam = 1.0 / theta[top]
     order = np.argsort(lam)
     return lam[order], vec[:, order]
+
+
+def _filled(chunks: list[np.ndarray], m: int, width: int) -> list[np.ndarray]:
+    """The first ``m`` columns of the chunks (views)."""
+    return [c[:, :min(width, m - i * width)] for i, c in enumerate(chunks) if m > i * width]
+
+
+def _lanczos_columns(k: int, b: int) -> int:
+    """Lanczos vectors reserved for k pairs in blocks of b (grown if convergence needs more)."""
+    return b * math.ceil((LANCZOS_RESERVE * k + 4 * b) / b)
+
+
+def _m_orthonormal(w: np.ndarray, mass, mw: np.ndarray | None = None
+                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Q, M Q, R with W = Q R, Q^T M Q = I, R upper triangular (c, c): Cholesky QR twice, on M W (``mw``, computed
+    if not given). A dependent direction (an invariant subspace reached) gets a zero row of R and a seeded random
+    direction M-orthogonal to the rest."""
+    import scipy.linalg as la
+
+    q, mq, r_total = w, np.asarray(mass @ w) if mw is None else mw, np.eye(w.shape[1])
+    for _ in range(2):
+        g = q.T @ mq
+        try:
+            r = la.cholesky(0.5 * (g + g.T), lower=False)
+        except la.LinAlgError:
+            return _m_orthonormal_rank_revealing(w, mass)
+        r_inv = la.solve_triangular(r, np.eye(r.shape[0]), lower=False)
+        q, mq, r_total = q @ r_inv, mq @ r_inv, r @ r_total
+    return q, mq, r_total
+
+
+def _m_orthonormal_rank_revealing(w: np.ndarray, mass) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`_m_orthonormal` for a W without full rank: by the eigen decomposition of W^T M W."""
+    g = w.T @ np.asarray(mass @ w)
+    mu, u = np.linalg.eigh(0.5 * (g + g.T))
+    keep = mu > 1e-14 * max(mu.max(), 1e-300)
+    q = w @ (u[:, keep] / np.sqrt(mu[keep]))
+    rng = np.random.default_rng(1)
+    while q.shape[1] < w.shape[1]:
+        x = rng.standard_normal((w.shape[0], 1))
+        for _ in range(2):
+            x -= q @ (q.T @ np.asarray(mass @ x))
+        x /= np.sqrt(float(x.T @ np.asarray(mass @ x)))
+        q = np.hstack([q, x])
+    mq = np.asarray(mass @ q)
+    return q, mq, mq.T @ w  # W = Q R exactly on the kept directions, zero on the added ones
 
 
 def _none() -> tuple[np.ndarray, np.ndarray]:
