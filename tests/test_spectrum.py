@@ -104,3 +104,19 @@ def test_block_lanczos_finds_both_members_of_double_pairs():
     for j in range(0, 20, 2):  # each pair spans one bar's mode on either bar: rank 2 over the two halves
         pair = np.vstack([vec[:n, j:j + 2], vec[n:, j:j + 2]])
         assert np.linalg.matrix_rank(pair, tol=1e-8 * np.abs(pair).max()) == 2
+
+
+def test_block_lanczos_on_a_space_it_exhausts():
+    """K = diag(1 ... 12), M = I, blocks of 4: asking for 10 pairs fills the whole space (12 vectors) before a
+    block beyond them fits, and the start block reaches an invariant subspace (its Krylov space has dependent
+    columns): the pairs are still exact and the vectors orthonormal."""
+    import scipy.sparse as sp
+
+    from flexgear.fe.spectrum import shift_invert_pairs
+
+    d = np.arange(1.0, 13.0)
+    for k in (5, 10):
+        lam, vec = shift_invert_pairs(lambda y: y / d[:, None], sp.identity(12, format="csr"), k, np.ones(12),
+                                      block=4)
+        np.testing.assert_allclose(lam, d[:k], rtol=1e-12)
+        np.testing.assert_allclose(vec.T @ vec, np.eye(k), atol=1e-12)

@@ -86,7 +86,8 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     which has the found pairs' eigenvalues 1 / lambda moved to 0 and every other pair unchanged (K^-1 M keeps the
     M-orthogonal complement of its eigenvectors), so that its largest eigenvalues theta = 1 / lambda are the next
     lowest pairs. OP is self-adjoint in the M inner product: blocks Q_j of ``block`` M-orthonormal vectors,
-    W = OP Q_j orthogonalised against every block before (twice, classical Gram-Schmidt) and M-orthonormalised,
+    W = OP Q_j orthogonalised against every block before (classical Gram-Schmidt, a second pass where the first
+    took more than :data:`REORTHOGONALISE_BELOW` of a column's M-norm squared) and M-orthonormalised,
     W = Q_(j+1) B_(j+1) (Cholesky QR, twice), make T = Q^T M OP Q block tridiagonal; its eigenpairs (theta, s)
     give the Ritz pairs (1 / theta, Q s), converged when the residual ||B_(j+1) s_last|| (M norm) is at most
     ``tol`` theta, as ARPACK's test. A block of vectors costs one solve of ``block`` columns and dense products.
@@ -136,10 +137,12 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
             if np.all(np.einsum("ij,ij->j", w, mw) > REORTHOGONALISE_BELOW * before):
                 break  # no column lost more than this share of its M-norm squared: orthogonal to round-off
         t[:m + b, m:m + b] = h
-        q, mq, r = _m_orthonormal(w, mass, mw)
+        done = _filled(chunks, m + b, LANCZOS_CHUNK * b)
+        q, mq, r = _m_orthonormal(w, mass, mw, lambda x, done=done: x - sum(  # a new direction: clear of them
+            c @ (c.T @ np.asarray(mass @ x)) for c in done))
         t[m + b:m + 2 * b, m:m + b] = r
         m += b
-        if m < k + b:
+        if m < k + b and m + b <= free:  # T is first read with a block beyond the k pairs (or all there is)
             continue
         theta, s_ = la.eigh(t[:m, :m], lower=False)  # T's upper triangle: the coefficients as computed
         top = np.arange(m - k, m)  # the k largest theta: the lowest lambda
@@ -165,11 +168,13 @@ def _lanczos_columns(k: int, b: int) -> int:
     return b * math.ceil((LANCZOS_RESERVE * k + 4 * b) / b)
 
 
-def _m_orthonormal(w: np.ndarray, mass, mw: np.ndarray | None = None
+def _m_orthonormal(w: np.ndarray, mass, mw: np.ndarray | None = None,
+                  clear: Callable[[np.ndarray], np.ndarray] | None = None
                   ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Q, M Q, R with W = Q R, Q^T M Q = I, R upper triangular (c, c): Cholesky QR twice, on M W (``mw``, computed
-    if not given). A dependent direction (an invariant subspace reached) gets a zero row of R and a seeded random
-    direction M-orthogonal to the rest."""
+    if not given). Where W has dependent columns (an invariant subspace reached), R is square but not triangular
+    and the missing directions are seeded random vectors, first passed through ``clear`` (which removes what they
+    must be M-orthogonal to, e.g. the Lanczos vectors so far), M-orthogonal to the rest."""
     import scipy.linalg as la
 
     q, mq, r_total = w, np.asarray(mass @ w) if mw is None else mw, np.eye(w.shape[1])
@@ -178,13 +183,14 @@ def _m_orthonormal(w: np.ndarray, mass, mw: np.ndarray | None = None
         try:
             r = la.cholesky(0.5 * (g + g.T), lower=False)
         except la.LinAlgError:
-            return _m_orthonormal_rank_revealing(w, mass)
+            return _m_orthonormal_rank_revealing(w, mass, clear)
         r_inv = la.solve_triangular(r, np.eye(r.shape[0]), lower=False)
         q, mq, r_total = q @ r_inv, mq @ r_inv, r @ r_total
     return q, mq, r_total
 
 
-def _m_orthonormal_rank_revealing(w: np.ndarray, mass) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _m_orthonormal_rank_revealing(w: np.ndarray, mass, clear: Callable[[np.ndarray], np.ndarray] | None
+                                  ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """:func:`_m_orthonormal` for a W without full rank: by the eigen decomposition of W^T M W."""
     g = w.T @ np.asarray(mass @ w)
     mu, u = np.linalg.eigh(0.5 * (g + g.T))
@@ -194,6 +200,7 @@ def _m_orthonormal_rank_revealing(w: np.ndarray, mass) -> tuple[np.ndarray, np.n
     while q.shape[1] < w.shape[1]:
         x = rng.standard_normal((w.shape[0], 1))
         for _ in range(2):
+            x = x if clear is None else clear(x)
             x -= q @ (q.T @ np.asarray(mass @ x))
         x /= np.sqrt(float(x.T @ np.asarray(mass @ x)))
         q = np.hstack([q, x])
