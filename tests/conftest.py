@@ -169,7 +169,8 @@ WORKER_MALLOC = {"MALLOC_MMAP_THRESHOLD_": str(256 * 2**20), "MALLOC_TRIM_THRESH
 """glibc's allocator in a worker process: arrays up to 256 MiB come from the heap, which keeps up to 512 MiB of
 freed memory for the next ones. (By default an array beyond the adaptive threshold, 128 KiB to 32 MiB, is mapped
 afresh and unmapped when freed, and every page of a fresh mapping is faulted in and zeroed by the kernel: the
-eigen solvers' and time runs' vectors, allocated over and over, made that a large part of the suite's kernel time.)"""
+eigen solvers' and time runs' vectors, allocated over and over, made that a large part of the suite's kernel time.)
+The CLI's build workers choose the other way, memory before time (flexgear.heap.lean_heap)."""
 
 
 def pytest_configure(config):
