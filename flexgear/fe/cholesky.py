@@ -26,6 +26,8 @@ import scipy.sparse as sp
 __all__ = ["SparseCholesky"]
 
 _CHOLMOD_REAL, _CHOLMOD_INT, _CHOLMOD_DOUBLE, _CHOLMOD_A = 1, 0, 0, 0  # cholmod_core.h / cholmod_cholesky.h codes
+_INT32_LIMIT = 2**31 - 1
+"""Entries of a matrix the int32 interface of CHOLMOD takes (larger ones go through CVXOPT's binding)."""
 _COMMON_BYTES = 1 << 16
 """Room for a ``cholmod_common`` (CHOLMOD 3 needs a few kB; ``cholmod_start`` fills it)."""
 _DEPENDENCIES = ("libquadmath", "libgfortran", "libsatlas", "libopenblas", "libsuitesparseconfig", "libamd",
@@ -95,7 +97,7 @@ class SparseCholesky:
         if k.shape[0] != k.shape[1]:
             raise ValueError(f"SparseCholesky: matrix must be square, got shape {k.shape}")
         self.n = k.shape[0]
-        self._lib = _cholmod()
+        self._lib = _cholmod() if k.nnz < _INT32_LIMIT else None  # the binding uses CHOLMOD's int32 interface
         if self._lib is None:
             self._cvxopt_factor(k)
             return
