@@ -204,7 +204,7 @@ class _Constrained:
         (flexgear.fe.spectrum.shift_invert_pairs)."""
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
         k = min(k, self.s.n - self.p - 2)
-        return shift_invert_pairs(lambda f: self.solve(f), m, k, v0, found)
+        return shift_invert_pairs(self.solve, m, k, v0, found)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")

@@ -15,7 +15,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-__all__ = ["LANCZOS_BLOCK", "LANCZOS_CHUNK", "LANCZOS_RESERVE", "LANCZOS_TOLERANCE",
+__all__ = ["LANCZOS_BLOCK", "LANCZOS_CHUNK", "LANCZOS_TOLERANCE",
            "REORTHOGONALISE_BELOW", "lowest_eigenpairs", "shift_invert_pairs"]
 
 LANCZOS_TOLERANCE = 1e-10
@@ -25,8 +25,6 @@ LANCZOS_BLOCK = 8
 """Vectors per block of :func:`shift_invert_pairs`: a block of columns is solved in one pass over the Cholesky
 factor (flexgear.fe.cholesky), and a block at least as large as a multiplicity finds all its eigenvectors
 (cyclic symmetry gives pairs)."""
-LANCZOS_RESERVE = 2.5
-"""Lanczos vectors foreseen per wanted pair (the projected matrix grows if convergence needs more)."""
 REORTHOGONALISE_BELOW = 0.5
 """A second Gram-Schmidt pass when a column's M-norm squared fell below this share in the first (Daniel, Gragg,
 Kaufman & Stewart 1976: 1 / sqrt(2) of the norm)."""
@@ -115,7 +113,7 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     start = np.column_stack([v0, np.random.default_rng(0).standard_normal((n, b - 1))])
     q, mq, _ = _m_orthonormal(op(np.asarray(mass @ start)), mass)
     chunks: list[np.ndarray] = []  # the Lanczos vectors, in chunks of LANCZOS_CHUNK blocks (never copied)
-    t = np.zeros((_lanczos_columns(k, b) + b,) * 2)
+    t = np.zeros((k + 3 * b,) * 2)  # T to its first reading (k + b vectors) and one block beyond; doubled as needed
     m = 0
     while True:
         if m % (LANCZOS_CHUNK * b) == 0:
@@ -161,11 +159,6 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
 def _filled(chunks: list[np.ndarray], m: int, width: int) -> list[np.ndarray]:
     """The first ``m`` columns of the chunks (views)."""
     return [c[:, :min(width, m - i * width)] for i, c in enumerate(chunks) if m > i * width]
-
-
-def _lanczos_columns(k: int, b: int) -> int:
-    """Lanczos vectors reserved for k pairs in blocks of b (grown if convergence needs more)."""
-    return b * math.ceil((LANCZOS_RESERVE * k + 4 * b) / b)
 
 
 def _m_orthonormal(w: np.ndarray, mass, mw: np.ndarray | None = None,

@@ -379,8 +379,7 @@ def eigenvalues(t0: np.ndarray, t1: np.ndarray, remainder=None, s_max: float = n
                 order = np.argsort(roots.real)
                 s[cluster], y = roots.real[order], y[:, order].real
             ritz = basis @ y
-            if step < refine:
-                h, dh = remainder(s_c)
+            if step < refine:  # h, dh: the remainder at s_c, from the last Newton step
                 try:
                     basis = np.linalg.qr(np.linalg.solve(t0 - s_c * t1 + h, (dh - t1) @ ritz))[0]
                 except np.linalg.LinAlgError:  # T(s_c) singular in working precision: s_c is a root, keep them
