@@ -168,11 +168,10 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
                     kk[ix, iy] -= cg * om
                     kk[iy, ix] += cg * om
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
-        if friction is None:
-            return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
-                              omega_mesh)
+        rubbing = {} if friction is None else {"friction_rows": friction.rows,
+                                                "friction": friction.coefficients(w_in)}
         return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
-                          omega_mesh, friction_rows=friction.rows, friction=friction.coefficients(w_in))
+                          omega_mesh, **rubbing)
 
     return LumpedLinear(operating, tuple(s.labels[j] for j in free), free, s, mesh_frequency_hz(spec, 1.0),
                         f"lumped ({Path(str(spec.source)).stem})", q)
