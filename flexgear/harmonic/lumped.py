@@ -65,7 +65,8 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     torque: input spin held (the prescribed drive), mean mesh stiffness, no friction in the static solution. The
     contact law is the spec's (``[contact] law``): ISO 6336 (F = k delta, k_t = k, damping of eq. 13) or the impact
     law (F = k delta^e, k_t = e F_0 / delta_0, damping c_max STEP(delta_0, 0, 0, d, 1)). The stiffness harmonics c_h
-    (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model. A
+    (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model, whose
+    phase follows the gear's angle coordinate: the nominal spin plus the static deflection's rotation. A
     rotating carrier (planetary arrangement) adds its Coriolis, centripetal and bearing-damping terms; then the
     bearing accelerations are in the carrier frame. With mu > 0 the tooth friction at the static mesh forces adds
     its first-order excitation (flexgear.harmonic.lumped_friction), phased as the stiffness excitation.
@@ -128,7 +129,10 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     zs, zr = g.sun_teeth, g.ring_teeth
     rel = {2: 1.0 - r_c, 5: -(zs / zr) * (1.0 - r_c)}  # sun and ring spin per input angle, carrier frame
     rate = np.array([model.phase_coef[m] * rel[int(model.phase_index[m])] for m in range(nmesh)])
-    offset = model.phase_offset - model.phase_centre
+    # the static deflection turns the gears too: a mesh's phase at the operating point includes coef_m q0[index_m]
+    q_static = np.zeros(s.n)
+    q_static[free] = q
+    offset = model.phase_offset - model.phase_centre + model.phase_coef * q_static[model.phase_index]
     cos_c = np.asarray(model.harmonics, float)
     coef = _series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
     friction = lumped_friction(model, free, f0, harmonics, np.sign(rate))  # None at mu = 0
