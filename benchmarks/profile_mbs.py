@@ -2,7 +2,7 @@
 Jacobians per step, and the Python functions (cProfile)?
 
 Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
-     [--trace-newton 6] [--blas-threads 2]
+     [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then
@@ -11,6 +11,9 @@ generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``d
 case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
 step (the ``Python`` timer is the pre-step user functions), Newton iterations and Jacobians per step;
 with ``--cprofile`` the top Python functions. ``--blas-threads 2`` shows what BLAS threads cost the build.
+``--frozen contacts joints``: the flexible gears' contact columns (flexgear.mbs.contact_kinematics.ContactKinematics)
+and the turning joints' coefficients (flexgear.mbs.joints.TurningBlocks) written at the first step only (wrong physics:
+a bound on what the Newton iterations and Jacobians that their change from step to step costs).
 """
 
 from __future__ import annotations
@@ -79,6 +82,26 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
     return text, wall, cpu
 
 
+def _frozen_classes() -> dict:
+    from flexgear.mbs.contact_kinematics import ContactKinematics
+    from flexgear.mbs.joints import TurningBlocks
+
+    return {"contacts": ContactKinematics, "joints": TurningBlocks}
+
+
+def freeze_after_first_step(cls) -> None:
+    """Make the pre-step ``cls.__call__`` act at each object's first step only (``--frozen``)."""
+    update = cls.__call__
+
+    def first_only(self, mbs, t):
+        if getattr(self, "_written", False):
+            return True
+        self._written = True
+        return update(self, mbs, t)
+
+    cls.__call__ = first_only
+
+
 @contextlib.contextmanager
 def _captured_stdout():
     """Exudyn prints from C++ through Python's sys.stdout: collect it."""
@@ -124,8 +147,13 @@ def main() -> None:
                          "the timers then include the printing)")
     ap.add_argument("--blas-threads", type=int, default=1,
                     help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
+    ap.add_argument("--frozen", nargs="+", choices=("contacts", "joints"), default=(),
+                    help="write these constraint coefficients at the first step only (a cost bound, wrong physics)")
     a = ap.parse_args()
     from threadpoolctl import threadpool_limits
+
+    for name in a.frozen:
+        freeze_after_first_step(_frozen_classes()[name])
 
     threadpool_limits(limits=a.blas_threads, user_api="blas")
     folder = Path(a.variants_dir)
