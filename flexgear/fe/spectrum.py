@@ -136,8 +136,7 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
                 break  # no column lost more than this share of its M-norm squared: orthogonal to round-off
         t[:m + b, m:m + b] = h
         done = _filled(chunks, m + b, LANCZOS_CHUNK * b)
-        q, mq, r = _m_orthonormal(w, mass, mw, lambda x, done=done: x - sum(  # a new direction: clear of them
-            c @ (c.T @ np.asarray(mass @ x)) for c in done))
+        q, mq, r = _m_orthonormal(w, mass, mw, lambda x, done=done: _cleared(x, mass, done))
         t[m + b:m + 2 * b, m:m + b] = r
         m += b
         if m < k + b and m + b <= free:  # T is first read with a block beyond the k pairs (or all there is)
@@ -154,6 +153,12 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     lam = 1.0 / theta[top]
     order = np.argsort(lam)
     return lam[order], vec[:, order]
+
+
+def _cleared(x: np.ndarray, mass, basis: list[np.ndarray]) -> np.ndarray:
+    """``x`` without its M-projection on the M-orthonormal columns of ``basis`` (chunks of columns)."""
+    mx = np.asarray(mass @ x)
+    return x - sum(c @ (c.T @ mx) for c in basis)
 
 
 def _filled(chunks: list[np.ndarray], m: int, width: int) -> list[np.ndarray]:

@@ -120,8 +120,8 @@ def state_space_roots(mass: np.ndarray, damping: np.ndarray, stiffness: np.ndarr
     [0, I; -M^-1 K, -M^-1 D] x = lambda x with x = (phi, lambda phi) (module docstring); ``damping`` includes any
     gyroscopic part. The roots come in the order LAPACK's dgeev returns them."""
     n = mass.shape[0]
-    minv_k, minv_d = np.linalg.solve(mass, np.hstack([stiffness, damping])).reshape(n, 2, n).transpose(1, 0, 2)
-    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv_k, -minv_d]])
+    minv_kd = np.linalg.solve(mass, np.hstack([stiffness, damping]))  # [M^-1 K, M^-1 D]
+    a = np.block([[np.zeros((n, n)), np.eye(n)], [-minv_kd]])
     return np.linalg.eig(a)
 
 
