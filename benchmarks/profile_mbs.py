@@ -5,12 +5,12 @@ Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end
      [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
-stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then
-solved as a run solves it (the Jacobian economy of the production formulation, the collector's
-generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed per
-case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per
-step (the ``Python`` timer is the pre-step user functions), Newton iterations and Jacobians per step;
-with ``--cprofile`` the top Python functions. ``--blas-threads 2`` shows what BLAS threads cost the build.
+stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then solved as a run solves it
+(the production formulation's Jacobian economy and, with flexible bodies, warm-started multipliers; the collector's
+generations frozen) with Exudyn's timers on (``timeIntegration.verboseMode``/``displayComputationTime``). Printed
+per case: every non-zero timer's share applied to the solve's CPU time, in seconds and microseconds per step (the
+``Python`` timer is the pre-step and pre-Newton user functions), Newton iterations and Jacobians per step; with
+``--cprofile`` the top Python functions. ``--blas-threads 2`` shows what BLAS threads cost the build.
 ``--frozen contacts joints``: the flexible gears' contact columns (flexgear.mbs.contact_kinematics.ContactKinematics)
 and the turning joints' coefficients (flexgear.mbs.joints.TurningBlocks) written at the first step only (wrong physics:
 a bound on what the Newton iterations and Jacobians that their change from step to step costs).
@@ -33,7 +33,7 @@ from pathlib import Path
 from bench_speed import floor_variant, load_average, shortened
 
 from flexgear.mbs.gearbox import build_star_gearbox
-from flexgear.mbs.newton import JacobianEconomy
+from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.spec import load_variant
 
@@ -51,17 +51,20 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
     mbs.Assemble()
     if timers:
         print(f"  build: wall {time.perf_counter() - b0:.2f} s, cpu {time.process_time() - bc0:.2f} s")
-    settings = simulation_settings(variant, t_end, False)
+    sv = variant.gearbox.solver_assumed
+    warm = not sv.reference and any(b.flexible for b in model.bodies.values())  # as flexgear.mbs.run.RunGuard
+    settings = simulation_settings(variant, t_end, False, warm)
     if timers:
         settings.timeIntegration.verboseMode = 2 if trace else 1  # 2: every Newton iteration's residual
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", DeprecationWarning)
             settings.displayComputationTime = True
             settings.displayStatistics = True
-    sv = variant.gearbox.solver_assumed
     if not sv.reference:  # as flexgear.mbs.run's post-step guard drives it
         economy = JacobianEconomy(sv.jacobian_cost_iterations)
         mbs.SetPostStepUserFunction(lambda mbs, t: economy(mbs) or True)
+    if warm:
+        mbs.SetPreNewtonResidualUserFunction(MultiplierWarmStart())
     prof = cProfile.Profile() if profile else None
     gc.collect()
     gc.freeze()  # as flexgear.mbs.run solves: the collector does not walk the built model every few steps

@@ -15,6 +15,7 @@ import numpy as np
 import pandas as pd
 
 from flexgear.mbs.bodies import Body
+from flexgear.mbs.newton import newton_absolute_tolerance
 
 if TYPE_CHECKING:
     from flexgear.mbs.gearbox import GearboxModel
@@ -90,12 +91,13 @@ class Recorder:
 
 def solver_settings(t_end: float, step_size: float, spectral_radius: float = 0.8, newton_iterations: int = 3,
                     relative_tolerance: float = 1e-6, progress: bool = False, record_every_steps: int = 1,
-                    reference: bool = False):
+                    reference: bool = False, absolute_tolerance: float | None = None):
     """Exudyn ``SimulationSettings``: generalized-alpha, modified Newton (Jacobian update after at most
     ``newton_iterations``), Eigen's sparse LU, one thread, no solution file, sensors every ``record_every_steps``
     steps. The LU keeps its ordering between Jacobians of one pattern, except in the ``reference`` formulation
-    (a new ordering per Jacobian, Exudyn's default). Times in s. The one solver set-up of the examples and the
-    study."""
+    (a new ordering per Jacobian, Exudyn's default). ``absolute_tolerance``: Newton's absolute residual tolerance
+    (flexgear.mbs.newton.newton_absolute_tolerance; None: Exudyn's). Times in s. The one solver set-up of the
+    examples and the study."""
     import exudyn as exu
 
     if not (t_end > 0 and step_size > 0):
@@ -108,6 +110,8 @@ def solver_settings(t_end: float, step_size: float, spectral_radius: float = 0.8
     ti.newton.useModifiedNewton = True
     ti.newton.maxModifiedNewtonIterations = newton_iterations
     ti.newton.relativeTolerance = relative_tolerance
+    if absolute_tolerance is not None:
+        ti.newton.absoluteTolerance = absolute_tolerance
     ti.verboseMode = 1 if progress else 0
     s.linearSolver.solverType = exu.LinearSolverType.EigenSparse
     s.linearSolver.reuseAnalyzedPattern = not reference
@@ -131,12 +135,15 @@ def solve(mbs, t_end: float, step_size: float, recorder: Recorder | None = None,
     return None if recorder is None else recorder.dataframe()
 
 
-def simulation_settings(variant: Variant, t_end: float, progress: bool):
-    """:func:`solver_settings` for the variant's load case (Table 5 step size) and solver assumptions."""
+def simulation_settings(variant: Variant, t_end: float, progress: bool, warm_start: bool = False):
+    """:func:`solver_settings` for the variant's load case (Table 5 step size) and solver assumptions. ``warm_start``:
+    the run warm-starts the multipliers (:class:`flexgear.mbs.newton.MultiplierWarmStart`) and takes the absolute
+    tolerance that goes with it (:func:`flexgear.mbs.newton.newton_absolute_tolerance`)."""
     sv = variant.gearbox.solver_assumed
     return solver_settings(t_end, variant.gearbox.load_case.step_size_s, sv.spectral_radius,
                            sv.newton_max_modified_iterations, sv.newton_relative_tolerance, progress,
-                           sv.record_every_steps, sv.reference)
+                           sv.record_every_steps, sv.reference,
+                           newton_absolute_tolerance(variant.gearbox) if warm_start else None)
 
 
 def add_gearbox_sensors(mbs, model: GearboxModel) -> dict[str, int]:
