@@ -24,9 +24,10 @@ mean excess ``t - (a + b n)`` of the steps with one. The converged solution is t
 tolerance (the tolerance and the iteration are unchanged, only the matrix they use is fresher);
 ``tests/test_newton.py`` checks it against Exudyn's own Jacobian policy.
 
-:class:`MultiplierWarmStart` (production; the reference keeps Exudyn's start) gives each step's Newton iteration the
-last step's Lagrange multipliers as its start. Exudyn starts every step from zero multipliers, so a step's initial
-residual holds every reaction force (model 7 at the Table 5 load: about 3.2 kN), and the modified Newton's
+:class:`MultiplierWarmStart` (production, in models with flexible bodies, flexgear.mbs.run.RunGuard.warm_start; rigid
+models and the reference keep Exudyn's start) gives each step's Newton iteration the last step's Lagrange multipliers
+as its start. Exudyn starts every step from zero multipliers, so a step's initial
+residual holds every reaction force (about N F_n, the sun's total normal mesh force), and the modified Newton's
 Jacobian, which lags the constraint rows that turn with the spin by the angle turned since it was computed, errs
 in its first increment by that angle times all of them. From the last step's multipliers the first increment
 carries only their change over one step. Converged is then a residual below
