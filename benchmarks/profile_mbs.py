@@ -33,7 +33,7 @@ from pathlib import Path
 from bench_speed import floor_variant, load_average, shortened
 
 from flexgear.mbs.gearbox import build_star_gearbox
-from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart
+from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.spec import load_variant
 
@@ -52,7 +52,7 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
     if timers:
         print(f"  build: wall {time.perf_counter() - b0:.2f} s, cpu {time.process_time() - bc0:.2f} s")
     sv = variant.gearbox.solver_assumed
-    warm = not sv.reference and any(b.flexible for b in model.bodies.values())  # as flexgear.mbs.run.RunGuard
+    warm = warm_starts(model.bodies.values(), sv.reference)
     settings = simulation_settings(variant, t_end, False, warm)
     if timers:
         settings.timeIntegration.verboseMode = 2 if trace else 1  # 2: every Newton iteration's residual

@@ -24,7 +24,7 @@ mean excess ``t - (a + b n)`` of the steps with one. The converged solution is t
 tolerance (the tolerance and the iteration are unchanged, only the matrix they use is fresher);
 ``tests/test_newton.py`` checks it against Exudyn's own Jacobian policy.
 
-:class:`MultiplierWarmStart` (production, in models with flexible bodies, flexgear.mbs.run.RunGuard.warm_start; rigid
+:class:`MultiplierWarmStart` (production, in models with flexible bodies, :func:`warm_starts`; rigid
 models and the reference keep Exudyn's start) gives each step's Newton iteration the last step's Lagrange multipliers
 as its start. Exudyn starts every step from zero multipliers, so a step's initial
 residual holds every reaction force (about N F_n, the sun's total normal mesh force), and the modified Newton's
@@ -38,12 +38,16 @@ or the relative tolerance of the (now smaller) initial residual, whichever comes
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
+from typing import TYPE_CHECKING
 
 from flexgear.spec import GearboxSpec
 from flexgear.theory import theory
 
-__all__ = ["MIN_SAMPLES", "JacobianEconomy", "MultiplierWarmStart", "newton_absolute_tolerance"]
+if TYPE_CHECKING:
+    from flexgear.mbs.bodies import Body
+
+__all__ = ["MIN_SAMPLES", "JacobianEconomy", "MultiplierWarmStart", "newton_absolute_tolerance", "warm_starts"]
 
 MIN_SAMPLES = 8
 """Steps without a Jacobian needed (beside one with a Jacobian) before the cost ratio is reported as measured."""
@@ -121,6 +125,13 @@ class JacobianEconomy:
             b = f[3] / f[1]
         a = (f[3] - b * f[1]) / f[0]
         return max((s[2] - s[0] * a - b * s[1]) / s[0] / b, 0.0)
+
+
+def warm_starts(bodies: Iterable[Body], reference: bool) -> bool:
+    """Whether a run warm-starts its multipliers (:class:`MultiplierWarmStart`): the production formulation with a
+    flexible body, whose constraint rows turn with the spin (a rigid model converges in about one iteration from
+    either start)."""
+    return not reference and any(b.flexible for b in bodies)
 
 
 def newton_absolute_tolerance(spec: GearboxSpec) -> float:

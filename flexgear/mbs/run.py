@@ -26,7 +26,7 @@ import pandas as pd
 from flexgear.design import design
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
-from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart
+from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.progress import Progress
@@ -138,14 +138,12 @@ class RunGuard:
         self.bar = Progress(t_end, f"run {variant.name}", "s", enabled=progress, fmt="{:.4g}")
         sv = variant.gearbox.solver_assumed
         self.economy = None if sv.reference else JacobianEconomy(sv.jacobian_cost_iterations)
-        self.flexible = any(b.flexible for b in model.bodies.values())
+        self._warm_start = warm_starts(model.bodies.values(), sv.reference)
 
     @property
     def warm_start(self) -> bool:
-        """Whether the run warm-starts its multipliers (flexgear.mbs.newton.MultiplierWarmStart): in the production
-        formulation with flexible bodies, whose constraint rows turn with the spin (a rigid model converges in about
-        one iteration from either start)."""
-        return self.economy is not None and self.flexible
+        """Whether the run warm-starts its multipliers (flexgear.mbs.newton.warm_starts)."""
+        return self._warm_start
 
     def __call__(self, mbs, t: float) -> bool:
         if self.economy is not None:
