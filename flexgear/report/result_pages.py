@@ -55,7 +55,7 @@ def run_time_page(d: ReportData) -> Page:
         draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34}, fontsize=7.5)
         fig.text(0.04, 0.37, "Both per simulated second: the study's Table 4 times are for 0.6 s simulated (its own "
                  "computer); ours for the simulated time shown (model build + simulation). Wall time includes waiting "
-                 "for a shared CPU; CPU time does not.", fontsize=7.5)
+                 "for a shared CPU; CPU time does not.", fontsize=7.5, wrap=True)
     return ("Run time per simulated second against the study's ADAMS times (Table 4)", draw)
 
 
@@ -198,7 +198,7 @@ def spectrum_pages(d: ReportData) -> list[Page]:
 
     def draw(fig: Figure) -> None:
         for i, side in enumerate(("input", "output")):
-            ax = fig.add_axes([0.07, 0.56 - 0.46 * i, 0.9, 0.33])
+            ax = fig.add_axes([0.07, 0.58 - 0.44 * i, 0.9, 0.31])
             spectra = [BearingSpectrum.of(r, side, _run_window(d, n, r, runs), n) for n, r in runs.items()]
             present: set[int] = set()
             for sp in spectra:
@@ -213,7 +213,7 @@ def spectrum_pages(d: ReportData) -> list[Page]:
             ax.set_title(f"{side}-shaft bearing, x acceleration, each run's settled window", fontsize=9, pad=14)
             ax.legend(fontsize=7, ncol=min(8, len(spectra)), loc="lower left", framealpha=0.85)
             ax.grid(alpha=0.3, which="major")
-        text_block(fig.add_axes([0.07, 0.03, 0.9, 0.04]), "Hann-windowed amplitude spectrum "
+        text_block(fig.add_axes([0.07, 0.01, 0.9, 0.04]), "Hann-windowed amplitude spectrum "
                    "(flexgear.study.compare). Markers at every harmonic of the mesh frequency that stands 20 dB above "
                    "its neighbourhood in any run (grey), the study's 1, 2, 4, 6, 9× (Table 7) in red.", width=190,
                    fontsize=7.5)
