@@ -3,12 +3,12 @@ each reference indicator's TEa on the scale where it matters (flexgear.study.scr
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from flexgear.schema_fields import _choice, _num, _text
 
-__all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance",
-           "ReferenceIndicators", "ScreeningSettings"]
+__all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance", "ErrorLevelTolerance",
+           "ReferenceIndicators", "ScreeningSettings", "DEFAULT_PURPOSES", "PURPOSE_NAMES"]
 
 
 @dataclass(frozen=True)
@@ -37,6 +37,11 @@ class _Tolerance:
     def tea(self) -> float:
         return float(getattr(self, self.tea_field))
 
+    @property
+    def floor(self) -> float | None:
+        """Smallest amplitude taken to dB, in the signal's SI unit (None: flexgear.study.indicators' default)."""
+        return None
+
 
 @dataclass(frozen=True)
 class IndicatorTolerance(_Tolerance):
@@ -63,6 +68,21 @@ class LevelTolerance(_Tolerance):
 
 
 @dataclass(frozen=True)
+class ErrorLevelTolerance(_Tolerance):
+    """TEa in dB of a transmission-error harmonic (20 log10 of the amplitude ratio); amplitudes below ``floor_um``
+    [um] count as ``floor_um`` (below what a transmission-error measurement resolves: both "no ripple")."""
+
+    tea_db: float = _num(0.0, 200.0, lo_open=True)
+    floor_um: float = _num(0.0, 1000.0, lo_open=True)
+    scale, tea_field = "db", "tea_db"
+
+    @property
+    def floor(self) -> float:
+        """The level floor in the signal's SI unit [m]."""
+        return self.floor_um * 1e-6
+
+
+@dataclass(frozen=True)
 class ReferenceIndicators:
     """TEa and weight of every indicator screened against a reference variant, each on the scale where it
     matters (``[screening.reference_indicators]``; flexgear.study.indicators defines each indicator)."""
@@ -81,6 +101,23 @@ class ReferenceIndicators:
     input_bearing_mesh1x: LevelTolerance
     output_bearing_mesh1x: LevelTolerance
     transmission_error: IndicatorTolerance
+    transmission_error_mesh1x: ErrorLevelTolerance
+    transmission_error_mesh2x: ErrorLevelTolerance
+
+
+DEFAULT_PURPOSES: dict[str, tuple[str, ...]] = {
+    "mean_loads": ("input_speed", "output_speed", "transmission_ratio", "outer_mesh_force", "inner_mesh_force"),
+    "tooth_loads": ("dynamic_factor", "load_sharing", "outer_mesh_ripple", "inner_mesh_ripple"),
+    "vibration": ("input_bearing_rms", "output_bearing_rms", "input_bearing_mesh1x", "output_bearing_mesh1x"),
+    "transmission_error": ("transmission_error_mesh1x", "transmission_error_mesh2x"),
+}
+"""The questions a gear engineer asks of a model, each with the reference indicators that answer it
+(``[screening.purposes]``; a file without that table gets these). The mean loaded transmission error
+(``transmission_error``) is in no purpose: a static offset, reported beside the transmission-error verdict with
+its split into the meshes' share and the rest (flexgear.study.purposes.static_te_split), never deciding it."""
+
+PURPOSE_NAMES = tuple(DEFAULT_PURPOSES)
+"""The purposes every ``[screening.purposes]`` table holds; a file may add more."""
 
 
 @dataclass(frozen=True)
@@ -110,3 +147,6 @@ class ScreeningSettings:
     reference: str = _text(default="")
     # numerical error bars: the reference's final state solved over this window at h and at h/2 (0: none)
     error_window_s: float = _num(0.0, default=0.05)
+    # reference mode: purpose -> the indicators judged for it, each alone (flexgear.study.purposes)
+    purposes: dict[str, tuple[str, ...]] = field(default_factory=lambda: dict(DEFAULT_PURPOSES),
+                                                  metadata={"purposes": True})

@@ -50,6 +50,7 @@ from flexgear.schema import (
     SpecError,
     Variant,
 )
+from flexgear.schema_screening import PURPOSE_NAMES
 
 __all__ = [
     "SpecError",
@@ -159,15 +160,41 @@ def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
     for name, f in fields.items():
         full = f"{prefix}.{name}"
         if name not in data:
-            if f.default is not dataclasses.MISSING:
+            if f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING:
                 continue
             raise SpecError(path, full, "missing (required)")
         hint = hints[name]
-        if dataclasses.is_dataclass(hint):
+        if f.metadata.get("purposes"):
+            values[name] = _check_purposes(path, full, data[name])
+        elif dataclasses.is_dataclass(hint):
             values[name] = _build(hint, data[name], path, full)
         else:
             values[name] = _check_value(path, full, data[name], hint, dict(f.metadata))
     return cls(**values)
+
+
+def _check_purposes(path: Path, name: str, value: Any) -> dict[str, tuple[str, ...]]:
+    """``[screening.purposes]``: a table of purpose -> list of reference indicator names, each indicator in at most
+    one purpose, every purpose of PURPOSE_NAMES present."""
+    known = [f.name for f in dataclasses.fields(ReferenceIndicators)]
+    if not isinstance(value, dict):
+        raise SpecError(path, name, "expected a table of purpose = [indicator names]", value)
+    out, seen = {}, {}
+    for purpose, keys in value.items():
+        if not isinstance(keys, list) or not keys or not all(isinstance(k, str) for k in keys):
+            raise SpecError(path, f"{name}.{purpose}", "expected a non-empty list of indicator names", keys)
+        for k in keys:
+            if k not in known:
+                raise SpecError(path, f"{name}.{purpose}", f"unknown indicator {k!r}; allowed: {', '.join(known)}")
+            if k in seen:
+                raise SpecError(path, f"{name}.{purpose}", f"indicator {k!r} is already in purpose {seen[k]!r}; "
+                                "each indicator serves one purpose")
+            seen[k] = purpose
+        out[str(purpose)] = tuple(keys)
+    missing = [p for p in PURPOSE_NAMES if p not in out]
+    if missing:
+        raise SpecError(path, f"{name}.{missing[0]}", f"missing (required purposes: {', '.join(PURPOSE_NAMES)})")
+    return out
 
 
 def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:

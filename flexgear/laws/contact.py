@@ -20,7 +20,8 @@ from flexgear.design import Design, as_design
 from flexgear.geometry.contact_lines import MeshContactGeometry
 from flexgear.spec import Contact, GearboxSpec
 
-__all__ = ["ContactLaw", "impact_force", "linear_force", "normal_force", "backlash_linear_force", "friction_forces",
+__all__ = ["ContactLaw", "static_deflection", "effective_stiffness", "impact_force",
+           "linear_force", "normal_force", "backlash_linear_force", "friction_forces",
            "mesh_damping", "mesh_laws", "half_laws"]
 
 LAWS = ("impact", "iso6336")
@@ -51,6 +52,21 @@ class ContactLaw:
         """The law of a ``share`` of the face width: stiffness and damping scale with it."""
         return ContactLaw(self.stiffness * share, self.exponent, self.damping_max * share, self.penetration_depth,
                           self.kind)
+
+
+def static_deflection(force_n: float, law: ContactLaw) -> float:
+    """Static normal deflection [m] of a mesh carrying ``force_n`` [N] under ``law`` at the mean of its stiffness
+    series (s = 1): delta = (F / k)^(1 / e) (impact law), F / k (linear law); the elastic term inverted, no damping."""
+    if force_n <= 0.0:
+        return 0.0
+    return (force_n / law.stiffness) ** (1.0 / law.exponent)
+
+
+def effective_stiffness(force_n: float, law: ContactLaw) -> float:
+    """Tangent stiffness [N/m] of ``law`` at the static deflection under ``force_n`` [N]: dF/d delta = e k
+    delta^(e - 1) = e F / delta (k for the linear law)."""
+    delta = static_deflection(force_n, law)
+    return law.exponent * force_n / delta if delta > 0.0 else math.nan
 
 
 def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, damping_ratio: float) -> float:

@@ -91,6 +91,28 @@ class ModalScreening:
     threshold: float
     candidates: dict[str, tuple[str, ...]]
 
+    def mode_table(self) -> pd.DataFrame:
+        """One row per weighted mode (a resonance peak in the band): mode (1-based, of the band), frequency_hz,
+        damping_ratio, kind, ``harmonic`` k (the mesh harmonic k f_m nearest to resonance, the largest A(r)),
+        ``weight`` w_j, and each Table 3 component's elastic strain share s_cj (``share_<component>``), the planets
+        added into one."""
+        f = self.modes.frequencies_hz[self.weighted]
+        zeta = np.maximum(self.modes.damping_ratios[self.weighted], 0.0)
+        k = np.arange(1, 11)
+        r = k[None, :] * self.f_mesh_hz / f[:, None]
+        a = 1.0 / np.sqrt((1.0 - r**2) ** 2 + (2.0 * zeta[:, None] * r) ** 2)
+        out = pd.DataFrame({"mode": np.asarray(self.weighted) + 1, "frequency_hz": f, "damping_ratio": zeta,
+                            "kind": [self.modes.kinds[i] for i in self.weighted], "harmonic": k[a.argmax(axis=1)],
+                            "weight": self.weights})
+        for c in TABLE3_COMPONENTS:
+            out[f"share_{c}"] = 0.0
+        for column in self.modes.energy.columns:
+            if column.startswith("strain_") and column.endswith("_elastic"):
+                c = _table3_component(column.removeprefix("strain_").removesuffix("_elastic"))
+                if c in TABLE3_COMPONENTS:
+                    out[f"share_{c}"] += self.modes.energy[column].to_numpy()[self.weighted]
+        return out
+
 
 def table3_variants(folder: Path) -> dict[str, tuple[str, ...]]:
     """Table 3's variants in ``folder`` (model<number>.toml, in number order): {name: its flexible components}."""

@@ -18,8 +18,11 @@ gives its CV like the study's:
 - ``transmission_error`` [m]: the loaded transmission error, segment mean of ``transmission_error_m``
   (the static TE under load, which the compliance of gears, shafts and supports sets directly;
   present only when the backend records it, otherwise left out and its weight shared out). Not
-  its peak-to-peak: near integer overlap ratios the steady TE ripple vanishes (below 0.1 nm with
-  the iso6336 law at eps_beta = 0.95, model 1) and a relative error of it is meaningless.
+  its peak-to-peak: near integer overlap ratios the steady TE ripple vanishes (the iso6336 law at
+  eps_beta near 1) and a relative error of it is meaningless.
+- ``transmission_error_mesh1x`` / ``transmission_error_mesh2x`` [m]: amplitude of the transmission error at 1x
+  and 2x the mesh frequency (windowed DTFT as for the bearings): the TE's alternating part, the excitation of the
+  vibration; judged in dB above a floor (``[screening.reference_indicators]``, ErrorLevelTolerance).
 
 The settled window is :mod:`flexgear.settling`'s test.
 """
@@ -56,6 +59,8 @@ DYNAMIC_INDICATORS: dict[str, str] = {
     "input_bearing_mesh1x": "input bearing accel. at 1x mesh",
     "output_bearing_mesh1x": "output bearing accel. at 1x mesh",
     "transmission_error": "loaded transmission error (mean)",
+    "transmission_error_mesh1x": "transmission error at 1x mesh",
+    "transmission_error_mesh2x": "transmission error at 2x mesh",
 }
 """Dynamic indicators of the reference screening: key -> readable name."""
 
@@ -110,6 +115,9 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     }
     if te is not None:
         funcs["transmission_error"] = lambda s: float(te[s].mean())
+        for order in (1, 2):
+            funcs[f"transmission_error_mesh{order}x"] = lambda s, n=order: float(harmonic_amplitudes(
+                te[s], float(np.median(np.diff(t[s]))), mesh_frequency_hz, (n,))[0])
     for s in slices:
         if s.stop - s.start < 4:
             raise ValueError(f"a segment holds {s.stop - s.start} recorded points (at least 4 needed): "
@@ -122,13 +130,14 @@ LEVEL_FLOOR_M_PER_S2 = 1e-9
 vibration where the reference has some is then far off in dB, not undefined."""
 
 
-def on_scale(key: str, scale: str, samples: np.ndarray) -> np.ndarray:
+def on_scale(key: str, scale: str, samples: np.ndarray, floor: float | None = None) -> np.ndarray:
     """An indicator's samples on the scale where it is judged (``[screening.reference_indicators]``):
 
     - "relative": unchanged (the bias is then relative to the reference's value);
     - "load": % of the mean tooth load: the ripples are that already (RMS alternating load / mean load), a load
       factor K (K_gamma, K_v) becomes 100 K, so that a difference is the extra load in % of the mean load;
-    - "db": 20 log10(x / 1 m/s^2), vibration level in dB (amplitudes below LEVEL_FLOOR_M_PER_S2 at the floor).
+    - "db": 20 log10(x / 1 SI unit), a level in dB (amplitudes below ``floor``, default LEVEL_FLOOR_M_PER_S2, at
+      the floor).
     """
     x = np.asarray(samples, dtype=float)
     if scale == "relative":
@@ -136,5 +145,5 @@ def on_scale(key: str, scale: str, samples: np.ndarray) -> np.ndarray:
     if scale == "load":
         return x if key.endswith("_ripple") else 100.0 * x
     if scale == "db":
-        return 20.0 * np.log10(np.maximum(np.abs(x), LEVEL_FLOOR_M_PER_S2))
+        return 20.0 * np.log10(np.maximum(np.abs(x), LEVEL_FLOOR_M_PER_S2 if floor is None else floor))
     raise ValueError(f"unknown indicator scale {scale!r}; allowed: relative, load, db")

@@ -14,8 +14,12 @@ start first (the longest first, so that the last ones overlap). Then it writes
   worker's total wall and CPU time (loading, build, simulation), input and configuration hashes,
   whether the run was resumed;
 - ``screening.csv`` / ``.parquet``: per variant Bias %, CV %, distance, zone, sigma, time,
-  selected (:func:`flexgear.study.screening.screening_tables`); ``screening_indicators.*`` per
-  indicator; ``selection.txt``: the selected variant and why.
+  selected (:func:`flexgear.study.screening.screen`); ``screening_indicators.*`` per indicator (with its
+  ``purpose``); ``selection.txt``: the selected variant and why;
+- with a reference variant, ``verdict.csv`` / ``.parquet``: one row per purpose and one for all purposes
+  (flexgear.study.purposes.VERDICT_COLUMNS: the selected variant, empty when none, the deciding indicator with
+  its Bias, CV and TEa in its unit, whether the verdict is resolved, the CPU-time ratio to the reference), and
+  ``purpose_zones.*``: each variant's zone per purpose and its weakest indicator.
 
 Nothing lost: every file is written atomically and a run folder is complete once its ``run.json`` is
 there (written last). A matrix killed at any moment (SIGKILL included) resumes when started again: a
@@ -47,7 +51,8 @@ from flexgear.cache import atomic_write_bytes, remove_stale_temporaries
 from flexgear.progress import Progress, say
 from flexgear.results import RunResult, load_result, save_result
 from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant, spec_hash
-from flexgear.study.screening import ReferenceNotUsable, Selection, screening_tables
+from flexgear.study.purposes import ALL_PURPOSES, verdict_table
+from flexgear.study.screening import ReferenceNotUsable, Selection, screen
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
@@ -240,15 +245,26 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     results = [load_result(out_dir / n) if (out_dir / n / "run.json").exists()
                else _failed(n, "no saved run") for n in names]
     ref = settings.reference if reference is None else reference
+    purposes = tuple(settings.purposes) if ref else ()
     try:
-        table, indicators, selection = screening_tables(results, settings, reference)
+        s = screen(results, settings, reference)
     except ReferenceNotUsable as exc:
         table = pd.DataFrame({"variant": [r.name for r in results], "status": "not screened", "reason": str(exc),
                               "selected": False})
-        indicators = pd.DataFrame(columns=["variant", "indicator"])
+        indicators = pd.DataFrame(columns=["variant", "indicator", "purpose"])
         selection = Selection(None, settings.selection, str(exc))
+        verdict = pd.DataFrame({"purpose": [*purposes, ALL_PURPOSES], "selected": "", "resolved": False,
+                                "reasoning": str(exc)}).reindex(columns=list(verdict_table([]).columns))
+        zones = None
+    else:
+        table, indicators, selection = s.table, s.indicators, s.selection
+        verdict, zones = verdict_table(list(s.verdicts)), s.purpose_zones
     write_table(table, out_dir / "screening")
     write_table(indicators, out_dir / "screening_indicators")
+    if ref:
+        write_table(verdict, out_dir / "verdict")
+        if zones is not None:
+            write_table(zones, out_dir / "purpose_zones")
     atomic_write_bytes(out_dir / "screening.json", json.dumps({"reference": ref}).encode())
     text = (f"selected: {selection.variant}\nrule: {selection.rule}\nreference: {ref or 'theory'}\n"
             f"{selection.reasoning}\n")
@@ -260,9 +276,9 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
 def modal_verdict(out_dir: Path, reference: Any, progress: bool = False) -> str:
     """The modal screening of the all-flexible reference (flexgear.modal.screening: which components deform in the
     modes that the mesh harmonics can excite) beside the Westgard verdict of ``out_dir/selection.txt``; writes
-    ``modal_screening.csv`` and ``modal_screening.txt`` (one paragraph) and returns the paragraph. ``reference``: a
-    Variant or its flexgear.modal.LinearModel. A failure is recorded in the text, not raised: the Westgard verdict
-    stands on its own."""
+    ``modal_screening.csv``, ``modal_screening_modes.csv`` (ModalScreening.mode_table) and ``modal_screening.txt``
+    (one paragraph) and returns the paragraph. ``reference``: a Variant or its flexgear.modal.LinearModel. A
+    failure is recorded in the text, not raised: the Westgard verdict stands on its own."""
     from flexgear.modal.screening import modal_screening
 
     name = reference.variant.name if hasattr(reference, "variant") else reference.name
@@ -273,6 +289,7 @@ def modal_verdict(out_dir: Path, reference: Any, progress: bool = False) -> str:
         text = f"Modal screening of {name} not done: {type(exc).__name__}: {exc}"
     else:
         write_table(m.table, out_dir / "modal_screening")
+        write_table(m.mode_table(), out_dir / "modal_screening_modes")
         selection = (out_dir / "selection.txt").read_text().splitlines()[0].removeprefix("selected: ")
         must = ", ".join(m.table.component[m.table.must_be_flexible]) or "none"
         text = (f"Modal screening of {name}'s modes up to {m.f_band_hz:.4g} Hz (10x the mesh frequency): "

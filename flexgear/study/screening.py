@@ -34,9 +34,10 @@ Reference mode (``[screening] reference = "model7"`` or ``flexgear matrix --refe
 five study indicators are fixed by kinematics and torque balance and cannot tell flexible from
 rigid variants apart, so the dynamic indicators of :mod:`flexgear.study.indicators` join them and
 every Bias is taken against the reference variant's mean (the reference has Bias 0 and sits on
-the CV axis). Each indicator i has its own TEa_i and weight w_i (``[screening.reference_indicators]``);
-the composite point is Bias_c = Σ w_i Bias_i / TEa_i · 100 and CV_c likewise, in % of the
-allowable error, judged against TEa = 100 %.
+the CV axis). Each indicator i has its own TEa_i (``[screening.reference_indicators]``) and is judged
+alone: the verdict is per purpose (:mod:`flexgear.study.purposes`), a variant's zone the zone of its
+weakest indicator. The weighted composite Bias_c = Σ w_i Bias_i / TEa_i · 100 (CV_c likewise, in % of
+TEa) is kept as a summary distance only; it decides nothing.
 """
 
 from __future__ import annotations
@@ -53,6 +54,7 @@ from flexgear.results import RunResult
 from flexgear.settling import SettleRule, Settling, settled_start
 from flexgear.spec import ScreeningSettings
 from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, on_scale, segment_slices
+from flexgear.study.purposes import ALL_PURPOSES, PurposeVerdict, judge_purposes
 from flexgear.study.selection import DecisionLines, Selection, select_variant, variant_names
 
 __all__ = ["INDICATORS", "DecisionLines", "Window", "IndicatorResult", "VariantScreening", "Selection",
@@ -238,7 +240,7 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
     else:
         window, samples = indicator_samples(result, settings, window=window)
         tol = {k: getattr(settings.reference_indicators, k) for k in samples if k in reference}
-        samples = {k: on_scale(k, tol[k].scale, v) for k, v in samples.items() if k in tol}
+        samples = {k: on_scale(k, tol[k].scale, v, tol[k].floor) for k, v in samples.items() if k in tol}
         targets = {k: float(reference[k]) for k in samples}
         total = sum(t.weight for t in tol.values())
         weights = {k: t.weight / total for k, t in tol.items()}
@@ -275,6 +277,8 @@ class Screening:
     selection: Selection
     lines: DecisionLines
     reference: str = ""
+    verdicts: tuple[PurposeVerdict, ...] = ()   # reference mode: one per purpose, then ALL_PURPOSES
+    purpose_zones: pd.DataFrame | None = None    # reference mode: flexgear.study.purposes.purpose_zones
 
     def plot(self, ax, xlim: float | None = None, ylim: float | None = None, title: str = "") -> list[str]:
         """Westgard decision diagram of the composite points (numbered markers); returns the legend
@@ -299,31 +303,25 @@ def numerical_error(reference: RunResult, settings: ScreeningSettings) -> tuple[
         t = table["time_s"].to_numpy()
         samples = indicator_segments(table, segment_slices(t, float(t[0]), float(t[-1]), settings.sample_count),
                                      f_mesh)
-        means.append({k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()})
+        means.append({k: float(np.mean(on_scale(k, getattr(tol, k).scale, v, getattr(tol, k).floor)))
+                      for k, v in samples.items()})
     errors = {k: scaled_bias(means[1][k], means[0][k], getattr(tol, k).scale) for k in means[0] if k in means[1]}
     total = sum(getattr(tol, k).weight for k in errors)
     return sum(getattr(tol, k).weight / total * e / getattr(tol, k).tea * 100.0 for k, e in errors.items()), errors
 
 
-def _resolution(table: pd.DataFrame, lines: DecisionLines, error: float, selection: Selection) -> Selection:
-    """Mark each variant's zone resolved when Bias -/+ the numerical error keeps it, and the verdict not resolved
-    when the selected variant's zone, or that of a faster screened variant, is not."""
+def _resolution(table: pd.DataFrame, indicators: pd.DataFrame, errors: dict[str, float], m1: float) -> None:
+    """Mark each screened variant ``resolved`` when no indicator's acceptability (|Bias| + m1 CV <= TEa) changes as
+    its Bias moves by -/+ the reference's numerical error of that indicator (``errors``, the indicator's unit)."""
     ok = table["status"] == "ok"
-    table["error_pct"] = np.where(ok, error, math.nan)
-    table["resolved"] = [bool(not r.status == "ok" or not math.isfinite(error)
-                              or lines.rank(r.bias_pct + error, r.cv_pct) == lines.rank(max(r.bias_pct - error, 0.0),
-                                                                                      r.cv_pct))
-                         for r in table.itertuples()]
-    if selection.variant is None or not math.isfinite(error):
-        return selection
-    chosen = table[table["variant"] == selection.variant]
-    deciding = table[ok & (table["time_s"] <= float(chosen["time_s"].iloc[0]))]
-    open_ = deciding[~deciding["resolved"]]
-    if open_.empty:
-        return selection
-    why = (f"NOT RESOLVED: the zone of {variant_names(open_)} lies within the numerical error ({error:.3g} % of "
-           "TEa, reference at h and h/2). ")
-    return Selection(selection.variant, selection.rule, why + selection.reasoning, False)
+    resolved = []
+    for r in table.itertuples():
+        ind = indicators[indicators["variant"] == r.variant]
+        flips = [i for i in ind.itertuples() if math.isfinite(errors.get(i.indicator, math.nan))
+                 and (i.bias + errors[i.indicator] + m1 * i.cv <= i.tea)
+                 != (max(i.bias - errors[i.indicator], 0.0) + m1 * i.cv <= i.tea)]
+        resolved.append(not flips)
+    table["resolved"] = np.where(ok, resolved, True)
 
 
 class ReferenceNotUsable(ValueError):
@@ -361,20 +359,15 @@ def reference_means(results: list[RunResult], name: str, settings: ScreeningSett
                                  "(--t-end settled)")
     _, samples = indicator_samples(ref, settings, window=window)
     tol = settings.reference_indicators
-    return {k: float(np.mean(on_scale(k, getattr(tol, k).scale, v))) for k, v in samples.items()}
+    return {k: float(np.mean(on_scale(k, getattr(tol, k).scale, v, getattr(tol, k).floor))) for k, v in samples.items()}
 
 
-def _reference_reasoning(table: pd.DataFrame, indicators: pd.DataFrame, name: str) -> str:
-    """Why the variants differ from the reference: distance and the two largest contributors of each."""
-    parts = []
-    for row in table[(table["status"] == "ok") & (table["variant"] != name)].itertuples():
-        ind = indicators[indicators["variant"] == row.variant]
-        share = (ind["weight"] * ind["bias"] / ind["tea"]).sort_values(ascending=False)
-        top = [ind.loc[i] for i in share.index[:2]]
-        parts.append(f"{row.variant} at distance {row.distance_pct:.3g} % of TEa"
-                     + (" (largest: " + ", ".join(f"{t['indicator']} {t['bias']:.3g} {t['unit']} off (TEa "
-                                                  f"{t['tea']:g} {t['unit']})" for t in top) + ")" if top else ""))
-    return (f" Against reference {name} (Bias 0 by definition): " + "; ".join(parts) + ".") if parts else ""
+STUDY_PURPOSE = "study composite"
+"""The ``purpose`` of the study mode's five indicators: judged together, as the study's composite point."""
+
+RULE_PER_PURPOSE = "cheapest_acceptable_per_purpose"
+"""The reference mode's rule (flexgear.study.purposes): each indicator alone, the cheapest acceptable variant per
+purpose, overall the cheapest acceptable for every purpose."""
 
 
 def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None) -> Screening:
@@ -426,14 +419,39 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
     over = indicators[indicators["bias"] > indicators["tea"]]
     table["outside_tea"] = [", ".join(f"{r.indicator} {r.bias:.3g} {r.unit} (TEa {r.tea:g})"
                                       for r in over[over["variant"] == v].itertuples()) for v in table["variant"]]
-    selection = select_variant(table, settings.selection, lines, ref_name)
-    if ref_name:
-        selection = Selection(selection.variant, selection.rule,
-                              selection.reasoning + _reference_reasoning(table, indicators, ref_name))
-        error, _ = numerical_error(next(r for r in results if r.name == ref_name), settings)
-        selection = _resolution(table, lines, error, selection)
+    if not ref_name:
+        indicators["purpose"] = STUDY_PURPOSE
+        selection = select_variant(table, settings.selection, lines, ref_name)
+        table["selected"] = table["variant"] == selection.variant
+        return Screening(table, indicators, selection, lines, ref_name)
+    error, errors = numerical_error(next(r for r in results if r.name == ref_name), settings)
+    purpose_of = {k: p for p, keys in settings.purposes.items() for k in keys}
+    indicators["purpose"] = indicators["indicator"].map(purpose_of).fillna("reported")
+    zones, verdicts = judge_purposes(indicators, table, settings.purposes, lines, ref_name, errors)
+    ok = table["status"] == "ok"
+    weakest = zones.groupby("variant")["rank"].min()
+    table["zone_rank"] = np.where(ok, table["variant"].map(weakest).fillna(0), np.nan)
+    table["zone"] = [lines.zone_names[int(r)] if o else z for r, o, z in zip(table["zone_rank"], ok, table["zone"],
+                                                                             strict=True)]
+    table["error_pct"] = np.where(ok, error, math.nan)
+    _resolution(table, indicators, errors, lines.multipliers[0])
+    selection = _purpose_selection(table, verdicts, ref_name)
     table["selected"] = table["variant"] == selection.variant
-    return Screening(table, indicators, selection, lines, ref_name)
+    return Screening(table, indicators, selection, lines, ref_name, tuple(verdicts), zones)
+
+
+def _purpose_selection(table: pd.DataFrame, verdicts: list[PurposeVerdict], reference: str) -> Selection:
+    """The reference mode's overall selection: the :data:`ALL_PURPOSES` verdict, its reasoning followed by each
+    purpose's."""
+    notes = "".join(f" Not screened ({status}): {variant_names(table[table['status'] == status])}."
+                    for status in ("unsettled", "failed") if (table["status"] == status).any())
+    if not verdicts:
+        return Selection(None, RULE_PER_PURPOSE, "No variant was screened, nothing to select." + notes)
+    overall = verdicts[-1]
+    head = overall.reasoning.replace(f"{ALL_PURPOSES}:", "For every purpose:", 1)
+    per = " ".join(v.reasoning for v in verdicts[:-1])
+    return Selection(overall.selected, RULE_PER_PURPOSE, f"{head} Per purpose: {per}{notes}",
+                     all(v.resolved for v in verdicts))
 
 
 def screening_tables(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None
