@@ -1,4 +1,4 @@
-# flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s), make report
+# flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s, both mesh laws), make report
 #
 # Environment: inside an active virtual environment ($VIRTUAL_ENV) make uses it; otherwise it creates
 # .venv with the first Python 3.11-3.13 it finds (PYTHON=/path/to/python3.x chooses one) and installs
@@ -13,6 +13,7 @@ PY := $(VENV)/bin/python
 STAMP := $(VENV)/.flexgear-installed
 PYTHON_CANDIDATES := $(PYTHON) python3 python3.13 python3.12 python3.11 /usr/bin/python3
 VARIANTS := $(sort $(wildcard model_variants/model*.toml))
+ISO_VARIANTS := $(sort $(wildcard model_variants/iso6336/model*.toml))
 QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 QUICK_ISO_VARIANTS := $(sort $(wildcard model_variants/quick_iso6336/model*.toml))
 RESULTS ?= results
@@ -28,7 +29,7 @@ quick: install
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width
 	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf --westgard-png docs/img/westgard.png \
-		--also $(RESULTS)/quick_iso6336 $(RESULTS)/full
+		--also $(RESULTS)/quick_iso6336 $(RESULTS)/full $(RESULTS)/full_iso6336
 
 install: $(STAMP)
 
@@ -56,11 +57,14 @@ meshes: install
 
 matrix: install
 	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7 --t-end settled
+	$(PY) -m flexgear.cli matrix $(ISO_VARIANTS) --out $(RESULTS)/full_iso6336 --reference model7 --t-end settled
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full --t-end settled
 
 report: install
 	$(PY) -m flexgear.cli report $(RESULTS)/full --output reports/full_screening_report.pdf --also $(RESULTS)/quick \
-		$(RESULTS)/quick_iso6336
+		$(RESULTS)/quick_iso6336 $(RESULTS)/full_iso6336
+	$(PY) -m flexgear.cli report $(RESULTS)/full_iso6336 --output reports/full_iso6336_screening_report.pdf \
+		--also $(RESULTS)/quick_iso6336 $(RESULTS)/full $(RESULTS)/quick
 
 lpm: install
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full

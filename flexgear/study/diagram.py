@@ -12,10 +12,11 @@ import math
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
+from matplotlib.lines import Line2D
 from matplotlib.patches import Ellipse, Patch, Polygon
 from matplotlib.ticker import MaxNLocator
 
-__all__ = ["ZONE_COLOURS", "decision_diagram", "place_labels"]
+__all__ = ["ZONE_COLOURS", "decision_diagram", "indicator_diagram", "place_labels", "PURPOSE_MARKERS"]
 
 ZONE_COLOURS = ("#f4b6b6", "#fbd9a6", "#fff3b0", "#d4efc4", "#a9dcb0", "#7fc8a9")
 _CLUSTER_PT = 7.0          # markers closer than this (points) share one label
@@ -121,6 +122,54 @@ def decision_diagram(ax: Axes, screening: pd.DataFrame, lines, xlim: float | Non
     ax.yaxis.set_major_locator(MaxNLocator(6))
     ax.set_xlabel(f"inaccuracy Bias [{lines.unit}]")
     ax.set_ylabel(f"imprecision CV [{lines.unit}]")
+    if title:
+        ax.set_title(title, fontsize=10)
+    return legend
+
+
+PURPOSE_MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*")
+"""Marker of each purpose, in the order of ``[screening.purposes]`` (indicators of no purpose: "x")."""
+
+
+def indicator_diagram(ax: Axes, indicators: pd.DataFrame, lines, purposes: list[str], xmax: float = 200.0,
+                      ymax: float = 60.0, title: str = "") -> list[str]:
+    """The normalised method decision chart of a reference screening: one point per variant and indicator at
+    (Bias / TEa 100, CV / TEa 100) [% of its own TEa], the decision lines at TEa = 100 %; marker shape per purpose,
+    colour per variant; points beyond the view sit on its edge as open markers. ``indicators``: the screening's
+    indicator table (variant, indicator, bias, cv, tea, purpose). Returns one legend line per variant: its
+    indicators outside the first line."""
+    lines = type(lines)(100.0, lines.multipliers, True)
+    handles = _zones(ax, 100.0, list(lines.multipliers), xmax, ymax, lines.zone_names)
+    b = np.linspace(0.0, 100.0, 50)
+    for m in lines.multipliers:
+        ax.plot(b, lines.cv_on_line(m, b), color="k", lw=0.9)
+    ax.set_xlim(0, xmax)
+    ax.set_ylim(0, ymax)
+    variants = list(dict.fromkeys(indicators["variant"]))
+    colours = [f"C{i % 10}" for i in range(len(variants))]
+    legend = []
+    for v, colour in zip(variants, colours, strict=True):
+        mine = indicators[indicators["variant"] == v]
+        x = (mine["bias"] / mine["tea"] * 100.0).to_numpy(float)
+        y = (mine["cv"] / mine["tea"] * 100.0).to_numpy(float)
+        outside = []
+        for xi, yi, p, name in zip(x, y, mine["purpose"], mine["indicator"], strict=True):
+            marker = PURPOSE_MARKERS[purposes.index(p) % len(PURPOSE_MARKERS)] if p in purposes else "x"
+            clipped = xi > xmax or yi > ymax
+            ax.plot(min(xi, xmax), min(yi, ymax), marker, ms=5.5, mfc="none" if clipped else colour, mec=colour,
+                    mew=1.2, clip_on=False, zorder=5, alpha=0.9)
+            if xi + lines.multipliers[0] * yi > 100.0 * (1 + 1e-12):
+                outside.append(f"{name} {xi:.0f} %")
+        legend.append(f"{v}: " + (", ".join(outside) if outside else "every indicator acceptable"))
+    handles += [Line2D([], [], color=c, marker="o", ls="", label=v) for v, c in zip(variants, colours, strict=True)]
+    handles += [Line2D([], [], color="k", marker=PURPOSE_MARKERS[i % len(PURPOSE_MARKERS)], mfc="none", ls="",
+                       label=p.replace("_", " ")) for i, p in enumerate(purposes)]
+    ax.legend(handles=handles, loc="upper right", fontsize=6.5, ncol=2, framealpha=0.9,
+              title="zones (TEa = 100 % of each indicator's own); variants; purposes", title_fontsize=6.5)
+    ax.xaxis.set_major_locator(MaxNLocator(5))
+    ax.yaxis.set_major_locator(MaxNLocator(6))
+    ax.set_xlabel("inaccuracy |Bias| [% of the indicator's TEa]")
+    ax.set_ylabel("imprecision CV [% of the indicator's TEa]")
     if title:
         ax.set_title(title, fontsize=10)
     return legend

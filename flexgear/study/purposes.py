@@ -131,8 +131,9 @@ def _describe(ind: pd.Series) -> str:
     return (f"{name} {ind['bias']:.3g} {ind['unit']} off, CV {ind['cv']:.2g} (TEa {ind['tea']:g} {ind['unit']})")
 
 
-def _acceptable_within(ind: pd.DataFrame, errors: Mapping[str, float], m1: float) -> bool:
-    """Whether each indicator's acceptability holds when its Bias moves by -/+ its numerical error."""
+def _flips(ind: pd.DataFrame, errors: Mapping[str, float], m1: float) -> list[str]:
+    """The indicators whose acceptability changes when their Bias moves by -/+ their numerical error, in words."""
+    out = []
     for r in ind.itertuples():
         e = float(errors.get(r.indicator, 0.0))
         if not math.isfinite(e):
@@ -140,8 +141,9 @@ def _acceptable_within(ind: pd.DataFrame, errors: Mapping[str, float], m1: float
         hi = r.bias + e + m1 * r.cv <= r.tea
         lo = max(r.bias - e, 0.0) + m1 * r.cv <= r.tea
         if hi != lo:
-            return False
-    return True
+            out.append(f"{r.variant}'s {ALL_INDICATORS.get(r.indicator, r.indicator)} {r.bias:.3g} -/+ {e:.2g} "
+                       f"{r.unit} (TEa {r.tea:g})")
+    return out
 
 
 def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.DataFrame, table: pd.DataFrame,
@@ -172,9 +174,10 @@ def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.
         ["margin", "indicator"], kind="stable")
     deciding = ind.iloc[0]
     rank = int(ind["rank"].min())
-    cheaper = [v for v in order[:order.index(selected) + 1]]
-    resolved = all(_acceptable_within(ranked[(ranked["variant"] == v) & ranked["indicator"].isin(keys)], errors, m1)
-                   for v in cheaper)
+    cheaper = order[:order.index(selected) + 1]
+    flips = [f for v in cheaper for f in _flips(ranked[(ranked["variant"] == v) & ranked["indicator"].isin(keys)],
+                                                 errors, m1)]
+    resolved = not flips
     t_sel = float(ok.loc[ok["variant"] == selected, "time_s"].iloc[0])
     ratio = t_sel / ref_time if ref_time > 0 else math.nan
     if selected == reference:
@@ -187,7 +190,7 @@ def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.
                + ".")
     if not resolved:
         why = ("NOT RESOLVED: an acceptability that decides this verdict changes within the reference's numerical "
-               "error. " + why)
+               "error (h against h/2): " + "; ".join(flips) + ". " + why)
     return PurposeVerdict(purpose, keys, selected, str(deciding["indicator"]), float(deciding["bias"]),
                           float(deciding["cv"]), float(deciding["tea"]), str(deciding["unit"]),
                           float(deciding["margin"]), lines.zone_names[rank],

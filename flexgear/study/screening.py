@@ -281,10 +281,14 @@ class Screening:
     purpose_zones: pd.DataFrame | None = None    # reference mode: flexgear.study.purposes.purpose_zones
 
     def plot(self, ax, xlim: float | None = None, ylim: float | None = None, title: str = "") -> list[str]:
-        """Westgard decision diagram of the composite points (numbered markers); returns the legend
-        lines "n: variant ..." in marker order (flexgear.study.diagram.decision_diagram)."""
-        from flexgear.study.diagram import decision_diagram
+        """Westgard decision diagram: in the study's mode the composite points (numbered markers,
+        flexgear.study.diagram.decision_diagram; legend lines "n: variant ..."), against a reference every
+        indicator's own normalised point (flexgear.study.diagram.indicator_diagram; legend lines per variant)."""
+        from flexgear.study.diagram import decision_diagram, indicator_diagram
 
+        if self.reference and len(self.indicators):
+            purposes = [v.purpose for v in self.verdicts if v.purpose != ALL_PURPOSES]
+            return indicator_diagram(ax, self.indicators, self.lines, purposes, xlim or 200.0, ylim or 60.0, title)
         return decision_diagram(ax, self.table, self.lines, xlim, ylim, title)
 
 
