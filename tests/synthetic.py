@@ -94,8 +94,10 @@ def failed_result(name: str, reason: str = "diverged") -> RunResult:
                       "theory": theory_meta(), "wall_time_s": 0.5})
 
 
-def fake_runner(variant, t_end_s: float | None = None, progress: bool = False) -> RunResult:
-    """Stand-in for flexgear.mbs.run.run_variant (picklable, importable by worker processes).
+def fake_runner(variant, t_end_s: float | None = None, progress: bool = False, error_window_s: float = 0.0
+                ) -> RunResult:
+    """Stand-in for flexgear.mbs.run.run_variant (picklable, importable by worker processes); a screening
+    reference's ``error_window_s`` is accepted and ignored (no numerical error windows: the errors are nan).
 
     More flexible components give a smaller bias and a longer time, as in the study. A variant
     named "boom" raises like a failing solver, "crash" kills its worker process, and "diverge"

@@ -135,7 +135,8 @@ def why_lines(d: ReportData) -> list[str]:
     for v in s.verdicts:
         if v.purpose == ALL_PURPOSES or not v.failing:
             continue
-        text = (f"{_SHORT.get(v.purpose, v.purpose)}: cheaper variants fail: "
+        head = "cheaper variants fail" if v.selected else "no variant is acceptable, the reference included"
+        text = (f"{_SHORT.get(v.purpose, v.purpose)}: {head}: "
                 + "; ".join(f"{variant} {reason}" for variant, reason in v.failing) + ".")
         rigid = list(dict.fromkeys(c for variant, _ in v.failing for c in _rigid(d, variant)))
         found = _component_modes(modes, rigid) if modes is not None else []
@@ -298,17 +299,19 @@ def verdict_lines(d: ReportData) -> list[str]:
         per = ", ".join(f"{_SHORT.get(p, p)} {v.selected or 'none'}" + ("" if v.resolved else " (NOT RESOLVED)")
                         for p, v in by.items() if p != ALL_PURPOSES)
         return [f"Verdict per purpose against {s.reference}, each indicator alone (|Bias| + 2 CV <= TEa): {per}.",
-                f"For all purposes: {overall.selected if overall else 'none'}"
+                f"For all purposes: {(overall.selected if overall else None) or 'none'}"
                 + ("" if overall is None or overall.resolved else " (NOT RESOLVED)") + "."]
     sel = s.selection
     return [f"Verdict: {sel.variant or 'none'}" + ("" if sel.resolved else " (NOT RESOLVED)")
             + ", screened against theory (the study's mode).", textwrap.shorten(sel.reasoning, 220)]
 
 
-def verdict_page(d: ReportData, others: list[ReportData], case_text: str) -> Callable[[Figure], None]:
-    """Page 1 (module docstring); ``case_text``: this folder's load case and law in words."""
+def verdict_page(d: ReportData, others: list[ReportData], case_text: str, other_lines: list[str] = ()
+                 ) -> Callable[[Figure], None]:
+    """Page 1 (module docstring); ``case_text``: this folder's load case and law in words; ``other_lines``: the
+    other folders' overall verdicts in words."""
     table = verdict_rows(d, others)
-    notes = [f"This case: {case_text}."]
+    notes = [f"This case: {case_text}.", *other_lines]
     if d.reference is not None and d.reference.verdicts:
         notes += case_difference_lines(d, others)
         notes += why_lines(d)
@@ -321,7 +324,7 @@ def verdict_page(d: ReportData, others: list[ReportData], case_text: str) -> Cal
         notes.append(f"Reference screening refused: {d.refused}")
     unscreened = d.primary.table[d.primary.table["status"] != "ok"] if len(d.primary.table) else d.primary.table
     if len(unscreened):
-        notes.append("Not screened: " + "; ".join(f"{r.variant} ({r.status}: {r.reason})"
+        notes.append("Not screened: " + "; ".join(f"{r.variant} ({r.status}): {r.reason}"
                                                   for r in unscreened.itertuples()) + ".")
 
     def draw(fig: Figure) -> None:
