@@ -9,7 +9,10 @@
   - lateral faces of each boundary loop of the stack: for a toothed outline the lateral faces of
     a helical sweep of the outline wire (``occ.Pipe(spine, wire, auxspine=helix)``, an auxiliary
     helical spine turns the section at the prism's twist rate; netgen.occ's ``twist`` argument is
-    not implemented); for a circle one cylinder face per run of prisms with the same radius;
+    not implemented), or of a straight extrusion of the section for spur teeth (twist 0: a sweep
+    without auxiliary spine is a different OCC algorithm that leaves the ends open); one lateral
+    face per outline curve (:func:`outline_edge_count`); for a circle one cylinder face per run of
+    prisms with the same radius;
   - planar faces at both ends and wherever the section changes: the annulus between the two
     boundary loops that differ (e.g. toothed outline and relief-groove circle);
   - the lower half of a double helix is the mirror image (z -> -z) of the upper half (same lead,
@@ -35,7 +38,7 @@ import numpy as np
 from flexgear.geometry.layout import ComponentLayout, Prism
 from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
 
-__all__ = ["FLANK_POINTS", "section_face", "component_solid", "occ_mass_properties"]
+__all__ = ["FLANK_POINTS", "outline_edge_count", "section_face", "component_solid", "occ_mass_properties"]
 
 FLANK_POINTS = 25
 """Roll-angle points of the spline through each involute flank. Measured deviation of the OCC
@@ -65,17 +68,33 @@ def _edge(seg, angle: float, z: float, flank_points: int):
     return occ.Segment(p[0], p[2])
 
 
-def section_face(profile: ToothProfile, z: float = 0.0, flank_points: int = FLANK_POINTS):
-    """Planar face bounded by the whole toothed outline of ``profile`` in the plane ``z``.
+def _outline_pitch(profile: ToothProfile) -> list:
+    """The curves of one pitch of the outline, centred on a tooth, one OCC edge each.
 
-    One pitch, centred on a tooth: fillet, flank, full tip arc, flank, fillet, full root arc.
+    Fillet, [radial line,] flank, full tip arc, flank, [radial line,] fillet, full root arc: the
+    radial line below the base circle exists only where the fillet reaches below it (few teeth,
+    negative shift) and the fillet only for a fillet radius > 0, so a pitch has 4 to 8 curves.
     """
     half = list(profile.half_pitch)
     tip, root = half[0], half[-1]
     full_tip = ArcSegment(0.0, 0.0, tip.radius, -tip.phi1, tip.phi1)
     full_root = ArcSegment(0.0, 0.0, root.radius, root.phi0, 2 * math.pi / profile.teeth - root.phi0)
     sides = half[1:-1]
-    pitch = [_mirror(seg) for seg in reversed(sides)] + [full_tip] + sides + [full_root]
+    return [_mirror(seg) for seg in reversed(sides)] + [full_tip] + sides + [full_root]
+
+
+def outline_edge_count(profile: ToothProfile) -> int:
+    """Edges of the whole toothed outline wire: teeth x curves per pitch (the lateral faces of its prism)."""
+    return profile.teeth * len(_outline_pitch(profile))
+
+
+def section_face(profile: ToothProfile, z: float = 0.0, flank_points: int = FLANK_POINTS):
+    """Planar face bounded by the whole toothed outline of ``profile`` in the plane ``z``.
+
+    One pitch, centred on a tooth: fillet, flank, full tip arc, flank, fillet, full root arc
+    (see :func:`_outline_pitch`), repeated ``teeth`` times.
+    """
+    pitch = _outline_pitch(profile)
     edges = [_edge(seg, 2 * math.pi * k / profile.teeth, z, flank_points)
              for k in range(profile.teeth) for seg in pitch]
     return occ.Face(occ.Wire(edges))
@@ -152,23 +171,32 @@ class _Boundary:
         return out
 
     def _sweep(self, z0: float, z1: float, twist: float) -> tuple[list, object, object]:
+        """Lateral faces and end wires of the toothed outline from z0 to z1 at ``twist`` [rad/m].
+
+        Spur teeth (twist 0) are a straight extrusion of the section face. Helical teeth are a sweep
+        along the axis whose auxiliary helical spine, at radius r_b / 2, turns the section by
+        ``twist * z``; the section at z0 is the outline rotated by ``twist * z0``.
+        """
         profile = self.layout.profile
         face = section_face(profile, z0, self.flank_points)
-        face = face.Rotate(occ.Axis(occ.Pnt(0, 0, 0), occ.Z), math.degrees(twist * z0))
-        spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, z0), occ.Pnt(0, 0, z1))])
         if twist == 0.0:
-            plug = occ.Pipe(spine, face.wires[0])
+            plug = face.Extrude(occ.Vec(0, 0, z1 - z0))
         else:
+            face = face.Rotate(occ.Axis(occ.Pnt(0, 0, 0), occ.Z), math.degrees(twist * z0))
+            spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, z0), occ.Pnt(0, 0, z1))])
             r_aux = 0.5 * profile.gear.base_radius
             helix = [occ.Pnt(r_aux * math.cos(twist * z), r_aux * math.sin(twist * z), float(z))
                      for z in np.linspace(z0, z1, _HELIX_POINTS)]
+            # netgen's Pipe with an auxiliary spine closes the ends (MakeSolid): the caps' wires are the
+            # sweep's own edges
             plug = occ.Pipe(spine, face.wires[0], auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
-        # netgen's Pipe of a closed wire closes the ends: keep the caps' wires (the sweep's own edges)
         caps = sorted((f for f in plug.faces if _flat(f)), key=lambda f: f.center.z)
         lateral = [f for f in plug.faces if not _flat(f)]
-        if len(caps) != 2 or len(lateral) != 6 * profile.teeth:
-            raise RuntimeError(f"helical sweep of the {profile.gear.teeth}-tooth outline gave {len(caps)} caps "
-                               f"and {len(lateral)} lateral faces")
+        expected = outline_edge_count(profile)
+        if len(caps) != 2 or len(lateral) != expected:
+            kind = "extrusion" if twist == 0.0 else "helical sweep"
+            raise RuntimeError(f"{kind} of the {profile.gear.teeth}-tooth outline gave {len(caps)} caps and "
+                               f"{len(lateral)} lateral faces (expected 2 and {expected})")
         return lateral, caps[0].wires[0], caps[1].wires[0]
 
 
