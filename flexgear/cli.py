@@ -13,11 +13,15 @@ import argparse
 import sys
 from collections.abc import Callable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from flexgear.harmonic.cli import SWEEP_SPEED
 from flexgear.modal.cli import CAMPBELL, SCREENING, speeds_rpm
 from flexgear.modal.cli import SUBCOMMAND as MODES
 from flexgear.progress import Progress, say
+
+if TYPE_CHECKING:
+    import pandas as pd
 
 __all__ = ["main", "SUBCOMMANDS"]
 
@@ -96,6 +100,7 @@ def cmd_matrix(a: argparse.Namespace) -> int:
 
     table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end, workers=a.workers,
                        scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget, reference=a.reference)
+    table = _with_screening_reason(table, Path(a.out))
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
     if a.speeds_rpm:
@@ -107,6 +112,23 @@ def cmd_matrix(a: argparse.Namespace) -> int:
             print(f"Westgard: {selection.read_text().splitlines()[0]}")
         print(f"Over the speed range (-> {Path(a.out) / 'speed_screening.txt'}):\n{text}", end="")
     return 0
+
+
+def _with_screening_reason(table: pd.DataFrame, out: Path) -> pd.DataFrame:
+    """The matrix table whose rows without a Westgard point say why: a finished run that was not screened gets
+    the screening's status (unsettled, failed, not screened) and reason from ``out/screening.parquet``."""
+    import pandas as pd
+
+    saved = out / "screening.parquet"
+    if not saved.is_file() or not {"variant", "status", "reason"} <= set(table.columns):
+        return table
+    screened = pd.read_parquet(saved).reindex(columns=["variant", "status", "reason"]).set_index("variant")
+    table = table.astype({"status": object, "reason": object})
+    status = table["variant"].map(screened["status"])
+    unscreened = (table["status"] == "ok") & status.notna() & (status != "ok")
+    table.loc[unscreened, "status"] = status[unscreened]
+    table.loc[unscreened, "reason"] = table.loc[unscreened, "variant"].map(screened["reason"]).fillna("")
+    return table
 
 
 # --------------------------------------------------------------------------- sweep
@@ -226,22 +248,26 @@ def _run_pairs(a: Path, b: Path) -> list[tuple[str, Path, Path]]:
 
 # --------------------------------------------------------------------------- report
 def _args_report(p: argparse.ArgumentParser) -> None:
-    p.add_argument("results", help="results folder of a matrix (matrix_results.csv, screening.csv, runs)")
+    p.add_argument("results", help="results folder of a matrix or sweep: a directory holding <run>/run.json, "
+                   "screening.json or matrix_results.csv. Every such folder gives a PDF, whatever its runs (failed, "
+                   "unsettled, too short, none screened: each said with its reason); an empty directory gives a PDF "
+                   "that says 'no runs in DIR'. Any other path (missing, a file, a directory without runs) prints one "
+                   "line naming it and exits with code 2")
     p.add_argument("--output", default="reports/screening_report.pdf", metavar="FILE",
                    help="PDF to write (default: %(default)s)")
     p.add_argument("--westgard-png", default=None, metavar="FILE",
                    help="also write the verdict's Westgard diagram as a PNG (default: none)")
     p.add_argument("--also", nargs="*", default=[], metavar="DIR",
                    help="results folders of other load cases or contact laws: their verdicts beside this one on "
-                        "page 1 (a missing folder is skipped)")
+                        "page 1 (a path that is not a results folder, or holds no run, is skipped)")
 
 
 def cmd_report(a: argparse.Namespace) -> int:
+    from flexgear.report.data import check_results_folder
     from flexgear.report.pages import build_report
 
-    if not Path(a.results).is_dir():
-        raise FileNotFoundError(f"{a.results}: expected the results folder of a matrix")
-    path = build_report(Path(a.results), Path(a.output), a.westgard_png, tuple(a.also))
+    results = check_results_folder(a.results)   # one line and exit code 2 (main) for any other path
+    path = build_report(results, Path(a.output), a.westgard_png, tuple(a.also))
     print(f"report -> {path}")
     return 0
 

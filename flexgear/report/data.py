@@ -1,7 +1,15 @@
-"""What the report reads: the saved runs of a results folder, the gearbox file and its documented assumptions."""
+"""What the report reads: the saved runs of a results folder, the gearbox file and its documented assumptions.
+
+A results folder is an existing directory that holds saved runs (``<run>/run.json``) or what a matrix or sweep
+writes beside them (:data:`RESULTS_MARKERS`), or that is empty (a matrix that has not saved a run yet). Any other
+path raises :class:`NotResultsFolder` with one line naming the path and what was expected. Every results folder
+gives a :class:`ReportData`, whatever its runs: none, all failed, none settled, a reference that is missing or not
+usable; :attr:`ReportData.nothing_screened` then says in one sentence why no variant has a Westgard point.
+"""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import tomllib
 from dataclasses import dataclass
@@ -25,6 +33,20 @@ from flexgear.study.sweep import SweepResult
 
 DEFAULT_GEARBOX = Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml"
 
+RESULTS_MARKERS = ("screening.json", "matrix_results.csv", "matrix_results.parquet", "sweep.json")
+"""Files a matrix or sweep writes into its results folder (besides the runs' ``<run>/run.json``)."""
+
+REASON_CHARS = 160
+"""Longest run reason quoted in :attr:`ReportData.nothing_screened` (a failed run's reason can be a traceback)."""
+
+_FILES = ("<run>/run.json", *RESULTS_MARKERS)
+EXPECTED = (f"expected a results folder: a directory holding {', '.join(_FILES[:-1])} or {_FILES[-1]} (as `flexgear "
+            "matrix --out DIR` writes), or an empty directory")
+
+
+class NotResultsFolder(ValueError):
+    """A path that is not a results folder (module docstring); the message is one line naming it."""
+
 
 @dataclass
 class ReportData:
@@ -40,8 +62,9 @@ class ReportData:
     study: Screening                    # the study's mode: Bias against theory
     reference: Screening | None         # against a reference variant, if one was used or configured
     sweep: SweepResult | None = None
-    refused: str = ""                   # why the reference screening was refused (its reference has not settled)
+    refused: str = ""                   # why the reference screening was refused (reference missing, failed, unsettled)
     modal_note: str = ""                # the modal screening beside the Westgard verdict (modal_screening.txt)
+    nothing_screened: str = ""          # why no variant has a Westgard point in the verdict's screening ("" if one has)
 
     @property
     def primary(self) -> Screening:
@@ -65,7 +88,15 @@ class ReportData:
         return self.primary.lines
 
     def window(self, result: RunResult) -> Window:
-        return run_window(result, self.settings)
+        """The run's analysis window [s]; a finished run whose window cannot be taken (e.g. a fixed window outside
+        the run) gets its whole span, marked not steady, with the reason as its rule."""
+        try:
+            return run_window(result, self.settings)
+        except (ValueError, KeyError) as exc:
+            if result.signals is None or result.signals.empty:
+                raise
+            t = result.signals["time_s"]
+            return Window(float(t.iloc[0]), float(t.iloc[-1]), False, f"whole run, NOT steady: {exc}")
 
 
 def _natural(name: str) -> tuple:
@@ -81,12 +112,79 @@ def _find_gearbox(results_dir: Path, runs: list[RunResult]) -> tuple[Path, str]:
     return DEFAULT_GEARBOX, "no gearbox file saved with the runs: the package's model_variants/gearbox.toml"
 
 
+def results_folder_problem(path: str | Path) -> str:
+    """Why ``path`` is not a results folder (module docstring), in one line; "" when it is one."""
+    path = Path(path)
+    if not path.exists():
+        return f"{path}: does not exist; {EXPECTED}"
+    if not path.is_dir():
+        return f"{path}: is a file, not a directory; {EXPECTED}"
+    if any(path.glob("*/run.json")) or any((path / m).is_file() for m in RESULTS_MARKERS):
+        return ""
+    if not any(not p.name.startswith(".") for p in path.iterdir()):
+        return ""
+    return f"{path}: holds no saved run and no matrix file; {EXPECTED}"
+
+
+def check_results_folder(path: str | Path) -> Path:
+    """``path`` as a Path if it is a results folder, else :class:`NotResultsFolder` (one line)."""
+    problem = results_folder_problem(path)
+    if problem:
+        raise NotResultsFolder(problem)
+    return Path(path)
+
+
+def short_reason(text: object, empty: str = "no reason recorded", chars: int = REASON_CHARS) -> str:
+    """A reason on one line, at most ``chars`` characters (``empty`` when there is none)."""
+    line = " ".join(str(text or "").split())
+    if not line:
+        return empty
+    return line if len(line) <= chars else line[:chars - 1] + "…"
+
+
+def nothing_screened_reason(results_dir: Path, runs: dict[str, RunResult], screening: Screening,
+                            refused: str = "") -> str:
+    """Why no variant has a Westgard point in ``screening`` (one sentence), "" when one has: no runs, the
+    reference refused, or each run's status and reason (failed, unsettled, too short)."""
+    if not runs:
+        return f"no runs in {results_dir} (expected <run>/run.json, written by `flexgear matrix`)"
+    if refused:
+        return refused
+    tab = screening.table
+    if (tab["status"] == "ok").any():
+        return ""
+    groups: dict[tuple[str, str], list[str]] = {}   # runs of the same status and reason named together
+    for r in tab.itertuples():
+        groups.setdefault((str(r.status), short_reason(r.reason)), []).append(str(r.variant))
+    return "no screened variant: " + "; ".join(f"{', '.join(names)} {status} ({reason})"
+                                               for (status, reason), names in groups.items())
+
+
+def _lead_with(s: Screening, why: str) -> Screening:
+    """``s`` whose selection reasoning starts with ``why`` (a first sentence the verdict quotes)."""
+    sel = s.selection
+    first = why[:1].upper() + why[1:]
+    reasoning = first + ("" if first.endswith(".") else ".") + " " + sel.reasoning
+    return dataclasses.replace(s, selection=Selection(sel.variant, sel.rule, reasoning, sel.resolved))
+
+
+def _recorded_reference(results_dir: Path, settings: ScreeningSettings) -> str:
+    """The reference the matrix screened against (``screening.json``), else the gearbox's ``[screening]``."""
+    recorded = results_dir / "screening.json"
+    try:
+        return str(json.loads(recorded.read_text()).get("reference", "") or "")
+    except (OSError, ValueError, AttributeError):
+        return settings.reference
+
+
 def gather(results_dir: str | Path) -> ReportData:
-    """Load every saved run under ``results_dir`` and screen the Exudyn variants."""
-    results_dir = Path(results_dir)
+    """Load every saved run under ``results_dir`` and screen the Exudyn variants.
+
+    Raises :class:`NotResultsFolder` for a path that is not a results folder (module docstring); otherwise
+    returns the data of every case, with :attr:`ReportData.nothing_screened` and :attr:`ReportData.refused` saying
+    what could not be screened and why."""
+    results_dir = check_results_folder(results_dir)
     loaded = [load_result(p.parent) for p in sorted(results_dir.glob("*/run.json"))]
-    if not loaded:
-        raise FileNotFoundError(f"{results_dir}: no saved runs (expected <run>/run.json); run `flexgear matrix` first")
     lumped = next((r for r in loaded if r.meta.get("backend") == "lumped"), None)
     runs = {r.name: r for r in sorted((r for r in loaded if r.meta.get("backend") != "lumped"),
                                       key=lambda r: _natural(r.name))}
@@ -97,20 +195,29 @@ def gather(results_dir: str | Path) -> ReportData:
         gearbox_file, note = DEFAULT_GEARBOX, f"saved gearbox file is not valid now ({exc}); package default used"
         gearbox = load_gearbox(gearbox_file)
     settings = gearbox.screening
-    recorded = results_dir / "screening.json"
-    ref_name = json.loads(recorded.read_text()).get("reference", "") if recorded.exists() else settings.reference
+    ref_name = _recorded_reference(results_dir, settings)
     study = screen(runs.values(), settings, reference="")
     reference, refused = None, ""
-    if ref_name and ref_name in runs:
+    if ref_name and runs and ref_name not in runs:
+        refused = f"not screened: reference {ref_name} is not among the runs ({', '.join(runs)})"
+    elif ref_name and ref_name in runs:
         try:
             reference = screen(runs.values(), settings, reference=ref_name)
         except ReferenceNotUsable as exc:
             refused = str(exc)
+        except (ValueError, KeyError) as exc:  # e.g. a fixed window outside the reference run
+            refused = f"not screened: reference {ref_name} cannot be screened ({short_reason(exc)})"
+    why = nothing_screened_reason(results_dir, runs, reference if reference is not None else study, refused)
+    if why and not refused:
+        if reference is not None:
+            reference = _lead_with(reference, why)
+        else:
+            study = _lead_with(study, why)
     sweeps = sorted([results_dir / "sweep.json", *results_dir.glob("*/sweep.json")])
     sweep = next((SweepResult.load(f.parent) for f in sweeps if f.exists()), None)
     modal = results_dir / "modal_screening.txt"
     return ReportData(results_dir, runs, lumped, gearbox, gearbox_file, note, settings, study, reference, sweep,
-                      refused, modal.read_text().strip() if modal.exists() else "")
+                      refused, modal.read_text().strip() if modal.exists() else "", why)
 
 
 def _split_comment(line: str) -> tuple[str, str]:

@@ -18,7 +18,7 @@ from matplotlib.axes import Axes
 
 from flexgear.study.reference import ADAMS_SIMULATED_S, ADAMS_TIME_S
 
-__all__ = ["fmt", "draw_table", "run_time_chart"]
+__all__ = ["fmt", "draw_table", "run_time_chart", "EMPTY_TABLE_TEXT"]
 
 
 def fmt(value: object, digits: int = 4) -> str:
@@ -42,16 +42,36 @@ def fmt(value: object, digits: int = 4) -> str:
 
 _CHAR_WIDTH_EM = 0.56   # mean character width of DejaVu Sans, in font sizes
 
+EMPTY_TABLE_TEXT = "no rows"
+"""What :func:`draw_table` writes in place of a table without rows, unless told why."""
+
+_LINE_HEIGHT_EM = 1.45  # height of one table text line, in font sizes
+_SENTENCE_WRAP = 160    # characters per line of the sentence that stands for an empty table
+_POINTS_PER_INCH = 72.0
+
+
+def _line_fraction(ax: Axes, fontsize: float) -> float:
+    """Height of one text line of ``fontsize`` points, as a fraction of the height of ``ax``."""
+    height_in = ax.get_position().height * ax.figure.get_figheight()
+    return fontsize * _LINE_HEIGHT_EM / _POINTS_PER_INCH / height_in
+
 
 def draw_table(ax: Axes, table: pd.DataFrame, col_widths: Sequence[float] | None = None, fontsize: float = 8.0,
-               wrap: int | dict[str, int] = 30, top: float = 1.0, max_height: float | None = None) -> float:
+               wrap: int | dict[str, int] = 30, top: float = 1.0, max_height: float | None = None,
+               empty: str = EMPTY_TABLE_TEXT) -> float:
     """Draw ``table`` at the top of ``ax``; return its bottom (axes fraction).
 
     Long cells are wrapped (``wrap`` characters, per column if a dict), each row is as high as its
     longest cell, columns are as wide as their text (unless ``col_widths`` is given) and the font
     shrinks if the text would not fit the width. Height: as the text needs, at most ``max_height``.
+    A table without rows or columns is one italic sentence instead, ``empty`` (why it is empty; ``fontsize`` in
+    points as for the table).
     """
     ax.axis("off")
+    if table.empty:
+        text = textwrap.fill(empty, _SENTENCE_WRAP) or EMPTY_TABLE_TEXT
+        ax.text(0.0, top, text, va="top", ha="left", fontsize=fontsize, style="italic", transform=ax.transAxes)
+        return top - (text.count("\n") + 1.5) * _line_fraction(ax, fontsize)
     cols = [str(c) for c in table.columns]
     widths = {c: (wrap.get(c, 30) if isinstance(wrap, dict) else wrap) for c in cols}
     body = [[textwrap.fill(fmt(v), widths[c]) or " " for c, v in zip(cols, row, strict=True)]
@@ -71,7 +91,7 @@ def draw_table(ax: Axes, table: pd.DataFrame, col_widths: Sequence[float] | None
     if col_widths is None:
         col_widths = [c / sum(chars) for c in chars]
     lines = [max(h.count("\n") + 1 for h in header)] + [max(c.count("\n") + 1 for c in r) for r in body]
-    line = fontsize * 1.45 / 72.0 / (box.height * ax.figure.get_figheight())   # one text line, axes fraction
+    line = _line_fraction(ax, fontsize)   # one text line, axes fraction
     total = min(sum(n + 0.5 for n in lines) * line, max_height if max_height is not None else top)
     tab = ax.table(cellText=body, colLabels=header, colWidths=col_widths, cellLoc="left", loc="upper center",
                    bbox=[0.0, top - total, 1.0, total])
@@ -91,13 +111,20 @@ def _model_number(name: str) -> int | None:
     return int(m.group(1)) if m else None
 
 
-def run_time_chart(ax: Axes, runs: pd.DataFrame) -> None:
+def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run time to chart") -> None:
     """Log-scale bars: our wall time per simulated second beside the study's ADAMS time per simulated
-    second (Table 4, 0.6 s simulated); columns variant, wall_time_s, t_end_s."""
+    second (Table 4, 0.6 s simulated); columns variant, wall_time_s [s], t_end_s [s]. Without runs, a sentence
+    ``empty`` says why instead; a run without a positive simulated time has no bar."""
+    if runs.empty or "variant" not in runs.columns:
+        ax.axis("off")
+        ax.text(0.5, 0.5, empty, ha="center", va="center", fontsize=10, style="italic", transform=ax.transAxes)
+        return
     names = list(runs["variant"])
     x = np.arange(len(names))
-    t_end = runs["t_end_s"].to_numpy(dtype=float)
-    ours = runs["wall_time_s"].to_numpy(dtype=float) / t_end
+    t_end = pd.to_numeric(runs["t_end_s"], errors="coerce").to_numpy(dtype=float)
+    wall = pd.to_numeric(runs["wall_time_s"], errors="coerce").to_numpy(dtype=float)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ours = np.where(t_end > 0, wall / t_end, np.nan)
     adams = np.array([ADAMS_TIME_S.get(_model_number(n) or 0, np.nan) for n in names]) / ADAMS_SIMULATED_S
     w = 0.38
     ax.bar(x - w / 2, np.where(np.isfinite(ours), ours, 0), w, color="#1f4e99",

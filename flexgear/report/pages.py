@@ -29,7 +29,7 @@ from matplotlib.backends.backend_pdf import PdfPages  # noqa: E402
 from matplotlib.figure import Figure  # noqa: E402
 
 from flexgear.report import result_pages as rp  # noqa: E402
-from flexgear.report.data import ReportData, documented_assumptions, gather  # noqa: E402
+from flexgear.report.data import ReportData, documented_assumptions, gather, results_folder_problem  # noqa: E402
 from flexgear.report.figures import draw_table, fmt  # noqa: E402
 from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
 from flexgear.spec import COMPONENTS  # noqa: E402
@@ -75,6 +75,8 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
                       f"{d.study.selection.variant or 'none'}. {d.study.selection.reasoning}"]
         lines += [f"Screening: lines m = {', '.join(map(str, d.lines.multipliers))}, {d.settings.sample_count} "
                   f"samples per window, window '{d.settings.window}', rule '{d.settings.selection}'."]
+        if d.refused:
+            lines += ["", f"Reference screening refused, nothing selected: {d.refused}."]
         if unsteady:
             lines += ["", "CAUTION: these runs have no settled window (they end before their transients decay): "
                       + ", ".join(unsteady) + ". Their Bias and CV measure the start-up, not the model's accuracy."]
@@ -109,6 +111,8 @@ def verdict_lines(d: ReportData) -> list[str]:
 
 def case_summary(d: ReportData) -> str:
     """The load case and law of a results folder's runs, in words (to tell two verdicts' cases apart)."""
+    if not d.runs:
+        return f"no runs in {d.results_dir}"
     laws = {((r.meta.get("spec") or {}).get("contact") or {}).get("law", "?") for r in d.runs.values()}
     ramps = {r.meta.get("ramp_time_s") for r in d.runs.values()}
     ends = [float(r.meta["t_end_s"]) for r in d.runs.values() if r.meta.get("t_end_s") is not None]
@@ -222,6 +226,10 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
     return draw
 
 
+_VARIANT_COLUMNS = ["variant", *(c.replace("_", " ") for c in COMPONENTS), "status", "simulated time [s]", "reason"]
+_PROVENANCE_COLUMNS = ["run", "backend", "status", "created", "t_end [s]", "step [s]", "config hash", "input hash"]
+
+
 def _variant_table(d: ReportData) -> pd.DataFrame:
     rows = []
     for name, r in d.runs.items():
@@ -229,7 +237,7 @@ def _variant_table(d: ReportData) -> pd.DataFrame:
         rows.append({"variant": name, **{c.replace("_", " "): comps.get(c, "–") for c in COMPONENTS},
                      "status": r.meta.get("status"), "simulated time [s]": r.meta.get("t_end_s"),
                      "reason": r.meta.get("reason") or ""})
-    return pd.DataFrame(rows)
+    return pd.DataFrame(rows, columns=_VARIANT_COLUMNS)
 
 
 def _provenance_pages(d: ReportData) -> list[Page]:
@@ -237,7 +245,7 @@ def _provenance_pages(d: ReportData) -> list[Page]:
     prov = pd.DataFrame([{"run": r.name, "backend": r.meta.get("backend"), "status": r.meta.get("status"),
                           "created": r.meta.get("created", ""), "t_end [s]": r.meta.get("t_end_s"),
                           "step [s]": r.meta.get("step_size_s"), "config hash": r.meta.get("config_hash", ""),
-                          "input hash": r.meta.get("input_hash", "")} for r in runs])
+                          "input hash": r.meta.get("input_hash", "")} for r in runs], columns=_PROVENANCE_COLUMNS)
     versions: dict[str, set[str]] = {}
     for r in runs:
         for k, v in (r.meta.get("versions") or {}).items():
@@ -250,10 +258,10 @@ def _provenance_pages(d: ReportData) -> list[Page]:
         ax = fig.add_axes([0.04, 0.07, 0.92, 0.83])
         text_block(ax, intro, width=170, fontsize=8.5)
         ax.text(0, 0.93, "Runs", fontsize=9, weight="bold", transform=ax.transAxes)
-        y = draw_table(ax, prov, top=0.9, fontsize=7.5, max_height=0.5)
+        y = draw_table(ax, prov, top=0.9, fontsize=7.5, max_height=0.5, empty=f"no runs in {d.results_dir}")
         ax.text(0, y - 0.05, "Software versions recorded by the runs", fontsize=9, weight="bold",
                 transform=ax.transAxes)
-        draw_table(ax, ver, top=y - 0.08, fontsize=7.5, wrap=60, max_height=y - 0.1)
+        draw_table(ax, ver, top=y - 0.08, fontsize=7.5, wrap=60, max_height=y - 0.1, empty="no run recorded any")
     return [("Provenance: runs, configuration hashes, software versions", draw)]
 
 
@@ -264,17 +272,20 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
                  westgard_png: str | Path | None = None, also: tuple[str | Path, ...] = (), modal: bool = True) -> Path:
     """Write the screening report of the saved results in ``results_dir`` to ``output`` (PDF): page 1 the verdict,
     then the details, the assumptions in an appendix. ``westgard_png``: also the verdict's diagram as a PNG.
-    ``also``: results folders of other load cases or laws whose verdicts page 1 sets beside this one. ``modal``: add
-    the modal pages (flexgear.report.modal_pages: modal tables, Campbell diagram, run-up maps, speed response)."""
+    ``also``: results folders of other load cases or laws whose verdicts page 1 sets beside this one (a path that is
+    not a results folder, or holds no run, is skipped). ``modal``: add the modal pages (flexgear.report.modal_pages:
+    modal tables, Campbell diagram, run-up maps, speed response) when a run finished. Any results folder gives a
+    report (flexgear.report.data: none, failed or unsettled runs, a refused reference say so); a path that is not
+    one raises flexgear.report.data.NotResultsFolder."""
     d = gather(results_dir)
-    others = [gather(o) for o in also if Path(o).is_dir()]
+    others = [o for o in (gather(x) for x in also if not results_folder_problem(x)) if o.runs]
     output = Path(output)
     created = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
     assumptions = documented_assumptions(d.gearbox_file)
     body: list[Page] = [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
     if rp.shown_runs(d):
         body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d)]
-    if modal:
+    if modal and rp.shown_runs(d):   # no finished run: no model to analyse
         from flexgear.report.modal_pages import modal_pages
 
         body += modal_pages(d, others=others)

@@ -1,13 +1,19 @@
 """Report pages of the results: run times, Westgard diagrams, screening tables, overlaid signals,
-spectra, Tables 6-7, sweeps. Each page lays out objects that draw themselves (``plot(ax)``)."""
+spectra, Tables 6-7, sweeps. Each page lays out objects that draw themselves (``plot(ax)``).
+
+Every page builder takes any :class:`flexgear.report.data.ReportData`: no runs, no finished run, no screened
+variant, a reference refused. What cannot be drawn is one sentence saying why, and every table row that has
+no values gives its status and reason."""
 
 from __future__ import annotations
+
+import textwrap
 
 import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from flexgear.report.data import ReportData
+from flexgear.report.data import ReportData, nothing_screened_reason, short_reason
 from flexgear.report.figures import draw_table, fmt, run_time_chart
 from flexgear.report.layout import Page, colours, components_text, text_block
 from flexgear.results import SIGNAL_TYPES, RunResult
@@ -20,6 +26,11 @@ __all__ = ["run_time_page", "diagram_pages", "screening_pages", "overlay_pages",
            "tables_6_7_pages", "sweep_pages", "shown_runs"]
 
 STUDY_RAMP_S, STUDY_END_S = 0.5, 0.6    # Table 5 and section 3.1: the study's load case
+_NOTE_WRAP = 110                        # characters per line of a note inside a figure
+NOT_RECORDED = "not recorded"           # an indicator a screened run has no signal for
+_RUN_TIME_REASON_CHARS = 100           # a failed run's reason in the run-time table (the variant matrix has it all)
+_RUN_TIME_COLUMNS = ["variant", "components", "status", "reason", "t_end_s", "wall_time_s", "cpu_time_s", "per_s",
+                     "cpu_per_s", "adams_per_s"]
 
 
 def shown_runs(d: ReportData) -> dict[str, RunResult]:
@@ -30,36 +41,49 @@ def shown_runs(d: ReportData) -> dict[str, RunResult]:
     return out
 
 
+def _number(meta: dict, key: str) -> float:
+    """A number of a run's metadata (NaN when it is missing or not a number)."""
+    try:
+        return float(meta.get(key))
+    except (TypeError, ValueError):
+        return np.nan
+
+
 def run_time_page(d: ReportData) -> Page:
+    """Run time per simulated second [s/s] of every run beside the study's ADAMS times; a run without a time says
+    its status and reason."""
     rows = []
     for name, r in d.runs.items():
         num = name[5:] if name.startswith("model") and name[5:].isdigit() else None
         adams = ADAMS_TIME_S.get(int(num), np.nan) if num else np.nan
-        t_end = r.meta.get("t_end_s", np.nan)
-        wall = r.meta.get("wall_time_s", np.nan) if r.ok else np.nan
+        t_end = _number(r.meta, "t_end_s")
+        wall = _number(r.meta, "wall_time_s") if r.ok else np.nan
+        cpu = _number(r.meta, "cpu_time_s") if r.ok else np.nan
+        per = t_end if t_end > 0 else np.nan
         rows.append({"variant": name, "components": components_text(r.meta), "status": r.meta.get("status"),
-                     "t_end_s": t_end, "wall_time_s": wall,
-                     "cpu_time_s": r.meta.get("cpu_time_s", np.nan) if r.ok else np.nan,
-                     "per_s": wall / t_end if t_end else np.nan,
-                     "cpu_per_s": r.meta.get("cpu_time_s", np.nan) / t_end if r.ok and t_end else np.nan,
-                     "adams_per_s": adams / ADAMS_SIMULATED_S})
-    runs = pd.DataFrame(rows)
+                     "reason": "" if r.ok else short_reason(r.meta.get("reason"), chars=_RUN_TIME_REASON_CHARS),
+                     "t_end_s": t_end, "wall_time_s": wall, "cpu_time_s": cpu, "per_s": wall / per,
+                     "cpu_per_s": cpu / per, "adams_per_s": adams / ADAMS_SIMULATED_S})
+    runs = pd.DataFrame(rows, columns=_RUN_TIME_COLUMNS)
+    empty = f"no runs in {d.results_dir}: no run time to show"
 
     def draw(fig: Figure) -> None:
-        run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs)
+        run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs, empty)
         shown = runs.assign(speedup=runs["adams_per_s"] / runs["per_s"]).rename(columns={
             "t_end_s": "simulated [s]", "wall_time_s": "wall [s]", "cpu_time_s": "CPU [s]",
             "per_s": "wall per simulated s", "cpu_per_s": "CPU per simulated s",
             "adams_per_s": "study ADAMS per simulated s",
             "speedup": "ADAMS / flexgear"})
-        draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34}, fontsize=7.5)
+        draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34, "reason": 34},
+                   fontsize=7.5, empty=empty)
         fig.text(0.04, 0.37, "Both per simulated second: the study's Table 4 times are for 0.6 s simulated (its own "
                  "computer); ours for the simulated time shown (model build + simulation). Wall time includes waiting "
                  "for a shared CPU; CPU time does not.", fontsize=7.5, wrap=True)
     return ("Run time per simulated second against the study's ADAMS times (Table 4)", draw)
 
 
-def _diagram_page(s: Screening, title: str, note: str) -> Page:
+def _diagram_page(s: Screening, title: str, note: str, why: str = "") -> Page:
+    """A Westgard diagram page; ``why``: the sentence shown when no variant has a point (the zones alone)."""
     ok = s.table[s.table["status"] == "ok"]
     tea = s.lines.tea_pct
     far = len(ok) and (float(ok["bias_pct"].max()) > 4 * tea or float(ok["cv_pct"].max()) > 2 * tea)
@@ -71,9 +95,20 @@ def _diagram_page(s: Screening, title: str, note: str) -> Page:
         else:
             xmax = max(1.3 * tea, 1.1 * float(ok["bias_pct"].max()) if len(ok) else 0.0)
             ymax = max(0.65 * tea, 1.15 * float(ok["cv_pct"].max()) if len(ok) else 0.0)
-            legend = s.plot(fig.add_axes([0.07, 0.2, 0.6, 0.68]), xmax, ymax)
+            ax = fig.add_axes([0.07, 0.2, 0.6, 0.68])
+            legend = s.plot(ax, xmax, ymax)
+            if not len(ok):
+                ax.text(0.5, 0.5, "no screened variant: no marker\n(the reasons beside)", ha="center",
+                        va="center", fontsize=11, style="italic", transform=ax.transAxes,
+                        bbox={"fc": "white", "ec": "#999999"})
+        if legend:
+            markers = "\n".join(legend)
+        elif why and why.lower() in s.selection.reasoning.lower():   # the selection's reasoning says why
+            markers = "No marker: no screened variant (why: below)."
+        else:
+            markers = "No marker: " + (why or "no screened variant") + "."
         text_block(fig.add_axes([0.72, 0.2, 0.27, 0.68]), f"Markers: variant: Bias, CV [{s.lines.unit}], zone\n"
-                   + "\n".join(legend) + f"\n\nSelected: {s.selection.variant or 'none'}. {s.selection.reasoning}",
+                   + markers + f"\n\nSelected: {s.selection.variant or 'none'}. {s.selection.reasoning}",
                    width=56, fontsize=7.2)
         text_block(fig.add_axes([0.07, 0.04, 0.9, 0.1]), note + " Axes as in the study (Bias on x, CV on y). "
                    "Lines Bias + m·CV = TEa; a point on a line belongs to the better zone. Markers closer than a "
@@ -81,16 +116,28 @@ def _diagram_page(s: Screening, title: str, note: str) -> Page:
     return (title, draw)
 
 
+def _refused_page(d: ReportData) -> Page:
+    """The page of a reference screening that was refused: its reason instead of the diagram."""
+    def draw(fig: Figure) -> None:
+        text_block(fig.add_axes([0.07, 0.2, 0.86, 0.68]), f"No diagram: {d.refused}.\n\nThe verdict is none; the "
+                   "study's mode (against theory) is on the page before.", width=150, fontsize=10)
+    return ("Westgard decision diagram against the reference: not drawn", draw)
+
+
 def diagram_pages(d: ReportData) -> list[Page]:
+    """The study mode's diagram, then the reference screening's (or why it was refused): the last is the verdict's."""
     pages = [_diagram_page(d.study, "Westgard decision diagram, the study's mode: Bias against theory (section "
                            "2.2, Fig. 2)", f"The study's five indicators, 20 % each, TEa = "
                            f"{d.study.lines.tea_pct:g} %. They are fixed by kinematics and torque balance and barely "
-                           "depend on flexibility.")]
+                           "depend on flexibility.", nothing_screened_reason(d.results_dir, d.runs, d.study))]
     if d.reference is not None:
         name = d.reference.reference
         pages.append(_diagram_page(d.reference, f"Westgard decision diagram against the reference {name}: "
                                    "dynamic indicators", "Each indicator's Bias and CV in % of its own TEa "
-                                   "([screening.reference_indicators]), weighted; the reference sits on the CV axis."))
+                                   "([screening.reference_indicators]), weighted; the reference sits on the CV axis.",
+                                   nothing_screened_reason(d.results_dir, d.runs, d.reference)))
+    elif d.refused:
+        pages.append(_refused_page(d))
     return pages
 
 
@@ -100,11 +147,13 @@ def screening_pages(d: ReportData) -> list[Page]:
         if s is None:
             continue
         t = s.table
-        comp = t[["variant", "status", "bias_pct", "cv_pct", "distance_pct", "zone", "time_s", "window_start_s",
-                  "window_end_s", "steady_window", "selected"]].rename(columns={
-                      "bias_pct": f"Bias [{s.lines.unit}]", "cv_pct": f"CV [{s.lines.unit}]",
-                      "distance_pct": f"distance [{s.lines.unit}]", "time_s": "wall [s]",
-                      "window_start_s": "window from [s]", "window_end_s": "to [s]", "steady_window": "settled"})
+        why = nothing_screened_reason(d.results_dir, d.runs, s) or "no indicator values"
+        names = {"bias_pct": f"Bias [{s.lines.unit}]", "cv_pct": f"CV [{s.lines.unit}]",
+                 "distance_pct": f"distance [{s.lines.unit}]", "time_s": "wall [s]",
+                 "window_start_s": "window from [s]", "window_end_s": "to [s]", "steady_window": "settled"}
+        comp = t.reindex(columns=["variant", "status", "reason", "bias_pct", "cv_pct", "distance_pct", "zone",
+                                  "time_s", "window_start_s", "window_end_s", "steady_window", "selected"]
+                         ).rename(columns=names)
         ind = s.indicators
         order = [k for k in ALL_INDICATORS if k in set(ind["indicator"])]
         means = ind.pivot(index="indicator", columns="variant", values="mean").reindex(order)
@@ -112,21 +161,42 @@ def screening_pages(d: ReportData) -> list[Page]:
         first = ind.drop_duplicates("indicator").set_index("indicator").reindex(order)
         head = pd.DataFrame({"indicator": order, "unit": first["unit"].to_numpy(), "TEa": first["tea"].to_numpy(),
                              "weight": first["weight"].to_numpy()})
-        mean_tab = pd.concat([head, means.reset_index(drop=True)], axis=1)
-        bias_tab = pd.concat([head, bias.reset_index(drop=True)], axis=1)
+        mean_tab = _explained(pd.concat([head, means.reset_index(drop=True)], axis=1), head.columns)
+        bias_tab = _explained(pd.concat([head, bias.reset_index(drop=True)], axis=1), head.columns)
 
-        def draw(fig: Figure, s: Screening = s, comp=comp, mean_tab=mean_tab, bias_tab=bias_tab) -> None:
+        def draw(fig: Figure, s: Screening = s, comp=comp, mean_tab=mean_tab, bias_tab=bias_tab, why=why) -> None:
             ax = fig.add_axes([0.04, 0.06, 0.92, 0.85])
-            ax.text(0, 1.0, "Composite point per variant", fontsize=9, weight="bold", transform=ax.transAxes)
-            y = draw_table(ax, comp, top=0.975, fontsize=6.5, max_height=0.22)
+            ax.text(0, 1.0, "Composite point per variant (no values: see status and reason)", fontsize=9,
+                    weight="bold", transform=ax.transAxes)
+            y = draw_table(ax, comp, top=0.975, fontsize=6.5, max_height=0.22, wrap={"reason": 40},
+                           empty=f"no runs in {d.results_dir}")
             ax.text(0, y - 0.02, "Indicator means over each run's window (definitions and units: "
                     "flexgear.study.indicators)", fontsize=8.5, weight="bold", transform=ax.transAxes)
-            y = draw_table(ax, mean_tab, top=y - 0.035, fontsize=6.5, wrap=30)
+            y = draw_table(ax, mean_tab, top=y - 0.035, fontsize=6.5, wrap=30, empty=why)
             ax.text(0, y - 0.02, f"Bias of each indicator against {'theory' if not s.reference else s.reference} "
                     "in its unit (not yet scaled by its TEa)", fontsize=8.5, weight="bold", transform=ax.transAxes)
-            draw_table(ax, bias_tab, top=y - 0.035, fontsize=6.5, wrap=30)
+            draw_table(ax, bias_tab, top=y - 0.035, fontsize=6.5, wrap=30, empty=why)
         pages.append((f"Screening {mode}: composite points, indicators and selection", draw))
     return pages
+
+
+def _explained(table: pd.DataFrame, head: pd.Index) -> pd.DataFrame:
+    """An indicator table whose empty cells in a screened variant's column say why (:data:`NOT_RECORDED`: the run
+    has no signal for that indicator) instead of a bare dash."""
+    out = table.astype(object)
+    variants = [c for c in out.columns if c not in set(head)]
+    out[variants] = out[variants].where(out[variants].notna(), NOT_RECORDED)
+    return out
+
+
+def _unsettled(d: ReportData, runs: dict[str, RunResult]) -> list[str]:
+    """The variants among ``runs`` whose analysis window is not settled (their values are of the start-up)."""
+    return [n for n, r in runs.items() if n != "lumped" and (r.meta.get("settled") is False or not d.window(r).steady)]
+
+
+def _settled_words(unsettled: list[str]) -> str:
+    """"settled window", or what it is when some runs have none."""
+    return "settled window" if not unsettled else f"window (NOT settled: {', '.join(unsettled)})"
 
 
 def _window_span(d: ReportData, runs: dict[str, RunResult]) -> tuple[float, float]:
@@ -154,6 +224,7 @@ def overlay_pages(d: ReportData) -> list[Page]:
     col = colours(list(runs))
     th = next((r.meta["theory"] for r in runs.values() if "theory" in r.meta), {})
     span = _window_span(d, runs)
+    window = _settled_words(_unsettled(d, runs))
     cycles = 5.0 / th.get("mesh_frequency_hz", 5000.0)
     pages = []
     targets = {"input_speed": th.get("input_speed_deg_per_s"), "output_speed": th.get("output_speed_deg_per_s"),
@@ -173,7 +244,7 @@ def overlay_pages(d: ReportData) -> list[Page]:
                 r.plot(zoom, kind, zoom=span, **style)
                 t_end = float(r.signals["time_s"].iloc[-1])
                 r.plot(last, kind, zoom=(t_end - cycles, t_end), **style)
-            for ax, name in ((top, "whole run"), (zoom, f"common settled window {span[0]:.3g}–{span[1]:.3g} s"),
+            for ax, name in ((top, "whole run"), (zoom, f"common {window} {span[0]:.3g}–{span[1]:.3g} s"),
                              (last, "last 5 mesh cycles of each run")):
                 if targets.get(kind) is not None:
                     ax.axhline(targets[kind], color="#d62728", lw=0.9, ls=":", label="theory")
@@ -186,7 +257,7 @@ def overlay_pages(d: ReportData) -> list[Page]:
                 else:
                     ax.ticklabel_format(axis="y", useOffset=False)
             if span[1] > span[0]:
-                top.axvspan(*span, color="#2ca02c", alpha=0.1, label="common settled window")
+                top.axvspan(*span, color="#2ca02c", alpha=0.1, label=f"common {window}")
             top.legend(fontsize=7, ncol=min(6, len(having) + 2), loc="best", framealpha=0.85)
         pages.append((f"All variants overlaid: {title}", draw))
     return pages
@@ -195,11 +266,24 @@ def overlay_pages(d: ReportData) -> list[Page]:
 def spectrum_pages(d: ReportData) -> list[Page]:
     runs = shown_runs(d)
     col = colours(list(runs))
+    window = _settled_words(_unsettled(d, runs))
 
     def draw(fig: Figure) -> None:
         for i, side in enumerate(("input", "output")):
             ax = fig.add_axes([0.07, 0.58 - 0.44 * i, 0.9, 0.31])
-            spectra = [BearingSpectrum.of(r, side, _run_window(d, n, r, runs), n) for n, r in runs.items()]
+            spectra, skipped = [], []
+            for n, r in runs.items():
+                try:
+                    spectra.append(BearingSpectrum.of(r, side, _run_window(d, n, r, runs), n))
+                except (ValueError, KeyError) as exc:   # e.g. a window too short for a spectrum
+                    skipped.append(f"{n} ({short_reason(exc)})")
+            if skipped:
+                ax.text(0.99, 0.96, textwrap.fill("no spectrum: " + "; ".join(skipped), _NOTE_WRAP),
+                        transform=ax.transAxes, fontsize=7, ha="right", va="top", style="italic", zorder=7,
+                        bbox={"fc": "white", "ec": "#999999", "alpha": 0.9})
+            if not spectra:
+                ax.axis("off")
+                continue
             present: set[int] = set()
             for sp in spectra:
                 sp.plot(ax, color="k" if sp.name == "lumped" else col[sp.name],
@@ -210,7 +294,7 @@ def spectrum_pages(d: ReportData) -> list[Page]:
             mark_harmonics(ax, f, sorted(present))
             ax.set_xlabel(f"frequency [kHz] (mesh frequency {f:g} Hz)")
             ax.set_ylabel("amplitude of a_x [m/s²]")
-            ax.set_title(f"{side}-shaft bearing, x acceleration, each run's settled window", fontsize=9, pad=14)
+            ax.set_title(f"{side}-shaft bearing, x acceleration, each run's {window}", fontsize=9, pad=14)
             ax.legend(fontsize=7, ncol=min(8, len(spectra)), loc="lower left", framealpha=0.85)
             ax.grid(alpha=0.3, which="major")
         text_block(fig.add_axes([0.07, 0.01, 0.9, 0.04]), "Hann-windowed amplitude spectrum "
@@ -236,8 +320,13 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
     runs = shown_runs(d)
     t6 = {}
     t7 = []
+    skipped = []
     for n, r in runs.items():
-        a, b = compare_results(r, r, window=_run_window(d, n, r, runs))
+        try:
+            a, b = compare_results(r, r, window=_run_window(d, n, r, runs))
+        except (ValueError, KeyError) as exc:   # e.g. a window too short: named below the tables
+            skipped.append(f"{n} ({short_reason(exc)})")
+            continue
         t6.setdefault("theory", a["theory"])
         t6[n] = a.iloc[:, 1]
         row = {"run": n}
@@ -259,7 +348,12 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
             row.update({f"{side} {k}×": STUDY_TABLE7[k][j + off] for k in TABLE7_HARMONICS})
         t7.append(row)
     table7 = pd.DataFrame(t7)
-    note = _load_case_note(d)
+    unsettled = _unsettled(d, runs)
+    note = " ".join(filter(None, [
+        _load_case_note(d),
+        f"CAUTION: {', '.join(unsettled)} have not settled: their values are of the start-up, not of the steady "
+        "state." if unsettled else "",
+        f"Not in the tables: {'; '.join(skipped)}." if skipped else ""]))
 
     def draw(fig: Figure) -> None:
         ax = fig.add_axes([0.03, 0.06, 0.94, 0.85])
@@ -300,8 +394,13 @@ def sweep_pages(d: ReportData) -> list[Page]:
     if sw.folder is not None:   # indicator means again from the runs, with the report's screening settings
         from flexgear.study.sweep import indicator_means
 
-        fresh = pd.DataFrame([indicator_means(sw.folder / n, d.settings) for n in table["variant"]],
-                             index=table.index)
+        def means(name: str) -> dict[str, float]:
+            try:
+                return indicator_means(sw.folder / name, d.settings)
+            except (ValueError, KeyError):   # a run too short for its samples: no means, its status says why
+                return {}
+
+        fresh = pd.DataFrame([means(n) for n in table["variant"]], index=table.index)
         table[list(fresh.columns)] = fresh
     table["input_bearing_peak"] = [_peak(d, sw.folder, n, "input") for n in table["variant"]]
     table["output_bearing_peak"] = [_peak(d, sw.folder, n, "output") for n in table["variant"]]
