@@ -16,7 +16,6 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
-import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -32,6 +31,7 @@ from flexgear.report import result_pages as rp  # noqa: E402
 from flexgear.report.data import ReportData, documented_assumptions, gather, results_folder_problem  # noqa: E402
 from flexgear.report.figures import draw_table, fmt  # noqa: E402
 from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
+from flexgear.report.verdict_page import verdict_page  # noqa: E402
 from flexgear.spec import COMPONENTS  # noqa: E402
 
 __all__ = ["ReportData", "gather", "documented_assumptions", "build_report"]
@@ -85,30 +85,6 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
     return draw
 
 
-def verdict_lines(d: ReportData) -> list[str]:
-    """The verdict and its reason in at most three lines (the first page and ``flexgear report``'s output)."""
-    if d.refused:
-        return ["Verdict: none. " + d.refused[:200]]
-    sel, s = d.selection, d.primary
-    against = f"against the reference {s.reference}" if s.reference else "against theory (the study's mode)"
-    flag = "" if sel.resolved else " (NOT RESOLVED)"
-    lines = [f"Verdict: {sel.variant or 'none'}{flag}, screened {against}."]
-    tab = s.table
-    if sel.variant is not None:
-        row = tab[tab["variant"] == sel.variant].iloc[0]
-        ref_row = tab[tab["variant"] == s.reference]
-        faster = (f", {float(ref_row['time_s'].iloc[0]) / row['time_s']:.3g}x faster than {s.reference}"
-                  if len(ref_row) and sel.variant != s.reference else "")
-        lines.append(f"Zone '{row['zone']}', distance {row['distance_pct']:.3g} {s.lines.unit}{faster}."
-                     + (f" Outside their own TEa: {row['outside_tea']}." if row.get("outside_tea") else ""))
-    else:
-        lines.append(sel.reasoning.split(". ")[0][:180] + ".")
-    unscreened = tab[tab["status"] != "ok"]
-    if len(unscreened):
-        lines.append("Not screened: " + ", ".join(f"{r.variant} ({r.status})" for r in unscreened.itertuples()) + ".")
-    return lines[:3]
-
-
 def case_summary(d: ReportData) -> str:
     """The load case and law of a results folder's runs, in words (to tell two verdicts' cases apart)."""
     if not d.runs:
@@ -138,29 +114,6 @@ def other_verdicts(d: ReportData, others: list[ReportData]) -> list[str]:
                      + ("" if o.selection.resolved else " (NOT RESOLVED)")
                      + (" - the same." if same else " - DIFFERENT: the verdict depends on the load case or law."))
     return lines
-
-
-def _verdict_page(d: ReportData, others: list[ReportData]) -> Callable[[Figure], None]:
-    """Page 1: the verdict in at most three lines, the Westgard diagram, a small table, the other cases' verdicts."""
-    s = d.primary
-    cols = {"variant": "variant", "zone": "zone", "distance_pct": f"distance [{s.lines.unit}]",
-            "error_pct": f"± error [{s.lines.unit}]", "time_s": "CPU time [s]", "status": "status"}
-    tab = s.table.reindex(columns=list(cols)).rename(columns=cols)
-    tab["settled"] = s.table["status"].isin(["ok"]) & s.table.get("steady_window", True).fillna(False).astype(bool)
-
-    def draw(fig: Figure) -> None:
-        fig.text(0.04, 0.90, "\n".join(verdict_lines(d)), fontsize=10.5, va="top", wrap=True)
-        notes = [f"This case: {case_summary(d)}.", *other_verdicts(d, others)]
-        if d.modal_note:
-            notes += textwrap.wrap(d.modal_note, 170)
-        fig.text(0.04, 0.80, "\n".join(notes), fontsize=8, va="top", color="#333333")
-        ax = fig.add_axes([0.06, 0.07, 0.46, 0.56])
-        s.plot(ax, title="")
-        right = fig.add_axes([0.56, 0.07, 0.41, 0.56])
-        right.axis("off")
-        draw_table(right, tab.assign(**{c: [fmt(v, 4) if isinstance(v, float) else v for v in tab[c]]
-                                         for c in tab.columns}), top=1.0, fontsize=7.5, wrap=18)
-    return draw
 
 
 def write_westgard_png(d: ReportData, path: str | Path) -> Path:
@@ -299,7 +252,8 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
     # the other results folders' verdict diagrams first, each titled with its folder
     body = [(f"{o.results_dir.name}: {title}", draw) for o in others for title, draw in rp.diagram_pages(o)[-1:]] + body
     contents = [(i + 3, title) for i, (title, _) in enumerate(body)]
-    pages: list[Page] = [("flexgear screening report: verdict", _verdict_page(d, others)),
+    first = verdict_page(d, others, case_summary(d), other_verdicts(d, others))
+    pages: list[Page] = [("flexgear screening report: verdict", first),
                          ("Runs, screening rule and contents", _title_page(d, contents, created)), *body]
     if westgard_png is not None:
         write_westgard_png(d, westgard_png)

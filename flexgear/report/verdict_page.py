@@ -86,7 +86,7 @@ def verdict_rows(d: ReportData, others: list[ReportData]) -> pd.DataFrame:
     """The verdict table of page 1: one row per purpose, then all purposes (module docstring)."""
     s = d.reference
     if s is None or not s.verdicts:
-        return pd.DataFrame()
+        return _study_rows(d)
     cases = case_verdicts(others)
     rows = []
     for v in s.verdicts:
@@ -103,6 +103,16 @@ def verdict_rows(d: ReportData, others: list[ReportData]) -> pd.DataFrame:
             row[folder] = sel.get(v.purpose, sel.get("*", "–"))
         rows.append(row)
     return pd.DataFrame(rows)
+
+
+def _study_rows(d: ReportData) -> pd.DataFrame:
+    """The study's mode (no reference): one row per variant, its composite zone, distance and CPU time."""
+    t = d.primary.table
+    if t.empty:
+        return pd.DataFrame()
+    cols = {"variant": "variant", "status": "status", "zone": "zone", "distance_pct": f"distance [{d.lines.unit}]",
+            "time_s": "CPU time [s]", "selected": "selected"}
+    return t.reindex(columns=list(cols)).rename(columns=cols)
 
 
 def _rigid(d: ReportData, variant: str) -> list[str]:
@@ -292,7 +302,8 @@ def verdict_lines(d: ReportData) -> list[str]:
         return ["Verdict: none. " + d.refused[:200]]
     s = d.primary
     if s.table.empty or not (s.table["status"] == "ok").any():
-        return ["Verdict: none: no variant could be screened."]
+        why = d.nothing_screened or "no variant could be screened."
+        return ["Verdict: none. " + (why[:1].upper() + why[1:])[:300]]
     if s.reference and s.verdicts:
         by = {v.purpose: v for v in s.verdicts}
         overall = by.get(ALL_PURPOSES)
@@ -330,9 +341,8 @@ def verdict_page(d: ReportData, others: list[ReportData], case_text: str, other_
     def draw(fig: Figure) -> None:
         fig.text(0.04, 0.925, "\n".join(textwrap.fill(t, 160) for t in verdict_lines(d)), fontsize=9, va="top")
         top = fig.add_axes([0.04, 0.59, 0.92, 0.27])
-        y = draw_table(top, table, top=1.0, fontsize=7.0, wrap=16,
-                       empty="No verdict per purpose: " + (d.refused or "no reference screening in this folder."))
-        del y
+        draw_table(top, table, top=1.0, fontsize=7.0, wrap=16,
+                   empty="No verdict: " + (d.refused or d.nothing_screened or "nothing was screened."))
         text = fig.add_axes([0.47, 0.04, 0.50, 0.53])
         text.axis("off")
         wrapped = "\n".join(textwrap.fill(n, 128) for n in notes)
