@@ -1,0 +1,346 @@
+"""The study's contact stiffness under both readings of its unit (section 2.1): a report page.
+
+Section 2.1 prints the impact law's contact stiffness as "1.0×10^8 N·m", which is no stiffness unit. The project reads
+the number as N/m^1.5 (``model_variants/gearbox.toml [contact]``). ADAMS models are commonly built in millimetres and
+ADAMS's IMPACT law F = k delta^e depends on the length unit, so there the number means N/mm^1.5: 1000^1.5 times
+stiffer in SI, with the damping "0.1 % of the contact stiffness" 1e5 N s/mm = 1e8 N s/m
+(``model_variants/quick_mm_reading/``). :func:`contact_reading_pages` sets the results folders of the two readings
+side by side:
+
+- the reference variant's static loaded transmission error (mean of ``transmission_error_m`` over its settled window,
+  flexgear.study.screening.run_window) and the static mesh deflection the law predicts at the mean mesh forces
+  (flexgear.laws.contact.static_deflection, effective_stiffness), with the meshes' share of the TE
+  (flexgear.study.purposes.static_te_split);
+- Tables 6 and 7 as the report computes them (flexgear.report.result_pages.tables_6_7_pages: compare_results over
+  each run's settled window) for the study's multibody model (:data:`STUDY_MBD_VARIANT`) and the lumped run, beside
+  the study's ADAMS and lumped columns;
+- each reading's verdict per purpose (``verdict.csv`` of the results folder);
+- one sentence naming the reading whose Tables 6-7 lie closer to the study's, by the mean absolute decimal
+  log-ratio of the values to the study's (:func:`log_distance`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+
+from flexgear.design import as_design
+from flexgear.laws.contact import ContactLaw, effective_stiffness, static_deflection
+from flexgear.report.data import ReportData
+from flexgear.report.figures import fmt
+from flexgear.report.layout import Page, table_pages
+from flexgear.results import RunResult
+from flexgear.spec import Contact
+from flexgear.study.compare import TABLE7_HARMONICS, compare_results
+from flexgear.study.purposes import static_te_split
+from flexgear.study.reference import STUDY_TABLE6, STUDY_TABLE7
+
+__all__ = ["contact_reading_pages", "reading_of", "stiffness_n_per_m_exp", "damping_n_s_per_m", "log_distance",
+           "ReadingValues", "reading_values", "READINGS", "READING_M", "READING_MM", "STUDY_STIFFNESS_NUMBER",
+           "STUDY_DAMPING_FRACTION", "STUDY_EXPONENT", "STUDY_MBD_VARIANT", "REFERENCE_VARIANT"]
+
+STUDY_STIFFNESS_NUMBER = 1.0e8
+"""Section 2.1: the contact stiffness's number, printed as "1.0×10^8 N·m" (unit of the model's length^exponent)."""
+
+STUDY_DAMPING_FRACTION = 1.0e-3
+"""Section 2.1: the damping coefficient "0.1 % of the contact stiffness value" (in the model's units)."""
+
+STUDY_EXPONENT = 1.5
+"""Section 2.1: the impact law's "nonlinear coefficient" (exponent, unitless)."""
+
+READING_M, READING_MM = "N/m^1.5", "N/mm^1.5"
+READINGS: dict[str, float] = {READING_M: 1.0, READING_MM: 1.0e-3}
+"""Each reading of the study's stiffness unit -> the model's length unit [m] (metre, millimetre)."""
+
+STUDY_MBD_VARIANT = "model4"
+"""Section 3 (Fig. 4): model 4 is "selected as the subsequent analysis model", the multibody column of Tables 6-7."""
+
+REFERENCE_VARIANT = "model7"
+"""The reference variant when a results folder was not screened against one (Table 3: all five flexible)."""
+
+_REL_TOL = 1e-6   # a run's saved stiffness matches a reading within this relative tolerance
+_TE_UM, _F_N = "µm", "N"
+
+
+def stiffness_n_per_m_exp(number: float, length_unit_m: float, exponent: float = STUDY_EXPONENT) -> float:
+    """The impact law's stiffness in SI [N/m^exponent] of ``number`` given in N per (model length unit)^exponent,
+    ``length_unit_m`` the model's length unit [m]: F = number (delta / unit)^e, so k = number / unit^e (a millimetre
+    model: number 1000^e)."""
+    return number / length_unit_m**exponent
+
+
+def damping_n_s_per_m(number: float, length_unit_m: float, fraction: float = STUDY_DAMPING_FRACTION) -> float:
+    """The impact law's maximum damping in SI [N s/m] when it is ``fraction`` of the stiffness ``number`` in the
+    model's units (N s per model length unit): c = fraction number / unit (a millimetre model: 0.1 % of 1e8 is
+    1e5 N s/mm = 1e8 N s/m)."""
+    return fraction * number / length_unit_m
+
+
+def _stiffnesses(case: ReportData) -> set[float]:
+    """The impact-law stiffnesses [N/m^e] saved with the case's runs (and its lumped run)."""
+    out = set()
+    for r in [*case.runs.values(), *([case.lumped] if case.lumped is not None else [])]:
+        contact = (r.meta.get("spec") or {}).get("contact") or {}
+        if contact.get("law", "impact") == "impact" and contact.get("stiffness") is not None:
+            out.add(float(contact["stiffness"]))
+    return out
+
+
+def reading_of(case: ReportData) -> str | None:
+    """The reading (:data:`READINGS`) of the study's stiffness number whose SI value every impact-law run of
+    ``case`` carries (``run.meta["spec"]["contact"]["stiffness"]``); None when the runs carry another value, several,
+    or none."""
+    ks = _stiffnesses(case)
+    for name, unit in READINGS.items():
+        target = stiffness_n_per_m_exp(STUDY_STIFFNESS_NUMBER, unit)
+        if ks and all(math.isclose(k, target, rel_tol=_REL_TOL) for k in ks):
+            return name
+    return None
+
+
+def log_distance(values: Mapping[str, float], study: Mapping[str, float], keys: list[str] | None = None) -> float:
+    """Mean |log10(|value| / |study|)| [decades] over ``keys`` (default: every key of ``study``) where both are
+    finite and non-zero; NaN when there is none."""
+    terms = []
+    for k in keys if keys is not None else list(study):
+        a, b = abs(float(values.get(k, np.nan))), abs(float(study.get(k, np.nan)))
+        if np.isfinite(a) and np.isfinite(b) and a > 0.0 and b > 0.0:
+            terms.append(abs(math.log10(a / b)))
+    return float(np.mean(terms)) if terms else math.nan
+
+
+@dataclass
+class ReadingValues:
+    """What one results folder gives for the comparison.
+
+    ``law``: its rows of the contact law and the reference's static state (label -> value, SI units in the labels);
+    ``tables``: Table 6-7 values (label -> value) whose study value is ``study[label]``; ``verdicts``: purpose ->
+    the selected variant in words; ``notes``: what could not be computed and why."""
+
+    case: ReportData
+    reading: str
+    law: dict[str, object] = field(default_factory=dict)
+    tables: dict[str, float] = field(default_factory=dict)
+    study: dict[str, float] = field(default_factory=dict)
+    verdicts: dict[str, str] = field(default_factory=dict)
+    notes: list[str] = field(default_factory=list)
+
+
+def _window_mean(case: ReportData, r: RunResult, pattern: str) -> float:
+    """Mean [signal unit] of the columns matching ``pattern`` over the run's settled window."""
+    w = case.window(r)
+    t = r.signals["time_s"]
+    sel = r.signals.loc[(t >= w.start_s) & (t <= w.end_s)].filter(regex=pattern)
+    return float(sel.to_numpy().mean()) if sel.size else math.nan
+
+
+def _law_rows(case: ReportData, out: ReadingValues) -> None:
+    """The law's parameters, the reference's static TE and the law's static deflection at its mean mesh forces."""
+    ref_name = case.reference.reference if case.reference is not None else REFERENCE_VARIANT
+    ref = case.runs.get(ref_name)
+    spec_contact = next(((r.meta.get("spec") or {}).get("contact") for r in case.runs.values()
+                         if (r.meta.get("spec") or {}).get("contact")), None)
+    names = {f.name for f in dataclasses.fields(Contact)}
+    law = ContactLaw.from_contact(Contact(**{k: v for k, v in spec_contact.items() if k in names})) \
+        if spec_contact else None
+    out.law["results folder"] = case.results_dir.name
+    out.law["contact stiffness k [N/m^1.5]"] = law.stiffness if law else math.nan
+    out.law["maximum damping c_max [N s/m]"] = law.damping_max if law else math.nan
+    out.law["penetration (cutting) depth [m]"] = law.penetration_depth if law else math.nan
+    steps = sorted({float(r.meta["step_size_s"]) for r in case.runs.values() if r.meta.get("step_size_s")})
+    out.law["step size [s]"] = "/".join(fmt(s) for s in steps) if steps else math.nan
+    label_te = f"{ref_name}: static loaded TE (window mean) [{_TE_UM}]"
+    forces = {"outer": math.nan, "inner": math.nan}
+    te_m = math.nan
+    if ref is None or not ref.ok or ref.signals is None:
+        out.notes.append(f"{case.results_dir.name}: reference {ref_name} has no finished run")
+    else:
+        try:
+            forces = {m: _window_mean(case, ref, rf"^{m}_mesh_force_\d+_n$") for m in forces}
+            if "transmission_error_m" in ref.signals:
+                te_m = _window_mean(case, ref, r"^transmission_error_m$")
+        except (ValueError, KeyError) as exc:
+            out.notes.append(f"{case.results_dir.name}: {ref_name}'s window ({exc})")
+    out.law[label_te] = 1e6 * te_m
+    known = {m: law is not None and np.isfinite(f) for m, f in forces.items()}
+    deflection = {m: static_deflection(f, law) if known[m] else math.nan for m, f in forces.items()}
+    for m, f in forces.items():
+        out.law[f"{ref_name}: mean {m} mesh force [{_F_N}]"] = f
+    for m in forces:
+        out.law[f"law: static {m} mesh deflection (F/k)^(2/3) [{_TE_UM}]"] = 1e6 * deflection[m]
+    for m, f in forces.items():
+        out.law[f"law: {m} mesh tangent stiffness 1.5 F/delta [N/m]"] = (
+            effective_stiffness(f, law) if known[m] else math.nan)
+    beta_b = as_design(case.gearbox).gears.sun_planet.gear1.base_helix_angle
+    split = static_te_split(te_m, deflection["outer"], deflection["inner"], beta_b)
+    out.law[f"meshes' share of the TE (delta_o + delta_i) / cos(beta_b) [{_TE_UM}]"] = 1e6 * split.meshes_m
+    out.law[f"rest of the TE: wind-up of shafts, bearings, bodies [{_TE_UM}]"] = 1e6 * split.windup_m
+
+
+def _report_window(case: ReportData, name: str, r: RunResult) -> tuple[float, float]:
+    """The window Tables 6-7 of the report use (flexgear.report.result_pages.tables_6_7_pages): a variant's own
+    settled window; the lumped run: the variants' common window if it lies inside the lumped run, else its own."""
+    if name != "lumped":
+        w = case.window(r)
+        return (w.start_s, w.end_s)
+    windows = [case.window(v) for v in case.runs.values() if v.ok]
+    span = (max(w.start_s for w in windows), min(w.end_s for w in windows)) if windows else (0.0, 0.0)
+    if span[1] > span[0] and span[1] <= float(r.signals["time_s"].iloc[-1]) + 1e-9:
+        return span
+    w = case.window(r)
+    return (w.start_s, w.end_s)
+
+
+_T6_LABELS = {"input_speed_deg_per_s": "input speed [°/s]", "output_speed_deg_per_s": "output speed [°/s]",
+              "outer_mesh_force_n": "outer mesh force [N]", "inner_mesh_force_n": "inner mesh force [N]",
+              "input_bearing_peak_accel_m_per_s2": "input bearing peak accel. [m/s²]",
+              "output_bearing_peak_accel_m_per_s2": "output bearing peak accel. [m/s²]"}
+
+
+def _table_rows(case: ReportData, out: ReadingValues) -> None:
+    """Tables 6-7 of :data:`STUDY_MBD_VARIANT` against the study's ADAMS column and of the lumped run against its
+    lumped column (Table 6: column 1 and 2; Table 7: columns 0-1 and 2-3)."""
+    runs = {STUDY_MBD_VARIANT: (case.runs.get(STUDY_MBD_VARIANT), 1, 0, "ADAMS"),
+            "lumped": (case.lumped, 2, 2, "lumped")}
+    for name, (r, col6, col7, who) in runs.items():
+        t6: dict[str, float] = {}
+        t7: dict[tuple[int, str], float] = {}
+        if r is None or not r.ok or r.signals is None:
+            out.notes.append(f"{case.results_dir.name}: no finished {name} run")
+        else:
+            try:
+                a, b = compare_results(r, r, window=_report_window(case, name, r))
+                t6 = dict(a.iloc[:, 1])
+                t7 = {(k, side): float(b.iloc[i, j]) for i, k in enumerate(TABLE7_HARMONICS)
+                      for j, side in enumerate(("input", "output"))}
+            except (ValueError, KeyError) as exc:
+                out.notes.append(f"{case.results_dir.name}: {name} not in Tables 6-7 ({exc})")
+        for key, label in _T6_LABELS.items():
+            row = f"T6 {name} vs study {who}: {label}"
+            out.tables[row] = float(t6.get(key, math.nan))
+            out.study[row] = STUDY_TABLE6[key][col6]
+        for k in TABLE7_HARMONICS:
+            for j, side in enumerate(("input", "output")):
+                row = f"T7 {name} vs study {who}: {side} bearing {k}× mesh [m/s²]"
+                out.tables[row] = t7.get((k, side), math.nan)
+                out.study[row] = STUDY_TABLE7[k][col7 + j]
+
+
+def _verdict_rows(case: ReportData, out: ReadingValues) -> None:
+    """The selected variant per purpose: ``verdict.csv`` of the folder, else the reference screening's verdicts."""
+    path = case.results_dir / "verdict.csv"
+    if path.exists():
+        table = pd.read_csv(path, keep_default_na=False)
+    elif case.reference is not None and case.reference.verdicts:
+        table = pd.DataFrame([v.row() for v in case.reference.verdicts])
+    else:
+        out.notes.append(f"{case.results_dir.name}: no verdict per purpose (no verdict.csv, no reference screening)")
+        return
+    for row in table.itertuples():
+        resolved = str(row.resolved).strip().lower() in ("true", "1", "yes")
+        zone = f" ({row.zone})" if getattr(row, "zone", "") else ""
+        out.verdicts[str(row.purpose)] = (f"{row.selected or 'none'}{zone}"
+                                          + ("" if resolved else ", NOT RESOLVED"))
+
+
+def reading_values(case: ReportData, reading: str) -> ReadingValues:
+    """Everything :func:`contact_reading_pages` shows of one results folder (``reading``: its :data:`READINGS`)."""
+    out = ReadingValues(case, reading)
+    _law_rows(case, out)
+    _table_rows(case, out)
+    _verdict_rows(case, out)
+    return out
+
+
+def _ramps(case: ReportData) -> set[float | None]:
+    """The ramp times [s] of the case's runs (its load case; None for a run that has none)."""
+    return {r.meta.get("ramp_time_s") for r in case.runs.values()}
+
+
+def _pick(cases: list[ReportData], reading: str, like: ReportData | None) -> ReportData | None:
+    """The first folder of ``reading``, preferring one whose ramps are those of ``like`` (the same load case)."""
+    found = [c for c in cases if reading_of(c) == reading]
+    same = [c for c in found if like is not None and _ramps(c) == _ramps(like)]
+    return (same or found or [None])[0]
+
+
+def _case_words(case: ReportData | None) -> str:
+    """A results folder's name and ramp times [s] (its load case), or a dash."""
+    if case is None:
+        return "–"
+    ramps = "/".join(fmt(x) for x in sorted(_ramps(case) - {None}))
+    return f"{case.results_dir.name}, ramps {ramps} s" if ramps else case.results_dir.name
+
+
+def _sentence(m: ReadingValues | None, mm: ReadingValues, keys: list[str]) -> str:
+    """Which reading reproduces the study's Tables 6-7 better, by :func:`log_distance` over ``keys``."""
+    e_mm = log_distance(mm.tables, mm.study, keys)
+    if m is None:
+        return (f"Only the {READING_MM} reading was run: its Tables 6-7 lie a mean |log10(ours/study)| of "
+                f"{e_mm:.3g} decades from the study's; no {READING_M} folder to set beside it.")
+    e_m = log_distance(m.tables, m.study, keys)
+    if not (np.isfinite(e_m) and np.isfinite(e_mm)):
+        return "No Table 6-7 value is there for both readings: no comparison."
+    better = READING_MM if e_mm < e_m else READING_M
+    lo, hi = min(e_m, e_mm), max(e_m, e_mm)
+    by_table = ", ".join(
+        f"Table {n} alone {log_distance(m.tables, m.study, part):.3g} / {log_distance(mm.tables, mm.study, part):.3g}"
+        for n in (6, 7) if (part := [k for k in keys if k.startswith(f"T{n} ")]))
+    return (f"Over the {len(keys)} Table 6-7 values both readings give ({STUDY_MBD_VARIANT} against the study's "
+            f"ADAMS column, the lumped run against its lumped column) the mean |log10(ours/study)| is {e_m:.3g} "
+            f"decades under the {READING_M} reading and {e_mm:.3g} under the {READING_MM} reading: the {better} "
+            f"reading reproduces the study better (its values a geometric-mean factor {10 ** lo:.3g} off the "
+            f"study's, against {10 ** hi:.3g}). By table ({READING_M} / {READING_MM}): {by_table}.")
+
+
+_STUDY_LAW = {"contact stiffness k [N/m^1.5]": "1.0e8 'N·m' (2.1)", "maximum damping c_max [N s/m]": "0.1 % of k (2.1)",
+              "penetration (cutting) depth [m]": "1.0e-4 m (2.1)", "step size [s]": "1e-5 (3.1)"}
+"""The study's value of a law row, in words with its section."""
+
+
+def contact_reading_pages(d: ReportData, others: list[ReportData]) -> list[Page]:
+    """The two readings of the study's contact stiffness side by side (module docstring); [] unless ``d`` or one of
+    ``others`` is a millimetre-reading run (its runs' saved stiffness is 1e8 * 1000^1.5 N/m^1.5)."""
+    cases = [d, *others]
+    mm_case = _pick(cases, READING_MM, d if reading_of(d) != READING_MM else None)
+    if mm_case is None:
+        return []
+    m_case = _pick(cases, READING_M, mm_case)
+    mm = reading_values(mm_case, READING_MM)
+    m = reading_values(m_case, READING_M) if m_case is not None else None
+    blank = ReadingValues(mm_case, READING_M)
+    mv = m if m is not None else blank
+    rows = [{"quantity": "unit of section 2.1's stiffness number 1.0e8", "study": "'N·m' (as printed)",
+             READING_M: READING_M, READING_MM: READING_MM}]
+    for label in mm.law:
+        rows.append({"quantity": label, "study": _STUDY_LAW.get(label, "–"), READING_M: mv.law.get(label, math.nan),
+                     READING_MM: mm.law[label]})
+    for label in mm.tables:
+        rows.append({"quantity": label, "study": mm.study[label], READING_M: mv.tables.get(label, math.nan),
+                     READING_MM: mm.tables[label]})
+    for purpose in dict.fromkeys([*mv.verdicts, *mm.verdicts]):
+        rows.append({"quantity": f"verdict: {purpose}", "study": "model4 (section 3)" if purpose == "all purposes"
+                     else "–", READING_M: mv.verdicts.get(purpose, "–"), READING_MM: mm.verdicts.get(purpose, "–")})
+    keys = [k for k in mm.tables if np.isfinite(mm.tables[k]) and np.isfinite(mv.tables.get(k, math.nan))]
+    if m is None:
+        keys = [k for k in mm.tables if np.isfinite(mm.tables[k])]
+    measure = {"quantity": "mean |log10(ours / study)| over Tables 6-7 [decades]", "study": 0.0,
+               READING_M: log_distance(mv.tables, mv.study, keys) if m is not None else math.nan,
+               READING_MM: log_distance(mm.tables, mm.study, keys)}
+    rows.append(measure)
+    table = pd.DataFrame(rows, columns=["quantity", "study", READING_M, READING_MM])
+    table = table.assign(**{c: [fmt(v, 4) for v in table[c]] for c in ("study", READING_M, READING_MM)})
+    table = table.rename(columns={READING_M: f"reading {READING_M}", READING_MM: f"reading {READING_MM}"})
+    intro = " ".join([
+        f"Section 2.1's contact stiffness '1.0×10^8 N·m' read as N/m^1.5 ({_case_words(m_case)}) and as N/mm^1.5 = "
+        f"3.162e12 N/m^1.5 with c_max 1e8 N s/m ({_case_words(mm_case)}).",
+        _sentence(m, mm, keys),
+        *(["Not shown: " + "; ".join([*mv.notes, *mm.notes]) + "."] if mv.notes or mm.notes else [])])
+    return table_pages("The study's contact stiffness under both readings of its unit", table,
+                       {"quantity": 70, "study": 20, f"reading {READING_M}": 26, f"reading {READING_MM}": 26},
+                       [0.46, 0.12, 0.21, 0.21], intro, fontsize=7)
