@@ -31,6 +31,7 @@ from flexgear.report import result_pages as rp  # noqa: E402
 from flexgear.report.data import ReportData, documented_assumptions, gather, results_folder_problem  # noqa: E402
 from flexgear.report.figures import draw_table, fmt  # noqa: E402
 from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
+from flexgear.report.reading_pages import contact_reading_pages  # noqa: E402
 from flexgear.report.verdict_page import verdict_page  # noqa: E402
 from flexgear.spec import COMPONENTS  # noqa: E402
 
@@ -237,7 +238,8 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
     assumptions = documented_assumptions(d.gearbox_file)
     body: list[Page] = [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
     if rp.shown_runs(d):
-        body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d)]
+        body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d),
+                 *contact_reading_pages(d, others)]
     if modal and rp.shown_runs(d):   # no finished run: no model to analyse
         from flexgear.report.modal_pages import modal_pages
 
