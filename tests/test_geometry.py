@@ -14,34 +14,18 @@ import pytest
 
 from flexgear import gear_set_geometry, load_gearbox
 from flexgear.fe.mesh import component_mesh
-from flexgear.geometry.check import assembly_check, measure_backlash
+from flexgear.geometry.check import assembly_check, flank_deviation, measure_backlash
 from flexgear.geometry.layout import component_layout, component_mass_properties, exact_mass_properties, gear_profiles
 
 SPEC = load_gearbox(Path(__file__).resolve().parents[1] / "model_variants" / "gearbox.toml")
 GS = gear_set_geometry(SPEC)
 
 
-def _flank_deviation(component: str, twist_correction: float = 0.0) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Normal distance of each flank node from the involute helicoid, and the nodes' z and phase.
-
-    A node at (r, theta, z) of a toothed half with twist tau lies on a flank if
-    theta - tau z = +/- psi(r) (mod 2 pi / z); psi(r) = Gear.tooth_half_angle(r). The distance
-    along the flank normal is r * d_theta * cos(alpha_r), cos(alpha_r) = r_b / r.
-    """
+def _flank_deviation(component: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Normal distance of each flank node of the coarse mesh from the involute helicoid, and the nodes' z and
+    phase (flexgear.geometry.check.flank_deviation)."""
     mesh = component_mesh(SPEC, component, "coarse", order=2)
-    layout = component_layout(SPEC, component)
-    gear = layout.gear
-    pitch = 2 * math.pi / gear.teeth
-    p = mesh.nodes[mesh.regions["flanks"]]
-    r, theta, z = np.hypot(p[:, 0], p[:, 1]), np.arctan2(p[:, 1], p[:, 0]), p[:, 2]
-    psi = np.array([gear.tooth_half_angle(x) for x in r])
-    twist = np.array([next(q.twist for q in layout.prisms if q.section.gear and q.z0 - 1e-9 <= zz <= q.z1 + 1e-9)
-                      for zz in z]) * (1 + twist_correction)
-    base = theta - twist * z
-    resid = np.stack([(base - s * psi + pitch / 2) % pitch - pitch / 2 for s in (1.0, -1.0)])
-    best = np.abs(resid).argmin(axis=0)
-    d_theta = resid[best, np.arange(len(p))]
-    return d_theta * gear.base_radius, z, d_theta  # r cos(alpha_r) = r_b
+    return flank_deviation(component_layout(SPEC, component), mesh.nodes[mesh.regions["flanks"]])
 
 
 @pytest.mark.parametrize("component", ["sun", "planet", "ring"])

@@ -14,6 +14,8 @@ ring's) on either side gives the free play, i.e. the backlash
 
 (ISO 21771), to compare with the design value from the tooth thinning (Mesh.normal_backlash).
 Booleans of the sampled exact outlines use manifold3d cross sections (in mm).
+
+:func:`flank_deviation` checks points of a meshed gear (its flank nodes) against the involute helicoid.
 """
 
 from __future__ import annotations
@@ -25,7 +27,7 @@ import manifold3d
 import numpy as np
 
 from flexgear.geometry.involute import gear_set_geometry
-from flexgear.geometry.layout import component_layout, gear_profiles
+from flexgear.geometry.layout import ComponentLayout, component_layout, gear_profiles
 from flexgear.spec import GearboxSpec
 
 __all__ = [
@@ -34,6 +36,7 @@ __all__ = [
     "section_overlap",
     "measure_backlash",
     "assembly_check",
+    "flank_deviation",
 ]
 
 _MM = 1e3  # cross sections are built in mm (manifold3d works on a fixed-point grid)
@@ -144,9 +147,25 @@ def assembly_check(spec: GearboxSpec, z_levels: int = 5) -> dict[str, float]:
             "planet_ring_normal_backlash_m": pr["normal_m"], "design_normal_backlash_m": sp["design_normal_m"]}
 
 
+def flank_deviation(layout: ComponentLayout, points: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Signed normal distance [m] of flank ``points`` (n, 3) [m] from the involute helicoid of ``layout``'s gear,
+    their axial position z [m] and their phase residual d_theta [rad].
 
-
-
-
-
-
+    A point at (r, theta, z) of a toothed prism with twist tau [rad/m] lies on a flank if
+    theta - tau z = +/- psi(r) (mod 2 pi / z_teeth), psi(r) = Gear.tooth_half_angle(r) (radial below the
+    base circle); d_theta is the residual of the nearer flank. The distance along the flank normal is
+    r d_theta cos(alpha_r) = r_b d_theta, cos(alpha_r) = r_b / r. Points outside every toothed prism raise
+    ValueError.
+    """
+    gear = layout.gear
+    pitch = 2 * math.pi / gear.teeth
+    p = np.asarray(points, float)
+    r, theta, z = np.hypot(p[:, 0], p[:, 1]), np.arctan2(p[:, 1], p[:, 0]), p[:, 2]
+    psi = np.array([gear.tooth_half_angle(x) for x in r])
+    toothed = [q for q in layout.prisms if q.section.gear]
+    twist = np.array([next(q.twist for q in toothed if q.z0 - 1e-9 <= zz <= q.z1 + 1e-9) for zz in z])
+    base = theta - twist * z
+    resid = np.stack([(base - s * psi + pitch / 2) % pitch - pitch / 2 for s in (1.0, -1.0)])
+    best = np.abs(resid).argmin(axis=0)
+    d_theta = resid[best, np.arange(len(p))]
+    return d_theta * gear.base_radius, z, d_theta

@@ -6,12 +6,18 @@ field that causes the problem and what is allowed:
 - gear set: neighbouring planets' tip circles must not overlap, 2 a_w sin(pi/N) > d_a,planet
   (the equal-spacing assembly condition is checked in :mod:`flexgear.spec`);
 - centre distance: reachable by profile shifts, cos(alpha_wt) = a_0 cos(alpha_t) / a_w < 1 for both meshes
-  (ISO 21771 centre-distance equation);
+  (ISO 21771 centre-distance equation), also the mean standard centre distance that 0 selects;
 - tooth thickness at the tip > 0 for sun, planet and ring (no pointed tooth), psi(r_a) of
   :meth:`flexgear.geometry.involute.Gear.tooth_half_angle`; the field named is the one that makes it pointed
   (backlash, addendum or the profile shift, which the centre distance sets for sun and ring);
 - a ring whose tip circle lies inside its base circle has no involute at the tip;
+- the root fillets of every gear fit in its tooth space (the tooth profile of
+  :func:`flexgear.geometry.profile.tooth_profile` can be built): the field named is
+  ``root_fillet_coefficient`` with the largest value that fits, or ``dedendum_coefficient`` when even a
+  fillet-less space closes above the root circle;
 - backlash below the normal module (a larger one is a unit slip);
+- a relief groove depth > 0 (it sets the ring flange's inner edge beyond the tooth roots in either helix
+  layout, and the double helix's groove);
 - bores inside the root circle less the relief groove, shaft inner < outer diameter, the input shaft
   inside the sun's bore, the output shaft inside the ring flange, the flange beyond the rim with room for
   the bolt holes, the bolts side by side on their circle, bearing seats shorter than the shafts, the bolts'
@@ -26,8 +32,10 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections.abc import Callable
 
 from flexgear.geometry.involute import Gear, gear_set_geometry, transverse_pressure_angle
+from flexgear.geometry.profile import tooth_profile
 from flexgear.spec import GearboxSpec, SpecError, register_feasibility_check
 
 __all__ = ["check_feasibility"]
@@ -37,11 +45,17 @@ _MM = 1e-3
 
 def _reachable_centre_distance(spec: GearboxSpec) -> None:
     g, a = spec.gears, spec.gears_assumed
-    if a.operating_centre_distance_mm == 0.0:  # 0: the mean of the two standard centre distances
-        return
     alpha_t = transverse_pressure_angle(g.normal_pressure_angle_rad, g.helix_angle_rad)
     mt_mm = g.normal_module_mm / math.cos(g.helix_angle_rad)
     lower = max(abs(mt_mm * (g.planet_teeth + z) / 2) * math.cos(alpha_t) for z in (g.sun_teeth, -g.ring_teeth))
+    if a.operating_centre_distance_mm == 0.0:  # 0: the mean of the two standard centre distances
+        mean = mt_mm * (g.sun_teeth + g.ring_teeth) / 4
+        if mean <= lower:
+            raise SpecError(spec.source, "gears_assumed.operating_centre_distance_mm",
+                            f"0 selects the mean standard centre distance {mean:.3f} mm, which profile shifts "
+                            f"cannot reach (base-circle limit a_0 cos(alpha_t) of the larger mesh {lower:.3f} mm): "
+                            f"expected a centre distance > {lower:.3f} mm", a.operating_centre_distance_mm)
+        return
     if a.operating_centre_distance_mm <= lower:
         raise SpecError(spec.source, "gears_assumed.operating_centre_distance_mm",
                         f"cannot be reached by profile shifts: expected > {lower:.3f} mm (base-circle limit "
@@ -100,6 +114,50 @@ def _teeth(spec: GearboxSpec) -> None:
                         f"tip diameter {tip_d / _MM:.2f} mm); expected at most {fit} planets", g.planet_count)
 
 
+def _profile_fits(gear: Gear, fillet_radius: float) -> bool:
+    """Whether the tooth profile of ``gear`` with a root fillet of ``fillet_radius`` [m] can be built."""
+    try:
+        tooth_profile(gear, fillet_radius)
+    except ValueError:
+        return False
+    return True
+
+
+def _largest(fits: Callable[[float], bool], lo: float, hi: float) -> float:
+    """The largest x in [lo, hi] with ``fits(x)``, by bisection (``fits(lo)`` true, ``fits(hi)`` false)."""
+    for _ in range(40):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+    return lo
+
+
+def _profiles(spec: GearboxSpec) -> None:
+    """Each gear's tooth space must hold its root fillets (flexgear.geometry.profile.tooth_profile): the fillet of
+    radius rho = c m_n, tangent to the flank and the root circle, must lie inside the tooth space at the root,
+    i.e. the root point's polar angle < pi / z; without a fillet the flanks must not meet above the root circle."""
+    gs, a = gear_set_geometry(spec), spec.gears_assumed
+    coefficient = a.root_fillet_coefficient
+    for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
+        if _profile_fits(gear, coefficient * gear.normal_module):
+            continue
+        if coefficient > 0 and _profile_fits(gear, 0.0):
+            c_max = _largest(lambda c, g=gear: _profile_fits(g, c * g.normal_module), 0.0, coefficient)
+            raise SpecError(spec.source, "gears_assumed.root_fillet_coefficient",
+                            f"the {name}'s root fillets (radius {coefficient * gear.normal_module / _MM:.3f} mm) "
+                            f"do not fit in its tooth space (profile shift x = {gear.shift:.3f}); expected "
+                            f"< {c_max:.4f}", coefficient)
+        # the flanks meet above the root circle: a smaller dedendum raises an external gear's root circle and
+        # lowers the ring's, into the wider part of the space
+        def fits(dedendum: float, g: Gear = gear) -> bool:
+            return _profile_fits(dataclasses.replace(g, dedendum_coefficient=dedendum), coefficient * g.normal_module)
+
+        lowest = next(f.metadata["lo"] for f in dataclasses.fields(a) if f.name == "dedendum_coefficient")
+        hint = f"< {_largest(fits, lowest, a.dedendum_coefficient):.4f}" if fits(lowest) else "a smaller value"
+        raise SpecError(spec.source, "gears_assumed.dedendum_coefficient",
+                        f"the {name}'s tooth spaces close above its root circle (profile shift x = "
+                        f"{gear.shift:.3f}, no room for the root fillets); expected {hint}", a.dedendum_coefficient)
+
+
 def _value(spec: GearboxSpec, dotted: str) -> object:
     table, name = dotted.split(".")
     return getattr(getattr(spec, table), name)
@@ -107,7 +165,12 @@ def _value(spec: GearboxSpec, dotted: str) -> object:
 
 def _components(spec: GearboxSpec) -> None:
     gs, c, p = gear_set_geometry(spec), spec.components_assumed, spec.source
-    groove = c.relief_groove_depth_mm if spec.gears_assumed.helix_layout == "double" else 0.0
+    # the groove depth sets the ring flange's inner edge in either helix layout, and the bore limit with it
+    groove = c.relief_groove_depth_mm
+    if groove <= 0:
+        raise SpecError(p, "components_assumed.relief_groove_depth_mm",
+                        "expected > 0: the ring flange's inner edge (and a double helix's relief groove) lies this "
+                        "far beyond the root circle; at 0 its circle touches the tooth roots", groove)
     for name in ("sun", "planet"):
         limit = 2 * getattr(gs, name).root_radius / _MM - 2 * groove
         bore = getattr(c, f"{name}_bore_diameter_mm")
@@ -165,6 +228,7 @@ def check_feasibility(spec: GearboxSpec) -> None:
     _backlash(spec)
     _reachable_centre_distance(spec)
     _teeth(spec)
+    _profiles(spec)
     _components(spec)
 
 

@@ -6,7 +6,8 @@ gear centre at the origin, tooth 0 centred on the +x axis):
 - tip arc at the tip radius, across half the tooth (polar angle 0 .. psi(r_a)),
 - involute flank, polar angle theta = psi(r) (``Gear.tooth_half_angle``), parametrised by the
   roll angle t: r = r_b sqrt(1 + t^2), inv(alpha_r) = t - atan(t),
-- a radial line below the base circle when an external gear's fillet reaches below it,
+- a radial line below the base circle when an external gear's fillet (or, without a fillet, its root
+  circle) lies below it,
 - root fillet: circular arc of radius rho tangent to the flank and to the root circle,
 - root arc at the root radius up to the middle of the tooth space (polar angle pi/z).
 
@@ -233,8 +234,8 @@ def tooth_profile(gear: Gear, fillet_radius: float) -> ToothProfile:
         if miss(lo) * miss(hi) > 0:
             raise ValueError(f"root fillet of radius {rho} m does not fit between flank and root circle")
         r_form = brentq(miss, lo, hi, xtol=1e-13)
-    else:
-        r_form = max(rf, rb) if not gear.internal else rf
+    else:  # no fillet: the flank (radial below an external gear's base circle) runs down to the root circle
+        r_form = rf
     p_form, n_form = _flank_point(gear, r_form)
     centre = p_form + rho * n_form
     root_point = centre * (rf / np.linalg.norm(centre))
