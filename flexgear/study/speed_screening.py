@@ -18,6 +18,15 @@ grid, each standing for its neighbourhood: the trapezoid weights of the grid) wh
 
 The reference is the matrix's screening reference when that is a variant, else the variant with the most flexible
 bodies (the all-flexible model 7 of the study's matrix): the frequency domain has no theory values to compare with.
+
+The acceptable speed band of a purpose (:func:`acceptable_band`, :func:`speed_bands`): the contiguous input-speed
+band around the operating speed (the load case's input speed) over which the purpose's selected variant keeps every
+frequency-domain indicator of the purpose within its TEa (|d| <= TEa). Between grid speeds each d(n) is taken as
+linear (on its own scale, dB or % of load); a limit of the band is the interpolated crossing |d| = TEa, which lies
+between the last grid speed within and the first one beyond (named in the band's text): both responses are
+continuous in the speed, so the crossing is in that bracket, and its position inside it is uncertain by up to one
+grid step. A resonance narrower than the grid step can fall between two grid speeds unseen: the grid's step bounds
+what the band can claim.
 """
 
 from __future__ import annotations
@@ -31,7 +40,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["SpeedScreening", "speed_indicators", "compare_curves", "speed_screening", "screen_speed_range",
-           "SPEED_INDICATORS"]
+           "SPEED_INDICATORS", "SpeedBand", "acceptable_band", "speed_bands", "BAND_COLUMNS"]
 
 SPEED_INDICATORS = {"dynamic_factor": "load", "input_bearing_rms": "db", "output_bearing_rms": "db",
                     "input_bearing_mesh1x": "db", "output_bearing_mesh1x": "db"}
@@ -175,7 +184,9 @@ def screen_speed_range(variant_paths: Sequence[str | Path], out_dir: str | Path,
                        reference: str | None = None, harmonics: int | None = None) -> str:
     """:func:`speed_screening` of the variant files into the results folder ``out_dir``: writes
     speed_screening.csv (the table), speed_screening_summary.csv and speed_screening.txt (one line per variant);
-    returns the text. ``reference``: None = the gearbox's ``[screening] reference`` (then, if empty, the most
+    when the folder holds a verdict against a reference variant (verdict.csv), also speed_bands.csv
+    (:func:`speed_bands`, the operating speed being the variants' load case input speed) and one line per band in
+    the text; returns the text. ``reference``: None = the gearbox's ``[screening] reference`` (then, if empty, the most
     flexible variant)."""
     from flexgear.cache import atomic_write_bytes
     from flexgear.spec import load_variant
@@ -190,6 +201,195 @@ def screen_speed_range(variant_paths: Sequence[str | Path], out_dir: str | Path,
     out.mkdir(parents=True, exist_ok=True)
     write_table(result.table, out / "speed_screening")
     write_table(result.summary, out / "speed_screening_summary")
-    text = "\n".join(result.lines()) + "\n"
+    lines = result.lines()
+    operating = {float(v.gearbox.load_case.input_speed_rpm) for v in variants}
+    bands = speed_bands(out, operating.pop() if len(operating) == 1 else None)
+    if bands is not None:
+        lines += [f"acceptable speed band, {r.purpose}: {r.text}" for r in bands.itertuples()]
+    text = "\n".join(lines) + "\n"
     atomic_write_bytes(out / "speed_screening.txt", text.encode())
     return text
+
+
+# --------------------------------------------------------------------------- acceptable speed band
+@dataclass(frozen=True)
+class SpeedBand:
+    """The contiguous speed band around ``operating_rpm`` over which ``variant`` keeps every one of ``indicators``
+    within its TEa (module docstring). Speeds in rpm.
+
+    ``low_rpm``, ``high_rpm``: the band's limits (NaN when there is no band: the variant exceeds TEa at the operating
+    speed, or the operating speed lies outside the grid); ``grid_low_rpm``, ``grid_high_rpm``: the grid's range;
+    ``low_is_grid_end`` / ``high_is_grid_end``: that side of the band reaches the grid's end, so the band extends
+    at least that far (the grid does not tell how much further); otherwise the limit is the interpolated crossing of
+    ``low_indicator`` / ``high_indicator``, between the grid speeds ``low_bracket_rpm`` / ``high_bracket_rpm``
+    (the inner one is the operating speed when no grid speed lies between). ``status``: "band" (bounded on at least
+    one side), "whole grid" (within TEa at every grid speed), "fails" (beyond TEa at the operating speed), "off
+    grid" (operating speed outside the grid). ``text``: one line.
+    """
+
+    variant: str
+    indicators: tuple[str, ...]
+    operating_rpm: float
+    grid_low_rpm: float
+    grid_high_rpm: float
+    low_rpm: float
+    high_rpm: float
+    low_is_grid_end: bool
+    high_is_grid_end: bool
+    status: str
+    text: str
+    low_indicator: str = ""
+    high_indicator: str = ""
+    low_bracket_rpm: tuple[float, float] | None = None
+    high_bracket_rpm: tuple[float, float] | None = None
+
+
+def _band_limit(speeds: np.ndarray, diff: np.ndarray, tea: np.ndarray, start_rpm: float, start: np.ndarray,
+                ahead: np.ndarray) -> tuple[float, int, tuple[float, float] | None]:
+    """Walk from ``start_rpm`` (differences ``start``, all within TEa) over the grid speeds ``ahead`` (indices into
+    ``speeds`` / ``diff`` rows, in walking order) until an indicator leaves its TEa. Returns (limit [rpm], the
+    indicator's column, -1 at the grid's end; the bracketing speeds [rpm], None at the grid's end)."""
+    n_a, d_a = start_rpm, start
+    for j in ahead:
+        n_b, d_b = float(speeds[j]), diff[j]
+        out = ~(np.abs(d_b) <= tea)  # NaN counts as beyond
+        if out.any():
+            frac = np.full(tea.size, np.inf)
+            for i in np.flatnonzero(out):
+                if np.isfinite(d_b[i]):
+                    bound = np.copysign(tea[i], d_b[i])
+                    frac[i] = (bound - d_a[i]) / (d_b[i] - d_a[i])
+                else:
+                    frac[i] = 0.0  # no value to interpolate to: the last speed known within
+            i = int(np.argmin(frac))
+            return n_a + float(frac[i]) * (n_b - n_a), i, (min(n_a, n_b), max(n_a, n_b))
+        n_a, d_a = n_b, d_b
+    return n_a, -1, None
+
+
+def acceptable_band(table: pd.DataFrame, variant: str, indicators: Sequence[str], operating_rpm: float) -> SpeedBand:
+    """The contiguous input-speed band around ``operating_rpm`` [rpm] over which ``variant`` keeps each of
+    ``indicators`` within its TEa against the reference (|difference| <= tea), from ``table``: the speed
+    screening's table (:attr:`SpeedScreening.table` or speed_screening.csv; columns variant, speed_rpm [rpm],
+    indicator, difference and tea on the indicator's scale, unit). Between grid speeds each difference is taken
+    as linear in the speed, so the limits are the interpolated crossings |difference| = TEa (module docstring);
+    an operating speed between grid speeds is judged on the interpolated differences too."""
+    keys = tuple(dict.fromkeys(indicators))
+    if not keys:
+        raise ValueError(f"{variant}: no indicators to judge over the speed range")
+    rows = table[(table.variant == variant) & table.indicator.isin(keys)]
+    missing = [k for k in keys if k not in set(rows.indicator)]
+    if missing:
+        raise ValueError(f"{variant}: not in the speed screening for {', '.join(missing)}")
+    diff_frame = rows.pivot(index="speed_rpm", columns="indicator", values="difference").reindex(
+        columns=list(keys)).sort_index()
+    tea_of = rows.groupby("indicator").tea.first()
+    unit_of = rows.groupby("indicator").unit.first()
+    speeds = diff_frame.index.to_numpy(float)
+    diff = diff_frame.to_numpy(float)
+    tea = np.array([float(tea_of[k]) for k in keys])
+    lo, hi = float(speeds[0]), float(speeds[-1])
+    n0 = float(operating_rpm)
+    base = dict(variant=variant, indicators=keys, operating_rpm=n0, grid_low_rpm=lo, grid_high_rpm=hi)
+    grid = f"{lo:g}-{hi:g} rpm"
+    near = np.isclose(speeds, n0, rtol=1e-9, atol=1e-6)
+    if near.any():
+        n0 = float(speeds[np.flatnonzero(near)[0]])
+        start = diff[np.flatnonzero(near)[0]]
+    elif lo < n0 < hi:
+        start = np.array([np.interp(n0, speeds, diff[:, i]) for i in range(len(keys))])
+    else:
+        return SpeedBand(**base, low_rpm=np.nan, high_rpm=np.nan, low_is_grid_end=False, high_is_grid_end=False,
+                         status="off grid", text=f"{variant}: operating speed {n0:g} rpm outside the speed grid "
+                                                 f"{grid}: no band")
+    if not np.all(np.abs(start) <= tea):
+        with np.errstate(invalid="ignore"):
+            ratio = np.where(np.isfinite(start), np.abs(start) / tea, np.inf)
+        i = int(np.argmax(ratio))
+        return SpeedBand(**base, low_rpm=np.nan, high_rpm=np.nan, low_is_grid_end=False, high_is_grid_end=False,
+                         status="fails", text=f"{variant}: beyond TEa at the operating speed {n0:g} rpm ({keys[i]} "
+                                              f"{start[i]:+.2f} {unit_of[keys[i]]}, TEa {tea[i]:g} "
+                                              f"{unit_of[keys[i]]}): no band in {grid}")
+    low, i_low, br_low = _band_limit(speeds, diff, tea, n0, start, np.flatnonzero(speeds < n0)[::-1])
+    high, i_high, br_high = _band_limit(speeds, diff, tea, n0, start, np.flatnonzero(speeds > n0))
+    whole = i_low < 0 and i_high < 0
+    if whole:
+        text = (f"{variant}: within TEa over the whole grid, at least {lo:g}-{hi:g} rpm (operating speed {n0:g} "
+                f"rpm; {', '.join(keys)})")
+    else:
+        def side(limit: float, i: int, bracket: tuple[float, float] | None, end: str) -> str:
+            if i < 0:
+                return f"{limit:g} rpm or {end} (grid end)"
+            return f"{limit:.0f} rpm ({keys[i]} crosses TEa between {bracket[0]:g} and {bracket[1]:g} rpm)"
+
+        text = (f"{variant}: within TEa from {side(low, i_low, br_low, 'lower')} to "
+                f"{side(high, i_high, br_high, 'higher')}; operating speed {n0:g} rpm")
+    return SpeedBand(**base, low_rpm=low, high_rpm=high, low_is_grid_end=i_low < 0, high_is_grid_end=i_high < 0,
+                     status="whole grid" if whole else "band", text=text,
+                     low_indicator=keys[i_low] if i_low >= 0 else "",
+                     high_indicator=keys[i_high] if i_high >= 0 else "",
+                     low_bracket_rpm=br_low, high_bracket_rpm=br_high)
+
+
+BAND_COLUMNS = ("purpose", "selected", "indicators", "low_rpm", "high_rpm", "operating_rpm", "grid_low_rpm",
+                "grid_high_rpm", "text")
+"""The columns of speed_bands.csv (:func:`speed_bands`)."""
+
+
+def _operating_rpm(out: Path, variant: str) -> float:
+    """The input speed [rpm] of the load case of the saved run ``out/variant``."""
+    import json
+
+    meta = out / variant / "run.json"
+    try:
+        return float(json.loads(meta.read_text())["spec"]["load_case"]["input_speed_rpm"])
+    except (OSError, KeyError, TypeError, ValueError):
+        raise ValueError(f"{meta}: no load case input speed to take as the operating speed") from None
+
+
+def speed_bands(out_dir: str | Path, operating_rpm: float | None = None) -> pd.DataFrame | None:
+    """The acceptable speed band (:func:`acceptable_band`) of each purpose of ``out_dir/verdict.csv`` that has
+    indicators of :data:`SPEED_INDICATORS`, from ``out_dir/speed_screening.csv``; writes ``speed_bands.csv`` /
+    ``.parquet`` (columns :data:`BAND_COLUMNS`: purpose, selected, indicators judged over speed (space-separated),
+    low_rpm, high_rpm (empty when there is no band), operating_rpm, grid_low_rpm, grid_high_rpm, text) and returns
+    the table. ``operating_rpm`` [rpm]: None = the load case input speed of the selected variant's saved run
+    (``out_dir/<selected>/run.json``). Returns None, writing nothing, when the folder has no verdict (screened
+    without a reference variant). Raises ValueError when the speed screening was made against another reference
+    than the verdict's (the verdict's reference differs from itself in speed_screening.csv)."""
+    import json
+
+    from flexgear.study.matrix import write_table
+
+    out = Path(out_dir)
+    saved = out / "screening.json"
+    reference = json.loads(saved.read_text()).get("reference", "") if saved.is_file() else ""
+    if not (out / "verdict.csv").is_file() or not reference:
+        return None
+    table = pd.read_csv(out / "speed_screening.csv")
+    ref_rows = table[table.variant == reference]
+    if len(ref_rows) and not np.all(ref_rows.difference.fillna(0.0) == 0.0):
+        raise ValueError(f"{out}: speed_screening.csv was screened against another reference than verdict.csv "
+                         f"({reference})")
+    verdict = pd.read_csv(out / "verdict.csv", usecols=["purpose", "selected", "indicators"], dtype=str,
+                          keep_default_na=False)
+    rows = []
+    for purpose, selected, indicators in verdict.itertuples(index=False):
+        keys = [k for k in indicators.split() if k in SPEED_INDICATORS]
+        if not keys:
+            continue
+        row = dict(purpose=purpose, selected=selected, indicators=" ".join(keys), low_rpm=np.nan, high_rpm=np.nan,
+                   operating_rpm=np.nan, grid_low_rpm=float(table.speed_rpm.min()),
+                   grid_high_rpm=float(table.speed_rpm.max()))
+        if not selected:
+            row["text"] = "no variant selected: no band"
+        elif selected not in set(table.variant):
+            row["text"] = f"{selected}: not in the speed screening: no band"
+        else:
+            n0 = operating_rpm if operating_rpm is not None else _operating_rpm(out, selected)
+            band = acceptable_band(table, selected, keys, n0)
+            row.update(low_rpm=band.low_rpm, high_rpm=band.high_rpm, operating_rpm=band.operating_rpm,
+                       grid_low_rpm=band.grid_low_rpm, grid_high_rpm=band.grid_high_rpm, text=band.text)
+        rows.append(row)
+    bands = pd.DataFrame(rows, columns=list(BAND_COLUMNS))
+    write_table(bands, out / "speed_bands")
+    return bands
