@@ -18,6 +18,9 @@ QUICK_VARIANTS := $(sort $(wildcard model_variants/quick/model*.toml))
 QUICK_ISO_VARIANTS := $(sort $(wildcard model_variants/quick_iso6336/model*.toml))
 QUICK_MM_VARIANTS := $(sort $(wildcard model_variants/quick_mm_reading/model*.toml))
 RESULTS ?= results
+# input speeds [rpm] of the frequency-domain screening over the operating range (±50 % of Table 5's 6000 rpm in
+# steps of 100 rpm; the speed band of each selected variant per purpose, flexgear.study.speed_screening)
+SPEEDS_RPM ?= 3000:9000:100
 # pytest-xdist worker processes of `make test` (the machine's 2 cores; `make test TEST_WORKERS=auto` for all)
 TEST_WORKERS ?= 2
 
@@ -25,8 +28,9 @@ TEST_WORKERS ?= 2
 
 quick: install
 	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
-	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7
-	$(PY) -m flexgear.cli matrix $(QUICK_ISO_VARIANTS) --out $(RESULTS)/quick_iso6336 --reference model7
+	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7 --speeds-rpm $(SPEEDS_RPM)
+	$(PY) -m flexgear.cli matrix $(QUICK_ISO_VARIANTS) --out $(RESULTS)/quick_iso6336 --reference model7 \
+		--speeds-rpm $(SPEEDS_RPM)
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width
 	$(PY) -m flexgear.cli report $(RESULTS)/quick --output reports/screening_report.pdf --westgard-png docs/img/westgard.png \

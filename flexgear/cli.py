@@ -103,6 +103,7 @@ def cmd_matrix(a: argparse.Namespace) -> int:
     table = _with_screening_reason(table, Path(a.out))
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
     print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
+    _print_verdict(Path(a.out))
     if a.speeds_rpm:
         from flexgear.study.speed_screening import screen_speed_range
 
@@ -112,6 +113,21 @@ def cmd_matrix(a: argparse.Namespace) -> int:
             print(f"Westgard: {selection.read_text().splitlines()[0]}")
         print(f"Over the speed range (-> {Path(a.out) / 'speed_screening.txt'}):\n{text}", end="")
     return 0
+
+
+def _print_verdict(out: Path) -> None:
+    """The verdict per purpose of ``out/verdict.csv`` (reference screening), one line each."""
+    import pandas as pd
+
+    path = out / "verdict.csv"
+    if not path.is_file():
+        return
+    print("Verdict per purpose (each indicator alone, |Bias| + 2 CV <= TEa; cheapest acceptable):")
+    for r in pd.read_csv(path, keep_default_na=False).itertuples():
+        deciding = (f"{r.deciding_indicator} {float(r.bias):.3g} {r.unit} (TEa {float(r.tea):g})"
+                    if r.selected else r.reasoning[:160])
+        flag = "" if str(r.resolved) == "True" else " NOT RESOLVED"
+        print(f"  {r.purpose}: {r.selected or 'none'}{flag}; {deciding}")
 
 
 def _with_screening_reason(table: pd.DataFrame, out: Path) -> pd.DataFrame:

@@ -66,6 +66,12 @@ def test_verdict_csv_and_page_one_table_per_purpose(folders):
     assert rows.loc["tooth loads", "selected"] == "model1"
     assert "mean loads none" in verdict_lines(d)[0]
     assert case_difference_lines(d, [o]) == []          # the same selections in both cases
+    pd.DataFrame({"purpose": ["tooth_loads", "vibration"], "selected": ["model1", "model1"],
+                  "low_rpm": [3000.0, 5156.2], "high_rpm": [9000.0, 6290.3], "grid_low_rpm": [3000.0, 3000.0],
+                  "grid_high_rpm": [9000.0, 9000.0]}).to_csv(quick / "speed_bands.csv", index=False)
+    bands = verdict_rows(d, []).set_index("purpose")["speed band"]
+    assert bands["tooth loads"] == "≤ 3000 to ≥ 9000 rpm" and bands["vibration"] == "5156 to 6290 rpm"
+    (quick / "speed_bands.csv").unlink()
     fig = plt.figure(figsize=(11.69, 8.27))
     verdict_page(d, [o], "synthetic case")(fig)          # draws without error
     text = " ".join(t.get_text() for ax in fig.axes for t in ax.texts) + " ".join(t.get_text() for t in fig.texts)

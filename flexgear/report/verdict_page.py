@@ -57,6 +57,8 @@ def _folder_label(d: ReportData) -> str:
 
 
 def _speed_band(d: ReportData, purpose: str) -> str:
+    """The input-speed band [rpm] over which the purpose's selected variant stays within every TEa
+    (``speed_bands.csv``); a side at the grid's end reads as "at least"."""
     bands = _read(d.results_dir / "speed_bands.csv")
     if bands is None or "purpose" not in bands:
         return "not screened"
@@ -64,10 +66,12 @@ def _speed_band(d: ReportData, purpose: str) -> str:
     if row.empty:
         return "–"
     r = row.iloc[0]
-    lo, hi = r.get("low_rpm", math.nan), r.get("high_rpm", math.nan)
-    if not (isinstance(lo, float) and math.isfinite(lo)):
-        return str(r.get("text", "–"))
-    return f"{fmt(lo, 4)}–{fmt(hi, 4)} rpm"
+    lo, hi = float(r.get("low_rpm", math.nan)), float(r.get("high_rpm", math.nan))
+    if not (math.isfinite(lo) and math.isfinite(hi)):
+        return textwrap.shorten(str(r.get("text", "–")), 60)
+    below = "≤ " if lo <= float(r.get("grid_low_rpm", -math.inf)) else ""
+    above = "≥ " if hi >= float(r.get("grid_high_rpm", math.inf)) else ""
+    return f"{below}{lo:.0f} to {above}{hi:.0f} rpm"
 
 
 def case_verdicts(others: list[ReportData]) -> dict[str, dict[str, str]]:
@@ -98,7 +102,8 @@ def verdict_rows(d: ReportData, others: list[ReportData]) -> pd.DataFrame:
                "numerical error": fmt(v.error, 2) + (f" {v.unit}" if v.selected else ""),
                "resolved": "yes" if v.resolved else "NO",
                "CPU time / ref.": fmt(v.time_ratio, 3),
-               "speed band": _speed_band(d, v.purpose) if v.purpose in ("vibration", "tooth_loads") else "–"}
+               "speed band": _speed_band(d, v.purpose) if v.purpose in ("vibration", "tooth_loads", ALL_PURPOSES)
+               else "–"}
         for folder, sel in cases.items():
             row[folder] = sel.get(v.purpose, sel.get("*", "–"))
         rows.append(row)
@@ -227,9 +232,12 @@ def mesh_law_lines(d: ReportData) -> list[str]:
     return lines
 
 
-def _law(d: ReportData) -> str:
-    laws = {((r.meta.get("spec") or {}).get("contact") or {}).get("law", "?") for r in d.runs.values()}
-    return "/".join(sorted(map(str, laws)))
+def _contact(d: ReportData) -> str:
+    """The mesh law and contact stiffness of a folder's runs (two folders of the same contact differ only in
+    their load case)."""
+    keys = {(str(c.get("law", "?")), str(c.get("stiffness", "?")))
+            for c in (((r.meta.get("spec") or {}).get("contact") or {}) for r in d.runs.values())}
+    return "/".join(sorted(f"{law} {k}" for law, k in keys))
 
 
 def _weakest(d: ReportData, variant: str, keys: tuple[str, ...]) -> str:
@@ -246,14 +254,15 @@ def _weakest(d: ReportData, variant: str, keys: tuple[str, ...]) -> str:
 
 
 def case_difference_lines(d: ReportData, others: list[ReportData]) -> list[str]:
-    """Where another folder under the same mesh law selects another variant for a purpose: which indicator
+    """Where another folder under the same mesh law and contact stiffness (another load case) selects another
+    variant for a purpose: which indicator
     differs, and how much, in each case (the cheaper of the two variants' weakest indicator of the purpose)."""
     if d.reference is None:
         return []
     here = {v.purpose: v for v in d.reference.verdicts}
     lines = []
     for o in others:
-        if o.reference is None or _law(o) != _law(d):
+        if o.reference is None or _contact(o) != _contact(d):
             continue
         for v in o.reference.verdicts:
             mine = here.get(v.purpose)
