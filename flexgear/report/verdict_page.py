@@ -333,6 +333,9 @@ def verdict_page(d: ReportData, others: list[ReportData], case_text: str, other_
     table = verdict_rows(d, others)
     notes = [f"This case: {case_text}.", *other_lines]
     if d.reference is not None and d.reference.verdicts:
+        notes += [f"{_SHORT.get(v.purpose, v.purpose)} NOT RESOLVED: within the reference's numerical error (h against "
+                  "h/2) the acceptability of " + "; ".join(v.unresolved_by) + " changes."
+                  for v in d.reference.verdicts if v.unresolved_by and v.purpose != ALL_PURPOSES]
         notes += case_difference_lines(d, others)
         notes += why_lines(d)
         modal = _modal_line(d, {v.purpose: v for v in d.reference.verdicts})

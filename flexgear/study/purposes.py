@@ -52,7 +52,8 @@ class PurposeVerdict:
     ``bias``, ``cv``, ``tea`` and ``error`` are the deciding indicator's, in ``unit``; ``margin`` = (TEa - Bias -
     2 CV) / TEa (fraction; negative: outside the acceptable line); ``time_ratio`` = the selected variant's CPU time
     over the reference's; ``failing``: each cheaper screened variant -> its weakest indicator of the purpose in
-    words; ``zone``: the selected variant's zone for the purpose."""
+    words; ``zone``: the selected variant's zone for the purpose; ``unresolved_by``: the indicators, in words, whose
+    acceptability changes within the numerical error (empty when resolved)."""
 
     purpose: str
     indicators: tuple[str, ...]
@@ -69,6 +70,7 @@ class PurposeVerdict:
     time_ratio: float
     reasoning: str
     failing: tuple[tuple[str, str], ...] = ()
+    unresolved_by: tuple[str, ...] = ()
 
     def row(self) -> dict:
         """The verdict as one row of ``verdict.csv`` (VERDICT_COLUMNS, plus zone, margin, error, reasoning)."""
@@ -194,7 +196,8 @@ def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.
     return PurposeVerdict(purpose, keys, selected, str(deciding["indicator"]), float(deciding["bias"]),
                           float(deciding["cv"]), float(deciding["tea"]), str(deciding["unit"]),
                           float(deciding["margin"]), lines.zone_names[rank],
-                          float(errors.get(deciding["indicator"], math.nan)), resolved, ratio, why, tuple(failing))
+                          float(errors.get(deciding["indicator"], math.nan)), resolved, ratio, why, tuple(failing),
+                          tuple(flips))
 
 
 def judge_purposes(indicators: pd.DataFrame, table: pd.DataFrame, purposes: Mapping[str, tuple[str, ...]],
