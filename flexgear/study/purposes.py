@@ -29,12 +29,14 @@ import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 
+import numpy as np
 import pandas as pd
 
 from flexgear.study.indicators import ALL_INDICATORS
-from flexgear.study.selection import DecisionLines
+from flexgear.study.selection import DecisionLines, Selection, variant_names
 
-__all__ = ["ALL_PURPOSES", "PurposeVerdict", "indicator_ranks", "purpose_zones", "judge_purposes", "verdict_table",
+__all__ = ["ALL_PURPOSES", "RULE_PER_PURPOSE", "STUDY_PURPOSE", "PurposeVerdict", "mark_resolved",
+           "purpose_selection", "indicator_ranks", "purpose_zones", "judge_purposes", "verdict_table",
            "VERDICT_COLUMNS", "static_te_split", "StaticTeSplit"]
 
 ALL_PURPOSES = "all purposes"
@@ -247,3 +249,38 @@ def static_te_split(total_m: float, outer_deflection_m: float, inner_deflection_
     meshes = (outer_deflection_m + inner_deflection_m) / math.cos(base_helix_angle_rad)
     return StaticTeSplit(float(total_m), float(meshes))
 
+
+STUDY_PURPOSE = "study composite"
+"""The ``purpose`` of the study mode's five indicators: judged together, as the study's composite point."""
+
+RULE_PER_PURPOSE = "cheapest_acceptable_per_purpose"
+"""The reference mode's rule (flexgear.study.purposes): each indicator alone, the cheapest acceptable variant per
+purpose, overall the cheapest acceptable for every purpose."""
+
+
+def mark_resolved(table: pd.DataFrame, indicators: pd.DataFrame, errors: dict[str, float], m1: float) -> None:
+    """Mark each screened variant ``resolved`` when no indicator's acceptability (|Bias| + m1 CV <= TEa) changes as
+    its Bias moves by -/+ the reference's numerical error of that indicator (``errors``, the indicator's unit)."""
+    ok = table["status"] == "ok"
+    resolved = []
+    for r in table.itertuples():
+        ind = indicators[indicators["variant"] == r.variant]
+        flips = [i for i in ind.itertuples() if math.isfinite(errors.get(i.indicator, math.nan))
+                 and (i.bias + errors[i.indicator] + m1 * i.cv <= i.tea)
+                 != (max(i.bias - errors[i.indicator], 0.0) + m1 * i.cv <= i.tea)]
+        resolved.append(not flips)
+    table["resolved"] = np.where(ok, resolved, True)
+
+
+def purpose_selection(table: pd.DataFrame, verdicts: list[PurposeVerdict], reference: str) -> Selection:
+    """The reference mode's overall selection: the :data:`ALL_PURPOSES` verdict, its reasoning followed by each
+    purpose's."""
+    notes = "".join(f" Not screened ({status}): {variant_names(table[table['status'] == status])}."
+                    for status in ("unsettled", "failed") if (table["status"] == status).any())
+    if not verdicts:
+        return Selection(None, RULE_PER_PURPOSE, "No variant was screened, nothing to select." + notes)
+    overall = verdicts[-1]
+    head = overall.reasoning.replace(f"{ALL_PURPOSES}:", "For every purpose:", 1)
+    per = " ".join(v.reasoning for v in verdicts[:-1])
+    return Selection(overall.selected, RULE_PER_PURPOSE, f"{head} Per purpose: {per}{notes}",
+                     all(v.resolved for v in verdicts))

@@ -54,8 +54,15 @@ from flexgear.results import RunResult
 from flexgear.settling import SettleRule, Settling, settled_start
 from flexgear.spec import ScreeningSettings
 from flexgear.study.indicators import STUDY_INDICATORS, indicator_segments, on_scale, segment_slices
-from flexgear.study.purposes import ALL_PURPOSES, PurposeVerdict, judge_purposes
-from flexgear.study.selection import DecisionLines, Selection, select_variant, variant_names
+from flexgear.study.purposes import (
+    ALL_PURPOSES,
+    STUDY_PURPOSE,
+    PurposeVerdict,
+    judge_purposes,
+    mark_resolved,
+    purpose_selection,
+)
+from flexgear.study.selection import DecisionLines, Selection, select_variant
 
 __all__ = ["INDICATORS", "DecisionLines", "Window", "IndicatorResult", "VariantScreening", "Selection",
            "analysis_window", "sample_means", "bias_pct", "cv_pct", "sigma_metric", "indicator_samples", "Screening",
@@ -314,20 +321,6 @@ def numerical_error(reference: RunResult, settings: ScreeningSettings) -> tuple[
     return sum(getattr(tol, k).weight / total * e / getattr(tol, k).tea * 100.0 for k, e in errors.items()), errors
 
 
-def _resolution(table: pd.DataFrame, indicators: pd.DataFrame, errors: dict[str, float], m1: float) -> None:
-    """Mark each screened variant ``resolved`` when no indicator's acceptability (|Bias| + m1 CV <= TEa) changes as
-    its Bias moves by -/+ the reference's numerical error of that indicator (``errors``, the indicator's unit)."""
-    ok = table["status"] == "ok"
-    resolved = []
-    for r in table.itertuples():
-        ind = indicators[indicators["variant"] == r.variant]
-        flips = [i for i in ind.itertuples() if math.isfinite(errors.get(i.indicator, math.nan))
-                 and (i.bias + errors[i.indicator] + m1 * i.cv <= i.tea)
-                 != (max(i.bias - errors[i.indicator], 0.0) + m1 * i.cv <= i.tea)]
-        resolved.append(not flips)
-    table["resolved"] = np.where(ok, resolved, True)
-
-
 class ReferenceNotUsable(ValueError):
     """The screening's reference did not finish or has not settled: nothing can be screened against it."""
 
@@ -364,14 +357,6 @@ def reference_means(results: list[RunResult], name: str, settings: ScreeningSett
     _, samples = indicator_samples(ref, settings, window=window)
     tol = settings.reference_indicators
     return {k: float(np.mean(on_scale(k, getattr(tol, k).scale, v, getattr(tol, k).floor))) for k, v in samples.items()}
-
-
-STUDY_PURPOSE = "study composite"
-"""The ``purpose`` of the study mode's five indicators: judged together, as the study's composite point."""
-
-RULE_PER_PURPOSE = "cheapest_acceptable_per_purpose"
-"""The reference mode's rule (flexgear.study.purposes): each indicator alone, the cheapest acceptable variant per
-purpose, overall the cheapest acceptable for every purpose."""
 
 
 def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None) -> Screening:
@@ -438,24 +423,10 @@ def screen(results: Iterable[RunResult], settings: ScreeningSettings, reference:
     table["zone"] = [lines.zone_names[int(r)] if o else z for r, o, z in zip(table["zone_rank"], ok, table["zone"],
                                                                              strict=True)]
     table["error_pct"] = np.where(ok, error, math.nan)
-    _resolution(table, indicators, errors, lines.multipliers[0])
-    selection = _purpose_selection(table, verdicts, ref_name)
+    mark_resolved(table, indicators, errors, lines.multipliers[0])
+    selection = purpose_selection(table, verdicts, ref_name)
     table["selected"] = table["variant"] == selection.variant
     return Screening(table, indicators, selection, lines, ref_name, tuple(verdicts), zones)
-
-
-def _purpose_selection(table: pd.DataFrame, verdicts: list[PurposeVerdict], reference: str) -> Selection:
-    """The reference mode's overall selection: the :data:`ALL_PURPOSES` verdict, its reasoning followed by each
-    purpose's."""
-    notes = "".join(f" Not screened ({status}): {variant_names(table[table['status'] == status])}."
-                    for status in ("unsettled", "failed") if (table["status"] == status).any())
-    if not verdicts:
-        return Selection(None, RULE_PER_PURPOSE, "No variant was screened, nothing to select." + notes)
-    overall = verdicts[-1]
-    head = overall.reasoning.replace(f"{ALL_PURPOSES}:", "For every purpose:", 1)
-    per = " ".join(v.reasoning for v in verdicts[:-1])
-    return Selection(overall.selected, RULE_PER_PURPOSE, f"{head} Per purpose: {per}{notes}",
-                     all(v.resolved for v in verdicts))
 
 
 def screening_tables(results: Iterable[RunResult], settings: ScreeningSettings, reference: str | None = None
