@@ -66,6 +66,8 @@ def _speed_band(d: ReportData, purpose: str) -> str:
     if row.empty:
         return "–"
     r = row.iloc[0]
+    if d.reference is not None and str(r.get("selected", "")) == d.reference.reference:
+        return "the reference (no comparison)"
     lo, hi = float(r.get("low_rpm", math.nan)), float(r.get("high_rpm", math.nan))
     if not (math.isfinite(lo) and math.isfinite(hi)):
         return textwrap.shorten(str(r.get("text", "–")), 60)
