@@ -140,12 +140,13 @@ def _profiles(spec: GearboxSpec) -> None:
     for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
         if _profile_fits(gear, coefficient * gear.normal_module):
             continue
+        shift = f"{round(gear.shift, 3) + 0.0:.3f}"  # + 0.0: no "-0.000"
         if coefficient > 0 and _profile_fits(gear, 0.0):
             c_max = _largest(lambda c, g=gear: _profile_fits(g, c * g.normal_module), 0.0, coefficient)
             raise SpecError(spec.source, "gears_assumed.root_fillet_coefficient",
                             f"the {name}'s root fillets (radius {coefficient * gear.normal_module / _MM:.3f} mm) "
-                            f"do not fit in its tooth space (profile shift x = {gear.shift:.3f}); expected "
-                            f"< {c_max:.4f}", coefficient)
+                            f"do not fit in its tooth space (profile shift x = {shift}); expected < {c_max:.4f}",
+                            coefficient)
         # the flanks meet above the root circle: a smaller dedendum raises an external gear's root circle and
         # lowers the ring's, into the wider part of the space
         def fits(dedendum: float, g: Gear = gear) -> bool:
@@ -154,8 +155,8 @@ def _profiles(spec: GearboxSpec) -> None:
         lowest = next(f.metadata["lo"] for f in dataclasses.fields(a) if f.name == "dedendum_coefficient")
         hint = f"< {_largest(fits, lowest, a.dedendum_coefficient):.4f}" if fits(lowest) else "a smaller value"
         raise SpecError(spec.source, "gears_assumed.dedendum_coefficient",
-                        f"the {name}'s tooth spaces close above its root circle (profile shift x = "
-                        f"{gear.shift:.3f}, no room for the root fillets); expected {hint}", a.dedendum_coefficient)
+                        f"the {name}'s tooth spaces close above its root circle (profile shift x = {shift}, no room "
+                        f"for the root fillets); expected {hint}", a.dedendum_coefficient)
 
 
 def _value(spec: GearboxSpec, dotted: str) -> object:

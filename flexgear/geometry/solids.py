@@ -11,8 +11,9 @@
     helical spine turns the section at the prism's twist rate; netgen.occ's ``twist`` argument is
     not implemented), or of a straight extrusion of the section for spur teeth (twist 0: a sweep
     without auxiliary spine is a different OCC algorithm that leaves the ends open); one lateral
-    face per outline curve (:func:`outline_edge_count`); for a circle one cylinder face per run of
-    prisms with the same radius;
+    face per outline curve (:func:`outline_edge_count`); a long or steep helix is swept in several
+    consecutive sweeps, each within 0.1 um of the exact surfaces (:func:`sweep_segments`; the
+    study's gears take one); for a circle one cylinder face per run of prisms with the same radius;
   - planar faces at both ends and wherever the section changes: the annulus between the two
     boundary loops that differ (e.g. toothed outline and relief-groove circle);
   - the lower half of a double helix is the mirror image (z -> -z) of the upper half (same lead,
@@ -38,7 +39,9 @@ import numpy as np
 from flexgear.geometry.layout import ComponentLayout, Prism
 from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
 
-__all__ = ["FLANK_POINTS", "outline_edge_count", "section_face", "component_solid", "occ_mass_properties"]
+__all__ = [
+    "FLANK_POINTS", "outline_edge_count", "sweep_segments", "section_face", "component_solid", "occ_mass_properties",
+]
 
 FLANK_POINTS = 25
 """Roll-angle points of the spline through each involute flank. Measured deviation of the OCC
@@ -47,6 +50,14 @@ spline from the exact involute: 25 points 0.006 um (planet, the worst gear), 10 
 _HELIX_POINTS = 16
 """Points of the spline through the auxiliary helix that steers the sweep (flank lead error of
 the meshed sun/planet < 1e-5 relative, tests/test_geometry.py)."""
+_SWEEP_TOLERANCE = 1e-7
+"""Largest deviation [m] of a helical sweep's faces from the exact twisted outline (:func:`sweep_segments`)."""
+_SWEEP_ERROR = 2.6e-3
+"""Measured e / (r theta^4) of netgen's sweep (OCC's pipe shell at its default approximation tolerance),
+e the largest distance of the second-order mesh's lateral surface nodes from the exact twisted outline, r the
+outer radius of the toothed band and theta the twist angle of one sweep: 2.6e-3 for the study's sun and
+planet (theta = 0.136 and 0.133 rad, e = 0.049 and 0.044 um) and for a 13-tooth sun of m_n = 10 mm,
+beta = 30 deg (theta = 0.46 rad, e = 9.4 um; 0.59, 0.12, 0.04 um in 2, 3, 4 sweeps)."""
 _OVERLAP = 1e-3
 """Axial overlap [m] of the bolt-hole cutters beyond their prism (no material there: no coplanar booleans)."""
 _Z_TOL = 1e-12
@@ -173,31 +184,61 @@ class _Boundary:
     def _sweep(self, z0: float, z1: float, twist: float) -> tuple[list, object, object]:
         """Lateral faces and end wires of the toothed outline from z0 to z1 at ``twist`` [rad/m].
 
-        Spur teeth (twist 0) are a straight extrusion of the section face. Helical teeth are a sweep
-        along the axis whose auxiliary helical spine, at radius r_b / 2, turns the section by
-        ``twist * z``; the section at z0 is the outline rotated by ``twist * z0``.
+        Spur teeth (twist 0) are a straight extrusion of the section face. Helical teeth are swept along
+        the axis, in :func:`sweep_segments` consecutive sweeps; in each an auxiliary helical spine, at
+        radius r_b / 2, turns the section by ``twist * z``. The section at z0 is the outline rotated by
+        ``twist * z0``; each further sweep starts from the previous one's end wire, so that neighbouring
+        sweeps share their edges.
         """
         profile = self.layout.profile
         face = section_face(profile, z0, self.flank_points)
+        expected = outline_edge_count(profile)
         if twist == 0.0:
-            plug = face.Extrude(occ.Vec(0, 0, z1 - z0))
+            ends = [z0, z1]
+            plugs = [face.Extrude(occ.Vec(0, 0, z1 - z0))]
         else:
             face = face.Rotate(occ.Axis(occ.Pnt(0, 0, 0), occ.Z), math.degrees(twist * z0))
-            spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, z0), occ.Pnt(0, 0, z1))])
-            r_aux = 0.5 * profile.gear.base_radius
-            helix = [occ.Pnt(r_aux * math.cos(twist * z), r_aux * math.sin(twist * z), float(z))
-                     for z in np.linspace(z0, z1, _HELIX_POINTS)]
-            # netgen's Pipe with an auxiliary spine closes the ends (MakeSolid): the caps' wires are the
-            # sweep's own edges
-            plug = occ.Pipe(spine, face.wires[0], auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
-        caps = sorted((f for f in plug.faces if _flat(f)), key=lambda f: f.center.z)
-        lateral = [f for f in plug.faces if not _flat(f)]
-        expected = outline_edge_count(profile)
-        if len(caps) != 2 or len(lateral) != expected:
-            kind = "extrusion" if twist == 0.0 else "helical sweep"
-            raise RuntimeError(f"{kind} of the {profile.gear.teeth}-tooth outline gave {len(caps)} caps and "
-                               f"{len(lateral)} lateral faces (expected 2 and {expected})")
-        return lateral, caps[0].wires[0], caps[1].wires[0]
+            gear = profile.gear
+            n = sweep_segments(twist, z1 - z0, max(gear.tip_radius, gear.root_radius))
+            ends = list(np.linspace(z0, z1, n + 1))
+            wire, plugs = face.wires[0], []
+            for a, b in zip(ends[:-1], ends[1:], strict=True):
+                plugs.append(self._pipe(wire, float(a), float(b), twist))
+                wire = sorted((f for f in plugs[-1].faces if _flat(f)), key=lambda f: f.center.z)[-1].wires[0]
+        lateral, bottom, top = [], None, None
+        for (a, b), plug in zip(zip(ends[:-1], ends[1:], strict=True), plugs, strict=True):
+            caps = sorted((f for f in plug.faces if _flat(f)), key=lambda f: f.center.z)
+            sides = [f for f in plug.faces if not _flat(f)]
+            if len(caps) != 2 or len(sides) != expected:
+                kind = "extrusion" if twist == 0.0 else "helical sweep"
+                raise RuntimeError(f"{kind} of the {profile.gear.teeth}-tooth outline from z = {a:.6g} to {b:.6g} m "
+                                   f"gave {len(caps)} caps and {len(sides)} lateral faces (expected 2 and {expected})")
+            lateral += sides
+            bottom = bottom or caps[0].wires[0]
+            top = caps[1].wires[0]
+        return lateral, bottom, top
+
+    def _pipe(self, wire, z0: float, z1: float, twist: float):
+        """The closed sweep of ``wire`` (the outline in the plane z0) to z1, turned at ``twist`` [rad/m]."""
+        spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, z0), occ.Pnt(0, 0, z1))])
+        r_aux = 0.5 * self.layout.profile.gear.base_radius
+        helix = [occ.Pnt(r_aux * math.cos(twist * z), r_aux * math.sin(twist * z), float(z))
+                 for z in np.linspace(z0, z1, _HELIX_POINTS)]
+        # netgen's Pipe with an auxiliary spine closes the ends (MakeSolid): the caps' wires are the sweep's own
+        # edges
+        return occ.Pipe(spine, wire, auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
+
+
+def sweep_segments(twist: float, length: float, outer_radius: float) -> int:
+    """Number of consecutive sweeps of a helical toothed prism, so that its faces stay within
+    :data:`_SWEEP_TOLERANCE` of the exact twisted outline.
+
+    A sweep that turns the section by theta = |twist| L deviates from the exact surfaces by about
+    e = :data:`_SWEEP_ERROR` r theta^4 (r: ``outer_radius`` [m] of the toothed band); n sweeps of theta / n each
+    keep e <= tolerance for n >= theta (C r / tolerance)^(1/4). ``twist`` [rad/m], ``length`` [m].
+    """
+    theta = abs(twist) * length
+    return max(1, math.ceil(theta * (_SWEEP_ERROR * outer_radius / _SWEEP_TOLERANCE) ** 0.25 - 1e-9))
 
 
 def _band(loop: _Loop | None, layout: ComponentLayout) -> tuple[float, float]:
