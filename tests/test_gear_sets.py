@@ -167,9 +167,13 @@ def test_steep_helices_are_swept_in_several_sweeps_and_the_study_in_one(tmp_path
 
 
 def _with(case: GearSetCase, **fields) -> dict:
-    """The gearbox file of ``case`` with single fields changed (looked up in gears_assumed, components_assumed)."""
+    """The gearbox file of ``case`` with single fields changed (looked up in gears_assumed, components_assumed;
+    ``coarse_<field>`` in meshing_assumed.coarse)."""
     data = gear_set_gearbox(case)
     for key, value in fields.items():
+        if key.startswith("coarse_"):
+            data["meshing_assumed"]["coarse"][key.removeprefix("coarse_")] = value
+            continue
         table = next(t for t in ("gears_assumed", "components_assumed") if key in data[t])
         data[table][key] = value
     return data
@@ -187,6 +191,8 @@ REFUSED = {
                                          "gears_assumed.operating_centre_distance_mm", ("51.000 mm", "56.382 mm")),
     "groove_depth_zero": (_with(SPUR, relief_groove_depth_mm=0.0), "components_assumed.relief_groove_depth_mm",
                           ("touches the tooth roots",)),
+    "tooth_elements_coarser_than_two_modules": (_with(SPUR, coarse_tooth_size_mm=7.0),
+                                                "meshing_assumed.coarse.tooth_size_mm", ("<= 6.000 mm",)),
     "single_helix_bore_in_the_groove": (_with(SPUR, sun_bore_diameter_mm=63.9, input_shaft_outer_diameter_mm=40.0),
                                         "components_assumed.sun_bore_diameter_mm", ("relief groove",)),
 }

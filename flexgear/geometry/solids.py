@@ -36,7 +36,7 @@ from dataclasses import dataclass
 import netgen.occ as occ
 import numpy as np
 
-from flexgear.geometry.layout import ComponentLayout, Prism
+from flexgear.geometry.layout import ComponentLayout, Prism, sweep_segments
 from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
 
 __all__ = [
@@ -50,14 +50,6 @@ spline from the exact involute: 25 points 0.006 um (planet, the worst gear), 10 
 _HELIX_POINTS = 16
 """Points of the spline through the auxiliary helix that steers the sweep (flank lead error of
 the meshed sun/planet < 1e-5 relative, tests/test_geometry.py)."""
-_SWEEP_TOLERANCE = 1e-7
-"""Largest deviation [m] of a helical sweep's faces from the exact twisted outline (:func:`sweep_segments`)."""
-_SWEEP_ERROR = 2.6e-3
-"""Measured e / (r theta^4) of netgen's sweep (OCC's pipe shell at its default approximation tolerance),
-e the largest distance of the second-order mesh's lateral surface nodes from the exact twisted outline, r the
-outer radius of the toothed band and theta the twist angle of one sweep: 2.6e-3 for the study's sun and
-planet (theta = 0.136 and 0.133 rad, e = 0.049 and 0.044 um) and for a 13-tooth sun of m_n = 10 mm,
-beta = 30 deg (theta = 0.46 rad, e = 9.4 um; 0.59, 0.12, 0.04 um in 2, 3, 4 sweeps)."""
 _OVERLAP = 1e-3
 """Axial overlap [m] of the bolt-hole cutters beyond their prism (no material there: no coplanar booleans)."""
 _Z_TOL = 1e-12
@@ -227,18 +219,6 @@ class _Boundary:
         # netgen's Pipe with an auxiliary spine closes the ends (MakeSolid): the caps' wires are the sweep's own
         # edges
         return occ.Pipe(spine, wire, auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
-
-
-def sweep_segments(twist: float, length: float, outer_radius: float) -> int:
-    """Number of consecutive sweeps of a helical toothed prism, so that its faces stay within
-    :data:`_SWEEP_TOLERANCE` of the exact twisted outline.
-
-    A sweep that turns the section by theta = |twist| L deviates from the exact surfaces by about
-    e = :data:`_SWEEP_ERROR` r theta^4 (r: ``outer_radius`` [m] of the toothed band); n sweeps of theta / n each
-    keep e <= tolerance for n >= theta (C r / tolerance)^(1/4). ``twist`` [rad/m], ``length`` [m].
-    """
-    theta = abs(twist) * length
-    return max(1, math.ceil(theta * (_SWEEP_ERROR * outer_radius / _SWEEP_TOLERANCE) ** 0.25 - 1e-9))
 
 
 def _band(loop: _Loop | None, layout: ComponentLayout) -> tuple[float, float]:
