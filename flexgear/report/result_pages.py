@@ -107,12 +107,13 @@ def _diagram_page(s: Screening, title: str, note: str, why: str = "") -> Page:
             markers = "No marker: no screened variant (why: below)."
         else:
             markers = "No marker: " + (why or "no screened variant") + "."
-        text_block(fig.add_axes([0.72, 0.2, 0.27, 0.68]), f"Markers: variant: Bias, CV [{s.lines.unit}], zone\n"
-                   + markers + f"\n\nSelected: {s.selection.variant or 'none'}. {s.selection.reasoning}",
-                   width=56, fontsize=7.2)
-        text_block(fig.add_axes([0.07, 0.04, 0.9, 0.1]), note + " Axes as in the study (Bias on x, CV on y). "
-                   "Lines Bias + m·CV = TEa; a point on a line belongs to the better zone. Markers closer than a "
-                   "few points share one label.", width=175, fontsize=8)
+        head, labels = (("Outside the acceptable line [% of each indicator's TEa]", "One marker per variant and "
+                         "indicator, shape per purpose.") if s.reference else (f"Markers: variant: Bias, CV "
+                         f"[{s.lines.unit}], zone", "Markers closer than a few points share one label."))
+        text_block(fig.add_axes([0.72, 0.2, 0.27, 0.68]), f"{head}\n{markers}\n\nSelected: "
+                   f"{s.selection.variant or 'none'}. {s.selection.reasoning}", width=56, fontsize=7.2)
+        text_block(fig.add_axes([0.07, 0.04, 0.9, 0.1]), f"{note} Axes as in the study (Bias on x, CV on y). Lines "
+                   f"Bias + m·CV = TEa; a point on a line belongs to the better zone. {labels}", width=175, fontsize=8)
     return (title, draw)
 
 
@@ -134,7 +135,8 @@ def diagram_pages(d: ReportData) -> list[Page]:
         name = d.reference.reference
         pages.append(_diagram_page(d.reference, f"Westgard decision diagram against the reference {name}: "
                                    "dynamic indicators", "Each indicator's Bias and CV in % of its own TEa "
-                                   "([screening.reference_indicators]), weighted; the reference sits on the CV axis.",
+                                   "([screening.reference_indicators]), judged alone; the reference sits on the CV "
+                                   "axis.",
                                    nothing_screened_reason(d.results_dir, d.runs, d.reference)))
     elif d.refused:
         pages.append(_refused_page(d))
