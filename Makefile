@@ -61,8 +61,10 @@ meshes: install
 	$(PY) -m flexgear.cli meshes --level default --no-reduce
 
 matrix: install
-	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7 --t-end settled
-	$(PY) -m flexgear.cli matrix $(ISO_VARIANTS) --out $(RESULTS)/full_iso6336 --reference model7 --t-end settled
+	$(PY) -m flexgear.cli matrix $(VARIANTS) --out $(RESULTS)/full --reference model7 --t-end settled \
+		--speeds-rpm $(SPEEDS_RPM)
+	$(PY) -m flexgear.cli matrix $(ISO_VARIANTS) --out $(RESULTS)/full_iso6336 --reference model7 --t-end settled \
+		--speeds-rpm $(SPEEDS_RPM)
 	$(PY) -m flexgear.cli lpm model_variants/gearbox.toml --out $(RESULTS)/full --t-end settled
 
 # the study's contact stiffness read as N/mm^1.5 (ADAMS models in mm): the quick matrix and the lumped model;
