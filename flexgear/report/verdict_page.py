@@ -33,7 +33,7 @@ from flexgear.study.indicators import ALL_INDICATORS
 from flexgear.study.purposes import ALL_PURPOSES, PurposeVerdict, static_te_split
 
 __all__ = ["verdict_page", "verdict_lines", "verdict_rows", "why_lines", "mesh_law_lines", "case_verdicts",
-           "static_te_lines", "case_difference_lines"]
+           "static_te_lines", "case_difference_lines", "band_difference_lines"]
 
 
 _SHORT = {"mean_loads": "mean loads", "tooth_loads": "tooth loads", "vibration": "vibration",
@@ -282,6 +282,30 @@ def case_difference_lines(d: ReportData, others: list[ReportData]) -> list[str]:
     return lines
 
 
+def band_difference_lines(d: ReportData, others: list[ReportData]) -> list[str]:
+    """Where another folder of the same contact selects the same variant for a purpose but its speed band differs:
+    both bands, and why they can (the frequency-domain models are linearised at the gears' angle at the end of
+    each case's ramp; a flexible gear's contact columns turn with that angle)."""
+    if d.reference is None:
+        return []
+    lines = []
+    for o in others:
+        if o.reference is None or _contact(o) != _contact(d):
+            continue
+        theirs = {v.purpose: v.selected for v in o.reference.verdicts}
+        for v in d.reference.verdicts:
+            if v.purpose == ALL_PURPOSES or v.selected is None or theirs.get(v.purpose) != v.selected:
+                continue
+            here, there = _speed_band(d, v.purpose), _speed_band(o, v.purpose)
+            if "–" in (here, there) or "not screened" in (here, there) or here == there:
+                continue
+            lines.append(f"{_SHORT.get(v.purpose, v.purpose)} speed band of {v.selected}: {here} here, {there} in "
+                         f"{_folder_label(o)}. NOT RESOLVED over speed: the two cases' variant files differ only in "
+                         "their load case, whose ramp time sets the gears' angle at which the frequency-domain models "
+                         "are linearised (flexgear.modal.linearize, t* = the ramp time).")
+    return lines
+
+
 def static_te_lines(d: ReportData) -> list[str]:
     """The transmission error beside its verdict: the reference's amplitudes at the judged mesh harmonics, and each
     variant's mean loaded TE against the reference's (a static offset, reported, not judged)."""
@@ -339,6 +363,7 @@ def verdict_page(d: ReportData, others: list[ReportData], case_text: str, other_
                   "h/2) the acceptability of " + "; ".join(v.unresolved_by) + " changes."
                   for v in d.reference.verdicts if v.unresolved_by and v.purpose != ALL_PURPOSES]
         notes += case_difference_lines(d, others)
+        notes += band_difference_lines(d, others)
         notes += why_lines(d)
         modal = _modal_line(d, {v.purpose: v for v in d.reference.verdicts})
         if modal:
