@@ -12,7 +12,13 @@ import pytest
 from synthetic import GEARBOX, fake_runner
 
 from flexgear.report.data import gather
-from flexgear.report.verdict_page import case_difference_lines, verdict_lines, verdict_page, verdict_rows
+from flexgear.report.verdict_page import (
+    band_difference_lines,
+    case_difference_lines,
+    verdict_lines,
+    verdict_page,
+    verdict_rows,
+)
 from flexgear.study.matrix import run_matrix
 from flexgear.study.purposes import VERDICT_COLUMNS
 
@@ -71,7 +77,14 @@ def test_verdict_csv_and_page_one_table_per_purpose(folders):
                   "grid_high_rpm": [9000.0, 9000.0]}).to_csv(quick / "speed_bands.csv", index=False)
     bands = verdict_rows(d, []).set_index("purpose")["speed band"]
     assert bands["tooth loads"] == "≤ 3000 to ≥ 9000 rpm" and bands["vibration"] == "5156 to 6290 rpm"
+    pd.DataFrame({"purpose": ["tooth_loads", "vibration"], "selected": ["model1", "model1"],
+                  "low_rpm": [3000.0, 5500.0], "high_rpm": [9000.0, 6290.3], "grid_low_rpm": [3000.0, 3000.0],
+                  "grid_high_rpm": [9000.0, 9000.0]}).to_csv(full / "speed_bands.csv", index=False)
+    moved = band_difference_lines(d, [o])          # the same variant, another band in the other load case
+    assert len(moved) == 1 and moved[0].startswith("vibration speed band of model1: 5156 to 6290 rpm here, 5500")
+    assert "NOT RESOLVED over speed" in moved[0]
     (quick / "speed_bands.csv").unlink()
+    (full / "speed_bands.csv").unlink()
     fig = plt.figure(figsize=(11.69, 8.27))
     verdict_page(d, [o], "synthetic case")(fig)          # draws without error
     text = " ".join(t.get_text() for ax in fig.axes for t in ax.texts) + " ".join(t.get_text() for t in fig.texts)
