@@ -147,23 +147,50 @@ def test_gear_builds_its_solid_and_coarse_mesh(tmp_path, cache, name, component)
     assert len(np.unique(half_pitch % (2 * layout.gear.teeth))) == 2 * layout.gear.teeth
 
 
-def test_steep_helices_are_swept_in_several_sweeps_and_the_study_in_one(tmp_path):
-    """The 13-tooth sun of m_n = 10 mm, beta = 30 deg turns 0.31 rad over its face: three sweeps (one sweep
-    would leave its faces about 2 um off the involute helicoid, 2.6e-3 r theta^4); the study's gears turn at most
-    0.136 rad per helix half and keep one sweep each (their solids unchanged)."""
-    from flexgear.geometry.layout import component_layout
-    from flexgear.geometry.solids import sweep_segments
+def _sweeps(spec) -> list:
+    """flexgear.geometry.layout.helix_sweep of the toothed prism of sun, planet and ring."""
+    from flexgear.geometry.layout import component_layout, helix_sweep
 
-    def segments(spec, component: str) -> int:
+    out = []
+    for component in ("sun", "planet", "ring"):
         layout = component_layout(spec, component)
         prism = next(q for q in layout.prisms if q.section.gear)
-        gear = layout.gear
-        return sweep_segments(prism.twist, prism.length, max(gear.tip_radius, gear.root_radius))
+        out.append(helix_sweep(prism.twist, prism.length, layout.profile))
+    return out
+
+
+def test_steep_helices_are_swept_precisely_and_the_study_as_before(tmp_path):
+    """The 13-tooth sun of m_n = 10 mm, beta = 30 deg turns 0.31 rad over its face: one sweep in metres would leave
+    its faces about 2 um off the involute helicoid (2.6e-3 r theta^4), so it is swept in millimetres; the study's
+    gears (at most 0.136 rad per helix half, every outline curve >= 1.2 mm) keep their sweep in metres."""
+    from flexgear.geometry.layout import HelixSweep
 
     steep = _load(tmp_path, "single_13_17_47_m10_b30_a20")
-    assert segments(steep, "sun") == 3
-    study = load_gearbox(VARIANTS / "gearbox.toml")
-    assert [segments(study, c) for c in ("sun", "planet", "ring")] == [1, 1, 1]
+    assert _sweeps(steep)[0] == HelixSweep(1, 1000.0)
+    assert _sweeps(load_gearbox(VARIANTS / "gearbox.toml")) == [HelixSweep(1, 1.0)] * 3
+
+
+def test_a_short_radial_flank_is_swept_precisely(tmp_path, cache):
+    """24/30/84, m_n 3 mm, beta 10 deg, alpha_n 20 deg: the planet's fillet meets its flank 26 um below the base
+    circle, a radial flank too short for a sweep in metres (OCC's tolerance there is 0.1 mm; the sweep failed). It
+    is swept in millimetres: one solid whose volume integrals match the exact ones."""
+    from netgen.occ import OCCGeometry
+
+    from flexgear.fe.mesh import component_brep
+    from flexgear.geometry.layout import HelixSweep, exact_mass_properties, gear_profiles
+    from flexgear.geometry.solids import occ_mass_properties
+
+    path = tmp_path / "gearbox.toml"
+    path.write_text(to_toml(_with(dataclasses.replace(SPUR, helix_deg=10.0))))
+    spec = load_gearbox(path)
+    assert dict(gear_profiles(spec)["planet"].outline_curves())["radial flank"] == pytest.approx(25.9e-6, abs=1e-7)
+    assert _sweeps(spec)[1] == HelixSweep(1, 1000.0)
+    shape = OCCGeometry(str(component_brep(spec, "planet"))).shape
+    mass, _, inertia = occ_mass_properties(shape, spec.material_assumed.density_kg_m3)
+    exact = exact_mass_properties(spec, "planet")
+    assert len(shape.solids) == 1
+    assert mass == pytest.approx(exact.mass, rel=1e-6)
+    assert inertia[2, 2] == pytest.approx(exact.inertia[2, 2], rel=1e-6)
 
 
 def _with(case: GearSetCase, **fields) -> dict:
@@ -193,6 +220,9 @@ REFUSED = {
                           ("touches the tooth roots",)),
     "tooth_elements_coarser_than_two_modules": (_with(SPUR, coarse_tooth_size_mm=7.0),
                                                 "meshing_assumed.coarse.tooth_size_mm", ("<= 6.000 mm",)),
+    "radial_flank_sliver": (_with(dataclasses.replace(SPUR, helix_deg=10.0), root_fillet_coefficient=0.308),
+                            "gears_assumed.root_fillet_coefficient",
+                            ("planet's radial flank is 2.4 um long", "< 0.304", "> 0.308")),
     "single_helix_bore_in_the_groove": (_with(SPUR, sun_bore_diameter_mm=63.9, input_shaft_outer_diameter_mm=40.0),
                                         "components_assumed.sun_bore_diameter_mm", ("relief groove",)),
 }

@@ -15,6 +15,8 @@ field that causes the problem and what is allowed:
   :func:`flexgear.geometry.profile.tooth_profile` can be built): the field named is
   ``root_fillet_coefficient`` with the largest value that fits, or ``dedendum_coefficient`` when even a
   fillet-less space closes above the root circle;
+- every curve of each outline (tip and root lands, involute, radial flank below the base circle, fillet) at
+  least 1/500 of the largest tooth mesh size long (Netgen cannot mesh shorter ones);
 - backlash below the normal module (a larger one is a unit slip);
 - a relief groove depth > 0 (it sets the ring flange's inner edge beyond the tooth roots in either helix
   layout, and the double helix's groove);
@@ -37,12 +39,19 @@ import math
 from collections.abc import Callable
 
 from flexgear.geometry.involute import Gear, gear_set_geometry, transverse_pressure_angle
-from flexgear.geometry.profile import tooth_profile
+from flexgear.geometry.profile import ToothProfile, tooth_profile
 from flexgear.spec import GearboxSpec, SpecError, register_feasibility_check
 
 __all__ = ["check_feasibility"]
 
 _MM = 1e-3
+_ELEMENTS_PER_CURVE = 500.0
+"""Largest ratio of the tooth mesh size to the shortest outline curve (tip or root land, radial flank, fillet):
+Netgen failed to mesh a 1 um tip land at 5.7 mm elements (ratio 5700), a 20 um tip land at 38 mm (1900) and a
+2.4 um radial flank at 5.7 mm (2400), and meshed a 5 um tip land at 1.9 mm (380), a 50 um one at 38 mm (760) and
+an 11 um radial flank at 5.7 mm (520)."""
+_MIN_CURVE = 1e-6
+"""Shortest outline curve [m] in any case: ten times the approximation tolerance of a precise sweep (0.1 um)."""
 _TOOTH_SIZE_PER_MODULE = 2.0
 """Largest tooth mesh size ([meshing_assumed.<level>] tooth_size_mm) per normal module m_n. Netgen's surface
 mesher failed on ring tooth spaces at 2.5 m_n (1 of 12 gears), 3 m_n (3 of 12) and 4 m_n, and meshed every
@@ -139,6 +148,44 @@ def _largest(fits: Callable[[float], bool], lo: float, hi: float) -> float:
     return lo
 
 
+def _short_curves(spec: GearboxSpec, name: str, gear: Gear, profile: ToothProfile) -> None:
+    """Every curve of the gear's outline (:meth:`ToothProfile.outline_curves`) at least the largest tooth mesh size
+    / :data:`_ELEMENTS_PER_CURVE` and :data:`_MIN_CURVE` long."""
+    tooth = max(level.tooth_size_mm for level in spec.meshing_assumed.values()) * _MM
+    limit = max(_MIN_CURVE, tooth / _ELEMENTS_PER_CURVE)
+    curve, shortest = min(profile.outline_curves(), key=lambda c: c[1])
+    if shortest >= limit:
+        return
+    c = spec.gears_assumed.root_fillet_coefficient
+    hi = next(f.metadata["hi"] for f in dataclasses.fields(spec.gears_assumed) if f.name == "root_fillet_coefficient")
+
+    def curves(coefficient: float) -> dict[str, float]:
+        return dict(tooth_profile(gear, coefficient * gear.normal_module).outline_curves())
+
+    field, hint = "gears_assumed.root_fillet_coefficient", "another value"
+    if curve == "tip land":
+        field, hint = _pointed_field(spec, name, gear), "a value that leaves a longer tip land"
+    elif curve == "root fillet":
+        hint = "0 (no fillet) or a larger value"
+    elif curve == "involute flank":
+        field, hint = "gears_assumed.addendum_coefficient", "a larger value"
+    elif curve == "radial flank":  # a smaller fillet lengthens it, a larger one meets the flank above r_b
+        def fits(x: float) -> bool:
+            return _profile_fits(gear, x * gear.normal_module)
+
+        top = hi if fits(hi) else _largest(fits, c, hi)
+        shorter = _largest(lambda x: curves(x).get(curve, 0.0) >= limit, 0.0, c)
+        hint = f"< {shorter:.4f}"
+        if curve not in curves(top):
+            hint += f" or > {_largest(lambda x: curve in curves(x), c, top):.4f} (no radial flank)"
+    elif curve == "root land":
+        hint = f"< {_largest(lambda x: curves(x)['root land'] >= limit, 0.0, c):.4f}"
+    raise SpecError(spec.source, field,
+                    f"the {name}'s {curve} is {shortest * 1e6:.1f} um long, shorter than {limit * 1e6:.1f} um "
+                    f"(1/{_ELEMENTS_PER_CURVE:g} of the largest tooth mesh size {tooth / _MM:g} mm): Netgen cannot "
+                    f"mesh it; expected {hint}", _value(spec, field))
+
+
 def _profiles(spec: GearboxSpec) -> None:
     """Each gear's tooth space must hold its root fillets (flexgear.geometry.profile.tooth_profile): the fillet of
     radius rho = c m_n, tangent to the flank and the root circle, must lie inside the tooth space at the root,
@@ -147,6 +194,7 @@ def _profiles(spec: GearboxSpec) -> None:
     coefficient = a.root_fillet_coefficient
     for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
         if _profile_fits(gear, coefficient * gear.normal_module):
+            _short_curves(spec, name, gear, tooth_profile(gear, coefficient * gear.normal_module))
             continue
         shift = f"{round(gear.shift, 3) + 0.0:.3f}"  # + 0.0: no "-0.000"
         if coefficient > 0 and _profile_fits(gear, 0.0):

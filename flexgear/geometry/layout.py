@@ -62,7 +62,8 @@ __all__ = [
     "component_mass_properties",
     "cached_mass_properties",
     "geometry_hash",
-    "sweep_segments",
+    "HelixSweep",
+    "helix_sweep",
 ]
 
 _HANDS = {"sun": 1.0, "planet": -1.0, "ring": -1.0}
@@ -72,44 +73,79 @@ _GEOMETRY_VERSION = 2  # bump when the construction changes: invalidates every c
 
 
 _SWEEP_TOLERANCE = 1e-7
-"""Largest deviation [m] of a helical sweep's faces from the exact twisted outline (:func:`sweep_segments`)."""
+"""Largest deviation [m] of a helical sweep's faces from the exact twisted outline (:func:`helix_sweep`)."""
 _SWEEP_ERROR = 2.6e-3
-"""Measured e / (r theta^4) of netgen's sweep (OCC's pipe shell at its default approximation tolerance,
-flexgear.geometry.solids), e the largest distance of the second-order mesh's lateral surface nodes from the
-exact twisted outline, r the outer radius of the toothed band and theta the twist angle of one sweep: 2.6e-3
-for the study's sun and planet (theta = 0.136 and 0.133 rad, e = 0.049 and 0.044 um) and for a 13-tooth sun of
-m_n = 10 mm, beta = 30 deg (theta = 0.46 rad, e = 9.4 um; 0.59, 0.12, 0.04 um in 2, 3, 4 sweeps)."""
+"""Measured e / (r theta^4) of netgen's sweep in metres (OCC's pipe shell, approximation tolerance 1e-4 in model
+units), e the largest distance of the second-order mesh's lateral surface nodes from the exact twisted outline,
+r the outer radius of the toothed band and theta the twist angle of the sweep: 2.6e-3 for the study's sun and
+planet (theta = 0.136 and 0.133 rad, e = 0.049 and 0.044 um) and for a 13-tooth sun of m_n = 10 mm,
+beta = 30 deg (theta = 0.46 rad, e = 9.4 um)."""
+_PLAIN_MIN_CURVE = 0.2e-3
+"""Shortest outline curve [m] a sweep in metres takes: it failed with a tip land or radial flank of 0.1 mm and a
+fillet arc of 0.05 mm (m_n 1, 3 and 10 mm; OCC's approximation tolerance is 0.1 mm there) and built them from
+0.12-0.15 mm on."""
+_PRECISE_SCALE = 1000.0
+"""Scale of a precise sweep: built in millimetres (OCC's approximation tolerance 1e-4 mm), then scaled back."""
+_PRECISE_ANGLE = 0.5
+"""Largest twist angle [rad] of one precise sweep. Measured: the 13-tooth sun above in one precise sweep of
+0.46 rad 0.024 um (9.4 um in metres); a 12-tooth sun of m_n 1 mm, beta 45 deg 0.06 um at 1.18 rad and 0.24 um at
+3.54 rad in one sweep."""
 
 
-def sweep_segments(twist: float, length: float, outer_radius: float) -> int:
-    """Number of consecutive sweeps of a helical toothed prism (flexgear.geometry.solids), so that its faces stay
-    within :data:`_SWEEP_TOLERANCE` of the exact twisted outline.
+@dataclass(frozen=True)
+class HelixSweep:
+    """How flexgear.geometry.solids sweeps one helical toothed prism: ``pieces`` consecutive sweeps, each built at
+    ``scale`` (1: in metres, the study's construction; :data:`_PRECISE_SCALE`: in millimetres, scaled back)."""
 
-    A sweep that turns the section by theta = |twist| L deviates from the exact surfaces by about
-    e = :data:`_SWEEP_ERROR` r theta^4 (r: ``outer_radius`` [m] of the toothed band); n sweeps of theta / n each
-    keep e <= tolerance for n >= theta (C r / tolerance)^(1/4). ``twist`` [rad/m], ``length`` [m].
+    pieces: int = 1
+    scale: float = 1.0
+
+    @property
+    def plain(self) -> bool:
+        return self.pieces == 1 and self.scale == 1.0
+
+
+def helix_sweep(twist: float, length: float, profile: ToothProfile) -> HelixSweep:
+    """The sweep of a toothed prism of ``profile`` turning at ``twist`` [rad/m] over ``length`` [m].
+
+    One sweep in metres deviates from the exact surfaces by about e = :data:`_SWEEP_ERROR` r theta^4
+    (theta = |twist| L, r the outer radius of the toothed band) and needs every outline curve at least
+    :data:`_PLAIN_MIN_CURVE` long; when both hold it is taken (the study's gears: e <= 0.05 um, curves >= 1.2 mm),
+    otherwise ceil(theta / :data:`_PRECISE_ANGLE`) precise sweeps (in millimetres).
     """
+    gear = profile.gear
     theta = abs(twist) * length
-    return max(1, math.ceil(theta * (_SWEEP_ERROR * outer_radius / _SWEEP_TOLERANCE) ** 0.25 - 1e-9))
+    error = _SWEEP_ERROR * max(gear.tip_radius, gear.root_radius) * theta**4
+    if error <= _SWEEP_TOLERANCE and min(c for _, c in profile.outline_curves()) >= _PLAIN_MIN_CURVE:
+        return HelixSweep()
+    return HelixSweep(max(1, math.ceil(theta / _PRECISE_ANGLE - 1e-9)), _PRECISE_SCALE)
 
 
-def _helix_sweeps(spec: GearboxSpec) -> tuple[int, ...]:
-    """:func:`sweep_segments` of the toothed prisms of sun, planet and ring (as :func:`_gear_prisms` lays them)."""
+def _helix_sweeps(spec: GearboxSpec) -> tuple[HelixSweep, ...]:
+    """:func:`helix_sweep` of the toothed prisms of sun, planet and ring (as :func:`_gear_prisms` lays them);
+    plain for spur gears (extruded) and for a gear set whose profiles cannot be built (nothing is swept)."""
     gs, a = gear_set_geometry(spec), spec.gears_assumed
+    if gs.sun.helix_angle == 0.0:
+        return (HelixSweep(),) * 3
     length = a.face_width_m / 2 if a.helix_layout == "double" else a.face_width_m
-    return tuple(sweep_segments(math.tan(g.helix_angle) / g.reference_radius, length, max(g.tip_radius, g.root_radius))
-                 for g in (gs.sun, gs.planet, gs.ring))
+    try:
+        profiles = tooth_profiles(gs, a.root_fillet_coefficient)
+    except ValueError:
+        return (HelixSweep(),) * 3
+    return tuple(helix_sweep(math.tan(g.helix_angle) / g.reference_radius, length, profiles[name])
+                 for name, g in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)))
 
 
 def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
     """Hash of every spec table the geometry depends on, the construction version and ``extra``.
 
-    A gear set whose helices take more than one sweep (:func:`sweep_segments`) also hashes the sweep counts:
-    such solids were swept in one piece before, so their earlier cache entries are not reused; every other key,
-    the study's among them, is unchanged.
+    A gear set with a helix that is not swept in one piece in metres (:func:`helix_sweep`) also hashes its
+    sweeps: such solids were swept in one piece before (or could not be built), so earlier cache entries are not
+    reused; every other key, the study's among them, is unchanged.
     """
     sweeps = _helix_sweeps(spec)
-    construction = (("helix_sweeps", *sweeps),) if max(sweeps) > 1 else ()
+    construction = () if all(w.plain for w in sweeps) else (
+        ("precise_sweeps", *((w.pieces, w.scale) for w in sweeps)),)
     return spec_hash(spec.gears, spec.gears_assumed, spec.components_assumed, spec.material_assumed,
                      _GEOMETRY_VERSION, *construction, *extra)
 

@@ -179,6 +179,20 @@ class ToothProfile:
             out.append(pitch @ rot.T)
         return np.vstack(out)
 
+    def outline_curves(self) -> list[tuple[str, float]]:
+        """(name, length [m]) of each curve of one pitch of the outline as the solid modeller builds it, one
+        edge each: the full tip land (twice its half-pitch part), an involute flank, the radial flank below the
+        base circle (if any), the root fillet (if any) and the full root land. Lengths by Gauss-Legendre
+        quadrature of |dp/ds| (exact to rounding on arcs and lines)."""
+        s = 0.5 * (_GAUSS_NODES + 1)
+        w = 0.5 * _GAUSS_WEIGHTS
+        half = self.half_pitch
+        names = ["tip land", "involute flank"] + [
+            "radial flank" if isinstance(seg, LineSegment) else "root fillet" for seg in half[2:-1]] + ["root land"]
+        lengths = [float(w @ np.linalg.norm(seg.velocity(s), axis=1)) for seg in half]
+        return [(n, length * (2 if n in ("tip land", "root land") else 1))
+                for n, length in zip(names, lengths, strict=True)]
+
     def flank_segment(self) -> InvoluteSegment:
         """The involute part of the upper flank of tooth 0."""
         return next(seg for seg in self.half_pitch if isinstance(seg, InvoluteSegment))

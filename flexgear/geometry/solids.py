@@ -11,9 +11,11 @@
     helical spine turns the section at the prism's twist rate; netgen.occ's ``twist`` argument is
     not implemented), or of a straight extrusion of the section for spur teeth (twist 0: a sweep
     without auxiliary spine is a different OCC algorithm that leaves the ends open); one lateral
-    face per outline curve (:func:`outline_edge_count`); a long or steep helix is swept in several
-    consecutive sweeps, each within 0.1 um of the exact surfaces (:func:`sweep_segments`; the
-    study's gears take one); for a circle one cylinder face per run of prisms with the same radius;
+    face per outline curve (:func:`outline_edge_count`); a steep or long helix, or an outline with a
+    curve shorter than 0.2 mm, is swept precisely: built in millimetres (OCC's approximation tolerance
+    is absolute) and scaled back, in pieces of at most 0.5 rad of twist
+    (:func:`flexgear.geometry.layout.helix_sweep`; the study's gears take one sweep in metres);
+    for a circle one cylinder face per run of prisms with the same radius;
   - planar faces at both ends and wherever the section changes: the annulus between the two
     boundary loops that differ (e.g. toothed outline and relief-groove circle);
   - the lower half of a double helix is the mirror image (z -> -z) of the upper half (same lead,
@@ -36,11 +38,11 @@ from dataclasses import dataclass
 import netgen.occ as occ
 import numpy as np
 
-from flexgear.geometry.layout import ComponentLayout, Prism, sweep_segments
+from flexgear.geometry.layout import ComponentLayout, Prism, helix_sweep
 from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
 
 __all__ = [
-    "FLANK_POINTS", "outline_edge_count", "sweep_segments", "section_face", "component_solid", "occ_mass_properties",
+    "FLANK_POINTS", "outline_edge_count", "section_face", "component_solid", "occ_mass_properties",
 ]
 
 FLANK_POINTS = 25
@@ -176,11 +178,11 @@ class _Boundary:
     def _sweep(self, z0: float, z1: float, twist: float) -> tuple[list, object, object]:
         """Lateral faces and end wires of the toothed outline from z0 to z1 at ``twist`` [rad/m].
 
-        Spur teeth (twist 0) are a straight extrusion of the section face. Helical teeth are swept along
-        the axis, in :func:`sweep_segments` consecutive sweeps; in each an auxiliary helical spine, at
-        radius r_b / 2, turns the section by ``twist * z``. The section at z0 is the outline rotated by
-        ``twist * z0``; each further sweep starts from the previous one's end wire, so that neighbouring
-        sweeps share their edges.
+        Spur teeth (twist 0) are a straight extrusion of the section face. Helical teeth are swept along the axis
+        as :func:`flexgear.geometry.layout.helix_sweep` says: in one or more consecutive sweeps, each in metres
+        or, precise, in millimetres and scaled back; in each an auxiliary helical spine, at radius r_b / 2, turns
+        the section by ``twist * z``. The section at z0 is the outline rotated by ``twist * z0``; each further
+        sweep starts from the previous one's end wire, so that neighbouring sweeps share their edges.
         """
         profile = self.layout.profile
         face = section_face(profile, z0, self.flank_points)
@@ -190,12 +192,11 @@ class _Boundary:
             plugs = [face.Extrude(occ.Vec(0, 0, z1 - z0))]
         else:
             face = face.Rotate(occ.Axis(occ.Pnt(0, 0, 0), occ.Z), math.degrees(twist * z0))
-            gear = profile.gear
-            n = sweep_segments(twist, z1 - z0, max(gear.tip_radius, gear.root_radius))
-            ends = list(np.linspace(z0, z1, n + 1))
+            plan = helix_sweep(twist, z1 - z0, profile)
+            ends = list(np.linspace(z0, z1, plan.pieces + 1))
             wire, plugs = face.wires[0], []
             for a, b in zip(ends[:-1], ends[1:], strict=True):
-                plugs.append(self._pipe(wire, float(a), float(b), twist))
+                plugs.append(self._pipe(wire, float(a), float(b), twist, plan.scale))
                 wire = sorted((f for f in plugs[-1].faces if _flat(f)), key=lambda f: f.center.z)[-1].wires[0]
         lateral, bottom, top = [], None, None
         for (a, b), plug in zip(zip(ends[:-1], ends[1:], strict=True), plugs, strict=True):
@@ -210,15 +211,20 @@ class _Boundary:
             top = caps[1].wires[0]
         return lateral, bottom, top
 
-    def _pipe(self, wire, z0: float, z1: float, twist: float):
-        """The closed sweep of ``wire`` (the outline in the plane z0) to z1, turned at ``twist`` [rad/m]."""
-        spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, z0), occ.Pnt(0, 0, z1))])
-        r_aux = 0.5 * self.layout.profile.gear.base_radius
-        helix = [occ.Pnt(r_aux * math.cos(twist * z), r_aux * math.sin(twist * z), float(z))
+    def _pipe(self, wire, z0: float, z1: float, twist: float, scale: float = 1.0):
+        """The closed sweep of ``wire`` (the outline in the plane z0) to z1, turned at ``twist`` [rad/m], built at
+        ``scale`` (the wire, spine and helix scaled by it about the origin, the result scaled back)."""
+        origin = occ.Pnt(0, 0, 0)
+        if scale != 1.0:
+            wire = wire.Scale(origin, scale)
+        spine = occ.Wire([occ.Segment(occ.Pnt(0, 0, scale * z0), occ.Pnt(0, 0, scale * z1))])
+        r_aux = 0.5 * self.layout.profile.gear.base_radius * scale
+        helix = [occ.Pnt(r_aux * math.cos(twist * z), r_aux * math.sin(twist * z), float(scale * z))
                  for z in np.linspace(z0, z1, _HELIX_POINTS)]
         # netgen's Pipe with an auxiliary spine closes the ends (MakeSolid): the caps' wires are the sweep's own
         # edges
-        return occ.Pipe(spine, wire, auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
+        plug = occ.Pipe(spine, wire, auxspine=occ.Wire([occ.SplineInterpolation(helix)]))
+        return plug if scale == 1.0 else plug.Scale(origin, 1.0 / scale)
 
 
 def _band(loop: _Loop | None, layout: ComponentLayout) -> tuple[float, float]:
