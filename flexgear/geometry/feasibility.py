@@ -10,7 +10,8 @@ field that causes the problem and what is allowed:
 - tooth thickness at the tip > 0 for sun, planet and ring (no pointed tooth), psi(r_a) of
   :meth:`flexgear.geometry.involute.Gear.tooth_half_angle`; the field named is the one that makes it pointed
   (backlash, addendum or the profile shift, which the centre distance sets for sun and ring);
-- a ring whose tip circle lies inside its base circle has no involute at the tip;
+- a gear whose tip circle lies inside its base circle has no involute flank (external gears: a negative
+  profile shift or a small addendum; the ring: a large addendum);
 - the root fillets of every gear fit in its tooth space (the tooth profile of
   :func:`flexgear.geometry.profile.tooth_profile` can be built): the field named is
   ``root_fillet_coefficient`` with the largest value that fits, or ``dedendum_coefficient`` when even a
@@ -115,6 +116,16 @@ def _teeth(spec: GearboxSpec) -> None:
                             f"the ring's tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
                             f"(d = {2e3 * gear.base_radius:.2f} mm): no involute at the tip; expected a smaller value",
                             spec.gears_assumed.addendum_coefficient)
+        if not gear.internal and gear.tip_radius <= gear.base_radius:  # r_a = r + m_n (h_a + x) <= r_b
+            field = "gears_assumed.addendum_coefficient"
+            if gear.shift < 0:  # the planet's own shift, or the sun's that the centre distance sets
+                field = ("gears_assumed.planet_shift_coefficient" if name == "planet"
+                         else "gears_assumed.operating_centre_distance_mm")
+            raise SpecError(spec.source, field,
+                            f"the {name}'s tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
+                            f"(d = {2e3 * gear.base_radius:.2f} mm, profile shift x = {gear.shift:.3f}): no involute "
+                            "flank; expected a value that puts the tip circle outside the base circle",
+                            _value(spec, field))
         if _tip_thickness(gear) <= 0:
             field = _pointed_field(spec, name, gear)
             raise SpecError(spec.source, field,
