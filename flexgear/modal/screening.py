@@ -57,13 +57,18 @@ TABLE3_COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
 _TABLE3 = re.compile(r"^model(\d+)\.toml$")
 
 
-def amplification(f_hz: np.ndarray, zeta: np.ndarray, f_mesh_hz: float, orders: int = 10) -> np.ndarray:
-    """Largest dynamic amplification A(r) over the harmonics k f_m, k = 1..``orders``, of each mode (frequencies
-    ``f_hz`` [Hz], damping ratios ``zeta`` [-]) under the mesh frequency ``f_mesh_hz`` [Hz] (module docstring)."""
+def _amplifications(f_hz: np.ndarray, zeta: np.ndarray, f_mesh_hz: float, orders: int = 10) -> np.ndarray:
+    """A(r) of each mode (rows) at each harmonic k f_m, k = 1..``orders`` (columns) (module docstring)."""
     k = np.arange(1, orders + 1)
     r = k[None, :] * f_mesh_hz / np.asarray(f_hz, float)[:, None]
     z = np.asarray(zeta, float)[:, None]
-    return (1.0 / np.sqrt((1.0 - r**2) ** 2 + (2.0 * z * r) ** 2)).max(axis=1)
+    return 1.0 / np.sqrt((1.0 - r**2) ** 2 + (2.0 * z * r) ** 2)
+
+
+def amplification(f_hz: np.ndarray, zeta: np.ndarray, f_mesh_hz: float, orders: int = 10) -> np.ndarray:
+    """Largest dynamic amplification A(r) over the harmonics k f_m, k = 1..``orders``, of each mode (frequencies
+    ``f_hz`` [Hz], damping ratios ``zeta`` [-]) under the mesh frequency ``f_mesh_hz`` [Hz] (module docstring)."""
+    return _amplifications(f_hz, zeta, f_mesh_hz, orders).max(axis=1)
 
 
 def _table3_component(component: str) -> str:
@@ -98,11 +103,9 @@ class ModalScreening:
         added into one."""
         f = self.modes.frequencies_hz[self.weighted]
         zeta = np.maximum(self.modes.damping_ratios[self.weighted], 0.0)
-        k = np.arange(1, 11)
-        r = k[None, :] * self.f_mesh_hz / f[:, None]
-        a = 1.0 / np.sqrt((1.0 - r**2) ** 2 + (2.0 * zeta[:, None] * r) ** 2)
+        a = _amplifications(f, zeta, self.f_mesh_hz)
         out = pd.DataFrame({"mode": np.asarray(self.weighted) + 1, "frequency_hz": f, "damping_ratio": zeta,
-                            "kind": [self.modes.kinds[i] for i in self.weighted], "harmonic": k[a.argmax(axis=1)],
+                            "kind": [self.modes.kinds[i] for i in self.weighted], "harmonic": a.argmax(axis=1) + 1,
                             "weight": self.weights})
         for c in TABLE3_COMPONENTS:
             out[f"share_{c}"] = 0.0

@@ -30,7 +30,13 @@ from matplotlib.figure import Figure
 from flexgear.report.data import ReportData
 from flexgear.report.figures import draw_table, fmt
 from flexgear.study.indicators import ALL_INDICATORS
-from flexgear.study.purposes import ALL_PURPOSES, PurposeVerdict, static_te_split
+from flexgear.study.purposes import (
+    ALL_PURPOSES,
+    PurposeVerdict,
+    describe_indicator,
+    indicator_ranks,
+    static_te_split,
+)
 
 __all__ = ["verdict_page", "verdict_lines", "verdict_rows", "why_lines", "mesh_law_lines", "case_verdicts",
            "static_te_lines", "case_difference_lines", "band_difference_lines"]
@@ -220,10 +226,8 @@ def mesh_law_lines(d: ReportData) -> list[str]:
              + ". A steel mesh (ISO 6336-1 c_gamma_alpha b / cos^2 beta_b): "
              + ", ".join(f"{m} {fmt(steel[m].stiffness, 3)} N/m, {1e6 * static_deflection(force[m], steel[m]):.3g} um"
                          for m in force) + "."]
-    if "transmission_error_m" in ref.signals:
-        w = d.window(ref)
-        t = ref.signals["time_s"]
-        total = float(ref.signals["transmission_error_m"][(t >= w.start_s) & (t <= w.end_s)].mean())
+    if "transmission_error" in ind.index:   # the reference's mean loaded TE over its screening window [m]
+        total = float(ind.loc["transmission_error", "mean"])
         split = static_te_split(total, delta["outer"], delta["inner"], des.gears.sun_planet.gear1.base_helix_angle)
         backlash = des.gears.sun_planet.normal_backlash
         lines.append(f"{ref.name}'s mean loaded transmission error {1e6 * total:.4g} um = the meshes' static "
@@ -247,12 +251,10 @@ def _weakest(d: ReportData, variant: str, keys: tuple[str, ...]) -> str:
     s = d.reference
     if s is None:
         return ""
-    ind = s.indicators[(s.indicators["variant"] == variant) & s.indicators["indicator"].isin(keys)].copy()
+    ind = s.indicators[(s.indicators["variant"] == variant) & s.indicators["indicator"].isin(keys)]
     if ind.empty:
         return ""
-    ind["margin"] = (ind["tea"] - ind["bias"] - 2.0 * ind["cv"]) / ind["tea"]
-    r = ind.sort_values("margin").iloc[0]
-    return f"{_name(r['indicator'])} {r['bias']:.3g} {r['unit']} (CV {r['cv']:.2g}, TEa {r['tea']:g})"
+    return describe_indicator(indicator_ranks(ind, s.lines).sort_values("margin").iloc[0])
 
 
 def case_difference_lines(d: ReportData, others: list[ReportData]) -> list[str]:

@@ -36,8 +36,8 @@ from flexgear.study.indicators import ALL_INDICATORS
 from flexgear.study.selection import DecisionLines, Selection, variant_names
 
 __all__ = ["ALL_PURPOSES", "RULE_PER_PURPOSE", "STUDY_PURPOSE", "PurposeVerdict", "mark_resolved",
-           "purpose_selection", "indicator_ranks", "purpose_zones", "judge_purposes", "verdict_table",
-           "VERDICT_COLUMNS", "static_te_split", "StaticTeSplit"]
+           "purpose_selection", "describe_indicator", "indicator_ranks", "purpose_zones", "judge_purposes",
+           "verdict_table", "VERDICT_COLUMNS", "static_te_split", "StaticTeSplit"]
 
 ALL_PURPOSES = "all purposes"
 """Name of the overall verdict: the cheapest variant acceptable for every purpose."""
@@ -129,7 +129,7 @@ def purpose_zones(indicators: pd.DataFrame, table: pd.DataFrame, purposes: Mappi
                                        "missing"])
 
 
-def _describe(ind: pd.Series) -> str:
+def describe_indicator(ind: pd.Series) -> str:
     """An indicator's standing in words: '<name> 4.2 dB off (+ 2 CV 0.1; TEa 3 dB)'."""
     name = ALL_INDICATORS.get(ind["indicator"], ind["indicator"])
     return (f"{name} {ind['bias']:.3g} {ind['unit']} off, CV {ind['cv']:.2g} (TEa {ind['tea']:g} {ind['unit']})")
@@ -168,7 +168,7 @@ def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.
             break
         ind = ranked[(ranked["variant"] == v) & ranked["indicator"].isin(keys)].sort_values("margin")
         if len(ind):
-            failing.append((v, _describe(ind.iloc[0])))
+            failing.append((v, describe_indicator(ind.iloc[0])))
     if selected is None:
         why = (f"{purpose}: no variant is acceptable (every indicator within |Bias| + {m1} CV <= TEa)"
                + (f"; closest: {failing[0][0]}, {failing[0][1]}" if failing else "") + ".")
@@ -189,9 +189,9 @@ def _judge(purpose: str, keys: tuple[str, ...], ranked: pd.DataFrame, zones: pd.
                + ("; ".join(f"{v}: {w}" for v, w in failing) or "no other variant was screened") + ".")
     else:
         why = (f"{purpose}: {selected} is the cheapest variant whose every indicator meets |Bias| + {m1} CV <= TEa "
-               f"(zone '{lines.zone_names[rank]}', deciding: {_describe(deciding)}; {ratio:.3g}x the reference's "
-               "time)" + ("; cheaper and failing: " + "; ".join(f"{v}: {w}" for v, w in failing) if failing else "")
-               + ".")
+               f"(zone '{lines.zone_names[rank]}', deciding: {describe_indicator(deciding)}; {ratio:.3g}x the "
+               "reference's time)"
+               + ("; cheaper and failing: " + "; ".join(f"{v}: {w}" for v, w in failing) if failing else "") + ".")
     if not resolved:
         why = ("NOT RESOLVED: an acceptability that decides this verdict changes within the reference's numerical "
                "error (h against h/2): " + "; ".join(flips) + ". " + why)
@@ -262,13 +262,7 @@ def mark_resolved(table: pd.DataFrame, indicators: pd.DataFrame, errors: dict[st
     """Mark each screened variant ``resolved`` when no indicator's acceptability (|Bias| + m1 CV <= TEa) changes as
     its Bias moves by -/+ the reference's numerical error of that indicator (``errors``, the indicator's unit)."""
     ok = table["status"] == "ok"
-    resolved = []
-    for r in table.itertuples():
-        ind = indicators[indicators["variant"] == r.variant]
-        flips = [i for i in ind.itertuples() if math.isfinite(errors.get(i.indicator, math.nan))
-                 and (i.bias + errors[i.indicator] + m1 * i.cv <= i.tea)
-                 != (max(i.bias - errors[i.indicator], 0.0) + m1 * i.cv <= i.tea)]
-        resolved.append(not flips)
+    resolved = [not _flips(indicators[indicators["variant"] == v], errors, m1) for v in table["variant"]]
     table["resolved"] = np.where(ok, resolved, True)
 
 
