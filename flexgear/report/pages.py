@@ -16,6 +16,7 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
+import textwrap
 from collections.abc import Callable
 from pathlib import Path
 
@@ -56,9 +57,13 @@ def _load_case_text(d: ReportData) -> list[str]:
     return lines
 
 
+_REASONING_CHARS = 500
+"""Characters of a selection's reasoning on the contents page (page 1 gives it whole)."""
+
+
 def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) -> Callable[[Figure], None]:
     def draw(fig: Figure) -> None:
-        ax = fig.add_axes([0.06, 0.05, 0.88, 0.85])
+        ax = fig.add_axes([0.06, 0.45, 0.88, 0.45])
         ok = sum(r.ok for r in d.runs.values())
         steady = d.study.table.get("steady_window")
         unsteady = [] if steady is None else list(d.study.table.loc[steady == False, "variant"])  # noqa: E712
@@ -70,10 +75,11 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
                  f"Selected model: {d.selection.variant or 'none'}"
                  + (f" (screened against the reference {ref.reference})" if ref is not None else
                     " (the study's mode: against theory)"),
-                 d.selection.reasoning]
+                 textwrap.shorten(d.selection.reasoning, _REASONING_CHARS, placeholder=" … (page 1)")]
         if ref is not None:
             lines += [f"In the study's mode (against theory, TEa = {d.settings.allowable_total_error_pct:g} %): "
-                      f"{d.study.selection.variant or 'none'}. {d.study.selection.reasoning}"]
+                      f"{d.study.selection.variant or 'none'}. "
+                      + textwrap.shorten(d.study.selection.reasoning, _REASONING_CHARS, placeholder=" …")]
         lines += [f"Screening: lines m = {', '.join(map(str, d.lines.multipliers))}, {d.settings.sample_count} "
                   f"samples per window, window '{d.settings.window}', rule '{d.settings.selection}'."]
         if d.refused:
@@ -81,8 +87,12 @@ def _title_page(d: ReportData, contents: list[tuple[int, str]], created: str) ->
         if unsteady:
             lines += ["", "CAUTION: these runs have no settled window (they end before their transients decay): "
                       + ", ".join(unsteady) + ". Their Bias and CV measure the start-up, not the model's accuracy."]
-        lines += ["", "Contents"] + [f"  page {p:>2}   {t}" for p, t in contents]
         text_block(ax, "\n".join(lines), width=150, fontsize=8.5)
+        half = (len(contents) + 1) // 2       # the contents in two columns below
+        for k, part in enumerate((contents[:half], contents[half:])):
+            col = fig.add_axes([0.06 + 0.45 * k, 0.05, 0.43, 0.38])
+            text_block(col, "\n".join((["Contents"] if k == 0 else [""]) + [f"page {p:>2}   {t}" for p, t in part]),
+                       width=95, fontsize=7.5)
     return draw
 
 
