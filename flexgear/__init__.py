@@ -14,6 +14,7 @@ first use, so ``import flexgear`` stays light.
 
 from importlib import import_module
 
+from flexgear import sizing as _sizing  # noqa: F401  (registers the sizes that follow the gear set)
 from flexgear.geometry import feasibility as _feasibility  # noqa: F401  (registers the load-time feasibility checks)
 from flexgear.geometry.involute import Gear, GearMesh, GearSetGeometry, Mesh, gear_set_geometry, solve_profile_shifts
 from flexgear.laws.ramps import step, step_integral

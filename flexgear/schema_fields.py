@@ -8,7 +8,7 @@ from dataclasses import field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SpecError", "_num", "_choice", "_text"]
+__all__ = ["SpecError", "_num", "_derived", "_choice", "_text"]
 
 
 class SpecError(ValueError):
@@ -24,6 +24,13 @@ def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = Fa
          integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
     """Field with a numeric range check (validated on load); optional when ``default`` is given."""
     return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
+
+
+def _derived(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, doc: str = "") -> Any:
+    """Numeric field that a gearbox file may leave out: its value then follows the gear data
+    (:mod:`flexgear.sizing`, registered with :func:`flexgear.spec.register_derived_defaults`). Required when the
+    dataclass is built in code."""
+    return field(metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": False, "doc": doc, "derived": True})
 
 
 def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:

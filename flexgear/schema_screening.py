@@ -4,8 +4,9 @@ each reference indicator's TEa on the scale where it matters (flexgear.study.scr
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from typing import Any
 
-from flexgear.schema_fields import _choice, _num, _text
+from flexgear.schema_fields import _choice, _derived, _num, _text
 
 __all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance", "ErrorLevelTolerance",
            "ReferenceIndicators", "ScreeningSettings", "DEFAULT_PURPOSES", "PURPOSE_NAMES"]
@@ -18,14 +19,14 @@ class IndicatorWeights:
     Section 2.2: "taking 20 % of each of the five simulation indicators".
     """
 
-    input_speed: float = _num(0.0, 1.0)
-    output_speed: float = _num(0.0, 1.0)
-    transmission_ratio: float = _num(0.0, 1.0)
-    outer_mesh_force: float = _num(0.0, 1.0)
-    inner_mesh_force: float = _num(0.0, 1.0)
+    input_speed: float = _num(0.0, 1.0, default=0.2)
+    output_speed: float = _num(0.0, 1.0, default=0.2)
+    transmission_ratio: float = _num(0.0, 1.0, default=0.2)
+    outer_mesh_force: float = _num(0.0, 1.0, default=0.2)
+    inner_mesh_force: float = _num(0.0, 1.0, default=0.2)
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class _Tolerance:
     """Weight of one indicator in the reference screening and its TEa, in the unit its subclass names."""
 
@@ -43,7 +44,7 @@ class _Tolerance:
         return None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class IndicatorTolerance(_Tolerance):
     """TEa in % of the reference's value (a quantity far from zero: speeds, ratio, mean forces)."""
 
@@ -51,7 +52,7 @@ class IndicatorTolerance(_Tolerance):
     scale, tea_field = "relative", "tea_pct"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class LoadTolerance(_Tolerance):
     """TEa in % of the mean tooth load (a load factor or an alternating load, as a tooth-stress rating sees it)."""
 
@@ -59,7 +60,7 @@ class LoadTolerance(_Tolerance):
     scale, tea_field = "load", "tea_pct_of_load"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class LevelTolerance(_Tolerance):
     """TEa in dB of a vibration level (20 log10 of the amplitude ratio)."""
 
@@ -67,7 +68,7 @@ class LevelTolerance(_Tolerance):
     scale, tea_field = "db", "tea_db"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ErrorLevelTolerance(_Tolerance):
     """TEa in dB of a transmission-error harmonic (20 log10 of the amplitude ratio); amplitudes below ``floor_um``
     [um] count as ``floor_um`` (below what a transmission-error measurement resolves: both "no ripple")."""
@@ -82,27 +83,32 @@ class ErrorLevelTolerance(_Tolerance):
         return self.floor_um * 1e-6
 
 
+def _tol(cls: type, **values: float) -> Any:
+    """A reference indicator's tolerance field whose default is ``cls(**values)`` (the study's, gearbox.toml)."""
+    return field(default_factory=lambda: cls(**values))
+
+
 @dataclass(frozen=True)
 class ReferenceIndicators:
     """TEa and weight of every indicator screened against a reference variant, each on the scale where it
     matters (``[screening.reference_indicators]``; flexgear.study.indicators defines each indicator)."""
 
-    input_speed: IndicatorTolerance
-    output_speed: IndicatorTolerance
-    transmission_ratio: IndicatorTolerance
-    outer_mesh_force: IndicatorTolerance
-    inner_mesh_force: IndicatorTolerance
-    outer_mesh_ripple: LoadTolerance
-    inner_mesh_ripple: LoadTolerance
-    load_sharing: LoadTolerance
-    dynamic_factor: LoadTolerance
-    input_bearing_rms: LevelTolerance
-    output_bearing_rms: LevelTolerance
-    input_bearing_mesh1x: LevelTolerance
-    output_bearing_mesh1x: LevelTolerance
-    transmission_error: IndicatorTolerance
-    transmission_error_mesh1x: ErrorLevelTolerance
-    transmission_error_mesh2x: ErrorLevelTolerance
+    input_speed: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=0.1, weight=0.03)
+    output_speed: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=0.1, weight=0.03)
+    transmission_ratio: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=0.1, weight=0.03)
+    outer_mesh_force: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=1.0, weight=0.03)
+    inner_mesh_force: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=1.0, weight=0.03)
+    outer_mesh_ripple: LoadTolerance = _tol(LoadTolerance, tea_pct_of_load=2.0, weight=0.15)
+    inner_mesh_ripple: LoadTolerance = _tol(LoadTolerance, tea_pct_of_load=2.0, weight=0.15)
+    load_sharing: LoadTolerance = _tol(LoadTolerance, tea_pct_of_load=2.0, weight=0.1)
+    dynamic_factor: LoadTolerance = _tol(LoadTolerance, tea_pct_of_load=2.0, weight=0.1)
+    input_bearing_rms: LevelTolerance = _tol(LevelTolerance, tea_db=3.0, weight=0.06)
+    output_bearing_rms: LevelTolerance = _tol(LevelTolerance, tea_db=3.0, weight=0.06)
+    input_bearing_mesh1x: LevelTolerance = _tol(LevelTolerance, tea_db=3.0, weight=0.04)
+    output_bearing_mesh1x: LevelTolerance = _tol(LevelTolerance, tea_db=3.0, weight=0.04)
+    transmission_error: IndicatorTolerance = _tol(IndicatorTolerance, tea_pct=10.0, weight=0.15)
+    transmission_error_mesh1x: ErrorLevelTolerance = _tol(ErrorLevelTolerance, tea_db=3.0, floor_um=0.01, weight=0.0)
+    transmission_error_mesh2x: ErrorLevelTolerance = _tol(ErrorLevelTolerance, tea_db=3.0, floor_um=0.01, weight=0.0)
 
 
 DEFAULT_PURPOSES: dict[str, tuple[str, ...]] = {
@@ -120,29 +126,32 @@ PURPOSE_NAMES = tuple(DEFAULT_PURPOSES)
 """The purposes every ``[screening.purposes]`` table holds; a file may add more."""
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class ScreeningSettings:
     """Westgard screening of the variants (section 2.2); TEa and the rules are assumptions.
 
     See ``[screening]`` in gearbox.toml and :mod:`flexgear.study.screening` for each value's meaning.
     """
 
-    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True)
-    lines: str = _choice("westgard", "six_sigma")
-    window: str = _choice("settled", "after_ramps", "fixed")
-    after_ramp_delay_s: float = _num(0.0)
-    window_start_s: float = _num(0.0)
-    window_end_s: float = _num(0.0, lo_open=True)
-    short_run_fraction: float = _num(0.0, 1.0, lo_open=True)
-    sample_count: int = _num(2, 10000, integer=True)
-    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable")
-    weights: IndicatorWeights
-    reference_indicators: ReferenceIndicators
-    # settled window (flexgear.settling.settled_start): blocks of whole mesh cycles, tolerances in %
-    settle_block_mesh_cycles: int = _num(1, 100000, integer=True)
-    settle_final_blocks: int = _num(1, 1000, integer=True)
-    settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
-    settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True)
+    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True, default=1.0)
+    lines: str = _choice("westgard", "six_sigma", default="westgard")
+    window: str = _choice("settled", "after_ramps", "fixed", default="settled")
+    after_ramp_delay_s: float = _num(0.0, default=0.0)
+    # window = "fixed" only: from the ramps' end to the load case's end when left out (flexgear.sizing)
+    window_start_s: float = _derived(0.0)
+    window_end_s: float = _derived(0.0, lo_open=True)
+    short_run_fraction: float = _num(0.0, 1.0, lo_open=True, default=0.5)
+    sample_count: int = _num(2, 10000, integer=True, default=10)
+    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable",
+                             default="fastest_in_best_zone")
+    weights: IndicatorWeights = field(default_factory=IndicatorWeights)
+    reference_indicators: ReferenceIndicators = field(default_factory=ReferenceIndicators)
+    # settled window (flexgear.settling.settled_start): blocks of whole mesh cycles, tolerances in %; the block
+    # follows the ring's tooth count when left out (flexgear.sizing)
+    settle_block_mesh_cycles: int = field(metadata={"lo": 1, "hi": 100000, "integer": True, "derived": True})
+    settle_final_blocks: int = _num(1, 1000, integer=True, default=8)
+    settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True, default=0.05)
+    settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True, default=5.0)
     # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
     reference: str = _text(default="")
     # numerical error bars: the reference's final state solved over this window at h and at h/2 (0: none)

@@ -85,11 +85,31 @@ __all__ = [
     "spec_hash",
     "as_dict",
     "register_feasibility_check",
+    "register_derived_defaults",
+    "REQUIRED_TABLES",
 ]
 
 
 # --------------------------------------------------------------------------- loading
 _FEASIBILITY: list[Callable[[GearboxSpec], None]] = []
+
+
+_DERIVED: list[Callable[[str, dict[str, Any], dict[str, Any]], dict[str, Any]]] = []
+
+REQUIRED_TABLES = ("gears", "bearings", "load_case")
+"""The tables every gearbox file gives; every other table and field has a documented default, fixed or derived
+from the gear data (:mod:`flexgear.sizing`)."""
+
+_FIRST = ("gears", "gears_assumed", "load_case", "material_assumed", "components_assumed")
+"""Tables built first, in this order: the derived defaults of the others follow from them."""
+
+
+def register_derived_defaults(provider: Callable[[str, dict[str, Any], dict[str, Any]], dict[str, Any]]) -> None:
+    """``provider(table, built, given)`` gives the derived defaults of ``table`` ("components_assumed",
+    "meshing_assumed.coarse", ...) from the tables already ``built`` (name -> dataclass) and the values the file
+    ``given`` in that table (raw, unchecked); see :mod:`flexgear.sizing`."""
+    if provider not in _DERIVED:
+        _DERIVED.append(provider)
 
 
 def register_feasibility_check(check: Callable[[GearboxSpec], None]) -> None:
@@ -167,10 +187,34 @@ def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
         if f.metadata.get("purposes"):
             values[name] = _check_purposes(path, full, data[name])
         elif dataclasses.is_dataclass(hint):
-            values[name] = _build(hint, data[name], path, full)
+            values[name] = _build(hint, _over_default(f, data[name]), path, full)
         else:
             values[name] = _check_value(path, full, data[name], hint, dict(f.metadata))
     return cls(**values)
+
+
+def _over_default(f: dataclasses.Field, data: Any) -> Any:
+    """A nested table given in part: its fields over the field's default instance (e.g. one reference indicator's
+    TEa given, its weight the default's)."""
+    if not isinstance(data, dict) or f.default_factory is dataclasses.MISSING:
+        return data
+    return {**dataclasses.asdict(f.default_factory()), **data}
+
+
+def _with_derived(path: Path, table: str, cls: type, data: Any, built: dict[str, Any], derived: list[str]) -> Any:
+    """``data`` with every derived field it leaves out filled by the registered providers (recorded in
+    ``derived``); fields no provider gives stay missing (then required)."""
+    if not isinstance(data, dict):
+        return data
+    missing = [f.name for f in dataclasses.fields(cls) if f.metadata.get("derived") and f.name not in data]
+    if not missing:
+        return data
+    given: dict[str, Any] = {}
+    for provider in _DERIVED:
+        given.update(provider(table, built, data))
+    filled = {name: given[name] for name in missing if name in given}
+    derived.extend(f"{table}.{name}" for name in filled)
+    return {**data, **filled}
 
 
 def _check_purposes(path: Path, name: str, value: Any) -> dict[str, tuple[str, ...]]:
@@ -200,40 +244,85 @@ def _check_purposes(path: Path, name: str, value: Any) -> dict[str, tuple[str, .
 def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     """Load and validate a gearbox TOML file (see ``model_variants/gearbox.toml``).
 
-    ``text``: the file's content, already read (``path`` then only names it in messages). Every field
-    is checked, then the consistency of the tables and the geometric feasibility (:mod:`flexgear.geometry.feasibility`).
+    ``text``: the file's content, already read (``path`` then only names it in messages). Only the tables of
+    :data:`REQUIRED_TABLES` are required; a value left out takes its documented default, fixed or derived from the
+    gear data (:mod:`flexgear.sizing`; ``GearboxSpec.derived`` lists those). Every field is checked, then the
+    consistency of the tables and the geometric feasibility (:mod:`flexgear.geometry.feasibility`).
     """
     path = Path(path)
     raw = _read_toml(path, text)
-    tables = {f.name for f in dataclasses.fields(GearboxSpec)} - {"source"}
+    tables = {f.name for f in dataclasses.fields(GearboxSpec)} - {"source", "derived"}
     for name in raw:
         _reject_removed(path, name)
     unknown = sorted(set(raw) - set(tables))
     if unknown:
         raise SpecError(path, unknown[0], f"unknown table; allowed: {', '.join(sorted(tables))}")
-    optional = {f.name for f in dataclasses.fields(GearboxSpec) if f.default_factory is not dataclasses.MISSING}
-    for name in tables - optional:
+    for name in REQUIRED_TABLES:
         if name not in raw:
             raise SpecError(path, name, "missing (required)")
-    if not isinstance(raw["title"], str):
-        raise SpecError(path, "title", "expected a string", raw["title"])
-    meshing = raw["meshing_assumed"]
-    if not isinstance(meshing, dict) or not meshing:
+    title = raw.get("title", path.stem)
+    if not isinstance(title, str):
+        raise SpecError(path, "title", "expected a string", title)
+    meshing = raw.get("meshing_assumed", {})
+    if not isinstance(meshing, dict) or not all(isinstance(v, dict) for v in meshing.values()):
         raise SpecError(path, "meshing_assumed", "expected a table of levels, e.g. [meshing_assumed.coarse]")
     hints = get_type_hints(GearboxSpec)
-    kwargs: dict[str, Any] = {"source": path, "title": raw["title"]}
-    for name in tables - {"title", "meshing_assumed"}:
-        if name in raw:
-            kwargs[name] = _build(hints[name], raw[name], path, name)
-    kwargs["meshing_assumed"] = {
-        level: _build(MeshingSettings, table, path, f"meshing_assumed.{level}")
-        for level, table in meshing.items()
+    built: dict[str, Any] = {}
+    derived: list[str] = []
+    rest = sorted(tables - set(_FIRST) - {"title", "meshing_assumed"})
+    for name in (*_FIRST, *rest):
+        data = _with_derived(path, name, hints[name], raw.get(name, {}), built, derived)
+        built[name] = _build(hints[name], data, path, name)
+    levels = {"coarse": {}, "default": {}, **meshing}
+    built["meshing_assumed"] = {
+        level: _build(MeshingSettings, _with_derived(path, f"meshing_assumed.{level}", MeshingSettings, table, built,
+                                                     derived), path, f"meshing_assumed.{level}")
+        for level, table in levels.items()
     }
-    spec = GearboxSpec(**kwargs)
-    _check_consistency(spec)
-    for check in _FEASIBILITY:
-        check(spec)
+    spec = GearboxSpec(source=path, title=title, derived=tuple(derived), **built)
+    _check_loaded(spec)
     return spec
+
+
+def _check_loaded(spec: GearboxSpec) -> None:
+    """Consistency and feasibility; a value the file left out is named as derived, with how to set it."""
+    try:
+        _check_consistency(spec)
+        for check in _FEASIBILITY:
+            check(spec)
+    except SpecError as exc:
+        if exc.field not in spec.derived:
+            raise
+        raise SpecError(spec.source, exc.field, f"{exc.allowed} (the default derived from the gear set, "
+                        "flexgear.sizing; give the field in the file)") from None
+
+
+def _rederive(spec: GearboxSpec, kept: set[str]) -> GearboxSpec:
+    """``spec`` with its derived values derived again from its (overridden) tables, except those in ``kept``."""
+    redo = [d for d in spec.derived if d not in kept]
+    if not redo:
+        return spec
+    built = {name: getattr(spec, name) for name in _FIRST}
+    changes: dict[str, Any] = {}
+
+    def order(table: str) -> tuple[int, str]:
+        top = table.partition(".")[0]
+        return (_FIRST.index(top) if top in _FIRST else len(_FIRST), table)
+
+    for table in sorted({d.rsplit(".", 1)[0] for d in redo}, key=order):
+        top, _, level = table.partition(".")
+        current = spec.meshing_assumed[level] if level else changes.get(top, getattr(spec, top))
+        names = {d.rsplit(".", 1)[1] for d in redo if d.rsplit(".", 1)[0] == table}
+        given = {k: v for k, v in dataclasses.asdict(current).items() if k not in names}
+        values: dict[str, Any] = {}
+        for provider in _DERIVED:
+            values.update(provider(table, built, given))
+        new = dataclasses.replace(current, **{n: values[n] for n in names if n in values})
+        if level:
+            changes["meshing_assumed"] = {**changes.get("meshing_assumed", spec.meshing_assumed), level: new}
+        else:
+            changes[top] = built[top] = new
+    return dataclasses.replace(spec.with_changes(**changes), derived=tuple(d for d in spec.derived if d not in kept))
 
 
 def _check_consistency(spec: GearboxSpec) -> None:
@@ -284,7 +373,8 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
         merged = {k: (dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v) for k, v in merged.items()}
         merged.update(values)
         changes[table] = _build(type(current), merged, path, f"overrides.{table}")
-    return gearbox.with_changes(**changes)
+    kept = {f"{table}.{name}" for table, values in overrides.items() for name in values}
+    return _rederive(gearbox.with_changes(**changes), kept)
 
 
 def _variant_gearbox(path: Path, raw: dict[str, Any], gearbox_text: str | None) -> GearboxSpec:
@@ -301,9 +391,7 @@ def _variant_gearbox(path: Path, raw: dict[str, Any], gearbox_text: str | None) 
         return gearbox
     gearbox = _apply_overrides(gearbox, raw["overrides"], path)
     try:
-        _check_consistency(gearbox)
-        for check in _FEASIBILITY:
-            check(gearbox)
+        _check_loaded(gearbox)
     except SpecError as exc:
         table, _, name = exc.field.partition(".")
         if name.split(".")[0] in raw["overrides"].get(table, {}):
@@ -355,7 +443,8 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
 def as_dict(obj: Any) -> Any:
     """A spec (or any of its tables) as plain JSON-able data; file paths are left out."""
     if dataclasses.is_dataclass(obj):
-        return {f.name: as_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj) if f.name != "source"}
+        return {f.name: as_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)
+                if f.name not in ("source", "derived")}
     if isinstance(obj, dict):
         return {k: as_dict(v) for k, v in sorted(obj.items())}
     if isinstance(obj, Path):

@@ -16,7 +16,7 @@ import math
 from dataclasses import dataclass
 
 from flexgear.geometry.involute import GearSetGeometry, gear_set_geometry
-from flexgear.spec import GearboxSpec
+from flexgear.spec import GearboxSpec, GearSet
 
 __all__ = ["Theory", "theory", "gear_set_theory", "mesh_frequency_hz"]
 
@@ -48,10 +48,11 @@ def theory(spec: GearboxSpec) -> Theory:
     return gear_set_theory(spec, gear_set_geometry(spec))
 
 
-def mesh_frequency_hz(spec: GearboxSpec, speed_rpm: float) -> float:
+def mesh_frequency_hz(spec: GearboxSpec | GearSet, speed_rpm: float) -> float:
     """f_m = z_s |n_sun - n_carrier| / 60 [Hz] (module docstring) at the input speed ``speed_rpm`` [rpm]: the carrier
-    fixed for the star, turning at z_s / (z_s + z_r) of the input for the planetary arrangement."""
-    g = spec.gears
+    fixed for the star, turning at z_s / (z_s + z_r) of the input for the planetary arrangement. ``spec``: the
+    gearbox or its gear set."""
+    g = spec if isinstance(spec, GearSet) else spec.gears
     r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
     return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
 

@@ -25,7 +25,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.optimize import brentq
 
-from flexgear.spec import GearboxSpec
+from flexgear.spec import GearboxSpec, GearSet, GearSetAssumed
 
 __all__ = [
     "inv",
@@ -34,6 +34,7 @@ __all__ = [
     "base_helix_angle",
     "Gear",
     "GearMesh",
+    "gear_set_geometry_of",
     "Mesh",
     "HelixHalf",
     "helix_halves",
@@ -319,6 +320,12 @@ def gear_set_geometry(spec: GearboxSpec) -> GearSetGeometry:
     their content.
     """
     return _gear_set_geometry(spec.gears, spec.gears_assumed)
+
+
+def gear_set_geometry_of(gears: GearSet, assumed: GearSetAssumed) -> GearSetGeometry:
+    """:func:`gear_set_geometry` from the two gear tables alone (``[gears]``, ``[gears_assumed]``), e.g. while the
+    rest of a gearbox file is still being loaded (flexgear.sizing)."""
+    return _gear_set_geometry(gears, assumed)
 
 
 @functools.lru_cache(maxsize=64)

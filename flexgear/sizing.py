@@ -1,0 +1,145 @@
+"""Sizes that follow the gear set: the default of every component dimension, joint size, mesh size and
+gear-dependent setting a gearbox file leaves out.
+
+A gearbox file needs only its gear data, bearings and load case (:data:`flexgear.spec.REQUIRED_TABLES`); every
+other value has a documented default. Fixed defaults sit on the schema's fields (:mod:`flexgear.schema`); the
+ones below scale with the gears, so that one file serves a 1 mm or a 20 mm module alike. Each rule states its
+proportion and what it gives for the study's gear set (44/45/136, m_n 2.12 mm, helix 25 deg, 30 mm per helix half;
+the study's file gives its own values, docs/configuration.md). A value given in the file is checked like any other
+field and wins.
+
+With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`flexgear.geometry.involute`):
+
+- gears: face width 0.6 d_sun (reference diameter) in all, split over the halves of a double helix (study 61.8 vs
+  60 mm); half gap between the halves 4 m (8.5 vs 8); normal backlash 0.05 m (0.106 vs 0.10);
+- bores: sun and planet 0.5 d_f (48.6 and 49.9 vs 50); relief groove 0.5 m (1.06 vs 1.0);
+- ring: rim 4 m below the root (8.5 vs 8); bolt holes 4 m (8.5 vs 8); flange outer diameter the rim's diameter
+  plus four bolt holes (376 vs 370); flange 4 m thick (8.5 vs 8); the bolt count is a fixed default (12);
+- joint: each bolt's clamped disc 2.5 bolt holes (21.2 vs 21);
+- shafts: input shaft outer diameter the sun's bore, inner 0.6 of it, length 3 sun bores (48.6/29.2/146 vs
+  50/30/150); output shaft outer diameter a quarter of the ring flange's, inner 0.78 of it, length as the input
+  shaft's (94/73/146 vs 90/70/150); bearing seats 0.4 sun bores wide (19.5 vs 20);
+- mesh levels: ``coarse`` teeth 1.9 m, body 3.8 m (4.03/8.06 vs 4/8); ``default`` teeth 0.95 m, body 2.8 m
+  (2.0/5.9 vs 2/6);
+- reduction: fixed-interface cutoff 3.5 mesh orders at the load case's input speed (15.4 kHz, as the study's);
+- load case: step 1/24 of the mesh period (9.5 vs 10 us);
+- screening: settled-window blocks of z_ring / settle_final_blocks mesh cycles, rounded (17, as the study's);
+  a fixed window from the ramps' end to the load case's end;
+- lumped model's carrier (turning in the planetary arrangement only): as heavy as its planets together (solid
+  discs over the root circle, the whole face width), its inertia that of a disc of radius a_w.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from flexgear.geometry.involute import gear_set_geometry_of
+from flexgear.schema import GearSet, GearSetAssumed, LoadCase, Material
+from flexgear.spec import register_derived_defaults
+from flexgear.theory import mesh_frequency_hz
+
+__all__ = ["derived_defaults", "FACE_WIDTH_PER_SUN_DIAMETER", "CUTOFF_MESH_ORDERS", "STEPS_PER_MESH_PERIOD",
+           "MESH_SIZES_PER_MODULE"]
+
+FACE_WIDTH_PER_SUN_DIAMETER = 0.6
+"""Face width (all helix halves) over the sun's reference diameter: b/d_1 of a planetary sun, 0.5-0.8 in practice."""
+CUTOFF_MESH_ORDERS = 3.5
+"""Fixed-interface cutoff of the reduction in mesh orders: every body's modes to 3 mesh orders converge within 0.5 %
+(benchmarks/RESULTS.md, the band check)."""
+STEPS_PER_MESH_PERIOD = 24.0
+"""Time steps per mesh period: 24 resolves the third mesh harmonic with 8 steps."""
+MESH_SIZES_PER_MODULE = {"coarse": (1.9, 3.8), "default": (0.95, 2.8)}
+"""(tooth, body) element size per normal module of the mesh levels every gearbox has."""
+
+_MM = 1e-3
+
+
+def _gear_sizes(g: GearSet, halves: int) -> dict[str, float]:
+    """[gears_assumed]: face width per helix half (``halves`` 1 or 2), half gap, backlash [mm]."""
+    m = g.normal_module_mm
+    d_sun = g.sun_teeth * m / math.cos(g.helix_angle_rad)
+    return {"face_width_mm": FACE_WIDTH_PER_SUN_DIAMETER * d_sun / halves, "half_gap_mm": 4.0 * m,
+            "normal_backlash_mm": 0.05 * m}
+
+
+def _given(given: dict[str, Any], name: str, default: float) -> float:
+    """The file's value of ``name`` when it is a positive number (the field's check judges any other), else
+    ``default``: derived sizes follow the sizes the file gives."""
+    value = given.get(name)
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and value > 0
+    return float(value) if ok else default
+
+
+def _component_sizes(g: GearSet, a: GearSetAssumed, given: dict[str, Any]) -> dict[str, float]:
+    """[components_assumed] [mm] from the profile-shifted root diameters and the sizes the file ``given`` (module
+    docstring): the shafts follow the sun's bore, the flange the rim and bolt holes, whether given or derived."""
+    m = g.normal_module_mm
+    gs = gear_set_geometry_of(g, a)
+    df_sun, df_planet, df_ring = (2 * getattr(gs, n).root_radius / _MM for n in ("sun", "planet", "ring"))
+    rim = _given(given, "ring_rim_thickness_mm", 4.0 * m)
+    hole = _given(given, "ring_bolt_hole_diameter_mm", 4.0 * m)
+    flange = _given(given, "ring_flange_outer_diameter_mm", df_ring + 2 * rim + 4 * hole)
+    sun_bore = _given(given, "sun_bore_diameter_mm", 0.5 * df_sun)
+    shaft_in = _given(given, "input_shaft_outer_diameter_mm", sun_bore)
+    shaft_out = _given(given, "output_shaft_outer_diameter_mm", 0.25 * flange)
+    length = _given(given, "input_shaft_length_mm", 3.0 * sun_bore)
+    return {
+        "sun_bore_diameter_mm": sun_bore, "planet_bore_diameter_mm": 0.5 * df_planet,
+        "ring_rim_thickness_mm": rim, "ring_flange_outer_diameter_mm": flange, "ring_flange_thickness_mm": 4.0 * m,
+        "ring_bolt_hole_diameter_mm": hole,
+        "input_shaft_outer_diameter_mm": shaft_in, "input_shaft_inner_diameter_mm": 0.6 * shaft_in,
+        "input_shaft_length_mm": length,
+        "output_shaft_outer_diameter_mm": shaft_out, "output_shaft_inner_diameter_mm": 0.78 * shaft_out,
+        "output_shaft_length_mm": _given(given, "output_shaft_length_mm", length),
+        "relief_groove_depth_mm": 0.5 * m, "bearing_seat_width_mm": 0.4 * sun_bore,
+    }
+
+
+def _carrier(g: GearSet, a: GearSetAssumed, material: Material) -> dict[str, float]:
+    """[lumped_assumed] carrier mass [kg] and inertia [kg m^2] (module docstring)."""
+    gs = gear_set_geometry_of(g, a)
+    width = a.face_width_m * (2 if a.helix_layout == "double" else 1)
+    mass = g.planet_count * material.density_kg_m3 * math.pi * gs.planet.root_radius ** 2 * width
+    return {"carrier_mass_kg": mass, "carrier_inertia_kg_m2": 0.5 * mass * gs.centre_distance ** 2}
+
+
+def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -> dict[str, Any]:
+    """The derived defaults of ``table`` from the tables already ``built`` (flexgear.spec's loading order: gears,
+    gears_assumed, load_case, material_assumed, then the rest) and the values ``given`` in the table itself (raw:
+    a value of the wrong type is left to the field's check); {} for a table without any."""
+    g: GearSet = built["gears"]
+    if table == "gears_assumed":
+        return _gear_sizes(g, 2 if given.get("helix_layout") == "double" else 1)
+    a: GearSetAssumed = built["gears_assumed"]
+    if table == "components_assumed":
+        return _component_sizes(g, a, given)
+    if table == "joints_assumed":
+        hole = built["components_assumed"].ring_bolt_hole_diameter_mm
+        return {"bolt_clamp_diameter_mm": 2.5 * hole}
+    if table.startswith("meshing_assumed."):
+        level = table.split(".", 1)[1]
+        if level not in MESH_SIZES_PER_MODULE:
+            return {}
+        tooth, body = MESH_SIZES_PER_MODULE[level]
+        return {"tooth_size_mm": tooth * g.normal_module_mm, "body_size_mm": body * g.normal_module_mm}
+    if table == "lumped_assumed":
+        return _carrier(g, a, built["material_assumed"])
+    if table == "load_case":
+        speed = given.get("input_speed_rpm")
+        if not isinstance(speed, (int, float)) or isinstance(speed, bool) or not speed:
+            return {}
+        return {"step_size_s": 1.0 / (STEPS_PER_MESH_PERIOD * mesh_frequency_hz(g, speed))}
+    lc: LoadCase = built["load_case"]
+    f_mesh = mesh_frequency_hz(g, lc.input_speed_rpm)
+    if table == "reduction_assumed":
+        return {"fixed_interface_cutoff_hz": CUTOFF_MESH_ORDERS * f_mesh}
+    if table == "screening":
+        blocks = given.get("settle_final_blocks", 8)
+        blocks = blocks if isinstance(blocks, int) and blocks > 0 else 8
+        return {"settle_block_mesh_cycles": max(1, round(g.ring_teeth / blocks)),
+                "window_start_s": lc.ramp_time_s, "window_end_s": lc.end_time_s}
+    return {}
+
+
+register_derived_defaults(derived_defaults)
