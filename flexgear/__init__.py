@@ -2,7 +2,9 @@
 
 The public API (``__all__``) builds any gearbox in a few lines: gear geometry (``gear_pair_geometry``),
 bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``; parts bolted or
-bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``), bearings
+bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``; any gear as a toothed
+body built as the study's gears, ``GearBody`` -> ``toothed_body`` (flexible, its high modes as residual
+compliance through ``dropped_modes``) or ``toothed_mass_properties`` (rigid)), bearings
 (``BearingElement``: a 6x6 stiffness and damping about a point on an axis, on a body frame or an interface,
 ``add_planet_bearing``), fixed joints (``FixedJointElement``, ``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
@@ -33,6 +35,10 @@ _LAZY = {
     "fe_model": "fe.fem", "ReducedBody": "fe.cms", "interface": "fe.cms", "reduce": "fe.tied",
     "Tie": "fe.tied", "TiedFE": "fe.tied", "tie_parts": "fe.tied",
     "LoadCircle": "fe.attachment", "static_compliance": "fe.compliance",
+    # toothed bodies of any gear set, rigid or flexible, built as the study's gears
+    "GearBody": "geometry.gear_body", "Engagement": "geometry.gear_body",
+    "toothed_body": "fe.toothed", "toothed_mass_properties": "fe.toothed", "toothed_fe_model": "fe.toothed",
+    "toothed_contacts": "fe.toothed", "toothed_load_circles": "fe.toothed",
     # laws
     "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",
     # multibody: bodies, elements, contacts
@@ -40,7 +46,7 @@ _LAZY = {
     "FlexibleBody": "mbs.flexible", "add_flexible_body": "mbs.flexible", "SpinSchedule": "mbs.spin",
     "add_fixed_joint": "mbs.elements", "add_interface_joint": "mbs.elements",
     "add_speed_drive": "mbs.elements", "add_load_torque": "mbs.elements",
-    "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts",
+    "GearContact": "mbs.contacts", "pair_contacts": "mbs.contacts", "dropped_modes": "mbs.residual",
     "Carrier": "mbs.carrier", "add_planet_bearing": "mbs.carrier",
     "GearTrain": "mbs.train", "add_gear_train": "mbs.train",
     # signals and solving

@@ -30,6 +30,7 @@ import json
 import os
 import time
 import uuid
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -45,16 +46,20 @@ from flexgear.cache import (
     record_digest,
 )
 from flexgear.design import Design, as_design
-from flexgear.geometry.layout import geometry_hash
+from flexgear.geometry.layout import ComponentLayout, geometry_hash
 from flexgear.progress import say
-from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, MeshingSettings
 
 __all__ = [
     "ComponentMesh",
+    "MeshSizes",
+    "MeshSource",
     "component_brep",
     "component_mesh",
+    "source_mesh",
     "build_meshes",
     "region_nodes",
+    "layout_regions",
 ]
 
 _MESH_VERSION = 2
@@ -118,11 +123,57 @@ def _private_temporary(path: Path, suffix: str) -> Path:
     return path.with_name(f".{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{suffix}")
 
 
+@dataclass(frozen=True)
+class MeshSizes:
+    """Netgen settings of a mesh: element size on the tooth (and bolt-hole) faces and elsewhere [m], Netgen's
+    curvaturesafety (element size <= curvature radius / it) and optimisation passes (optsteps2d, optsteps3d)."""
+
+    tooth: float
+    body: float
+    elements_per_curvature_radius: float = 0.3
+    optimisation_steps: int = 3
+
+    @classmethod
+    def of(cls, settings: MeshingSettings) -> MeshSizes:
+        """The sizes of a mesh level of gearbox.toml (``[meshing_assumed.<level>]``, mm)."""
+        return cls(settings.tooth_size_mm * 1e-3, settings.body_size_mm * 1e-3,
+                   settings.elements_per_curvature_radius, settings.optimisation_steps)
+
+
+@dataclass(frozen=True)
+class MeshSource:
+    """What a cached mesh is made of: the ``layout`` of its solid (its name names the cache files), the mesh
+    ``level`` (a label) and ``sizes``, the level's ``element_order``, the solid's cache key ``solid_key``, the
+    mesh's cache key per element order ``mesh_key(order)``, and its named boundary node sets
+    ``regions(nodes, boundary)`` (as :func:`region_nodes`). :func:`component_mesh` meshes the study's components
+    from one (:func:`_study_source`), flexgear.fe.toothed a single gear body."""
+
+    layout: ComponentLayout
+    level: str
+    sizes: MeshSizes
+    element_order: int
+    solid_key: str
+    mesh_key: Callable[[int], str]
+    regions: Callable[[np.ndarray, np.ndarray], dict[str, np.ndarray]]
+
+    @property
+    def name(self) -> str:
+        return self.layout.name
+
+
 def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = False) -> Path:
     """Path of the cached OCC solid (``.brep``) of ``component`` (``spec``: a spec or its design, flexgear.design),
     checked against its digest; built on a cache miss or when the file does not match its digest."""
     d = as_design(spec)
-    path = cache_dir() / f"solid-{component}-{geometry_hash(d.spec, component)}.brep"
+    return layout_brep(d.layouts[component], geometry_hash(d.spec, component), progress)
+
+
+def layout_brep(layout: ComponentLayout, key: str, progress: bool = False) -> Path:
+    """Path of the cached OCC solid (``solid-<layout name>-<key>.brep``) of ``layout``
+    (flexgear.geometry.solids.component_solid), checked against its digest; built on a cache miss or when the
+    file does not match its digest. ``key``: a hash of everything the layout is made from."""
+    component = layout.name
+    path = cache_dir() / f"solid-{component}-{key}.brep"
 
     def load() -> Path | None:
         if not path.exists():
@@ -134,7 +185,7 @@ def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = 
         from flexgear.geometry.solids import component_solid
 
         t0 = time.perf_counter()
-        shape = component_solid(d.layouts[component])
+        shape = component_solid(layout)
         tmp = _private_temporary(path, ".brep")
         shape.WriteBrep(str(tmp))
         tmp.replace(path)
@@ -150,14 +201,13 @@ def _say(progress: bool, text: str) -> None:
         say(text)
 
 
-def _refine_teeth(geo, d: Design, component: str, size: float, mp) -> None:
+def _refine_teeth(geo, layout: ComponentLayout, size: float, mp) -> None:
     """Tooth size on tooth faces (inside the tip-root band) and bolt-hole faces, and along their edges.
 
     ``geo.SetFaceMeshsize`` limits the faces; the edges get the same limit through points of
     ``mp.RestrictH`` along them (a face's ``maxh`` property would cover both, but only when set
     before the OCCGeometry is built, which costs a second build of it: 2.5 s for the ring).
     """
-    layout = d.layouts[component]
     bands = []
     if layout.gear is not None:
         g = layout.gear
@@ -180,18 +230,18 @@ def _refine_teeth(geo, d: Design, component: str, size: float, mp) -> None:
                     mp.RestrictH(p.x, p.y, p.z, size)
 
 
-def _netgen_mesh(brep: Path, d: Design, component: str, level: str):
-    """The first-order Netgen mesh of the solid, its OCC geometry attached (a second order is raised from it)."""
+def _netgen_mesh(brep: Path, layout: ComponentLayout, sizes: MeshSizes):
+    """The first-order Netgen mesh of the solid of ``layout``, its OCC geometry attached (a second order is raised
+    from it)."""
     import netgen.meshing as nm
     from netgen.occ import OCCGeometry
 
-    settings = d.spec.meshing_assumed[level]
     geo = OCCGeometry(str(brep))
     mp = nm.MeshingParameters(
-        maxh=settings.body_size_mm * 1e-3, curvaturesafety=settings.elements_per_curvature_radius,
-        grading=_GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=settings.optimisation_steps,
-        optsteps3d=settings.optimisation_steps)
-    _refine_teeth(geo, d, component, settings.tooth_size_mm * 1e-3, mp)
+        maxh=sizes.body, curvaturesafety=sizes.elements_per_curvature_radius,
+        grading=_GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=sizes.optimisation_steps,
+        optsteps3d=sizes.optimisation_steps)
+    _refine_teeth(geo, layout, sizes.tooth, mp)
     return geo.GenerateMesh(mp=mp)
 
 
@@ -206,8 +256,29 @@ def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
 
 
 def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
-    """Named boundary node sets of ``component`` of design ``d`` (indices into ``nodes``, among ``boundary``)."""
+    """Named boundary node sets of ``component`` of design ``d`` (indices into ``nodes``, among ``boundary``): those
+    of its layout (:func:`layout_regions`), and a shaft's ``bearing_seat`` and ``gear_seat``."""
     spec, layout = d.spec, d.layouts[component]
+    out = layout_regions(layout, nodes, boundary)
+    if component in ("input_shaft", "output_shaft"):
+        p = nodes[boundary]
+        r, z, tol = np.hypot(p[:, 0], p[:, 1]), p[:, 2], _REGION_TOL
+        tube = next(q for q in layout.prisms if q.name == "tube")
+        width = spec.components_assumed.bearing_seat_width_mm * 1e-3
+        outer = np.abs(r - tube.section.outer) < tol
+        if component == "input_shaft":
+            out["bearing_seat"] = boundary[outer & (z < tube.z0 + width + tol)]
+            sun = d.layouts["sun"].z_range
+            out["gear_seat"] = boundary[outer & (z > sun[0] - tol)]
+        else:
+            out["bearing_seat"] = boundary[outer & (z > tube.z1 - width - tol)]
+    return {k: np.unique(v) for k, v in out.items()}
+
+
+def layout_regions(layout: ComponentLayout, nodes: np.ndarray, boundary: np.ndarray) -> dict[str, np.ndarray]:
+    """Named boundary node sets of a component's ``layout`` (indices into ``nodes``, among ``boundary``, ascending):
+    a gear's ``flanks`` (between form and tip radius, inside its toothed prisms) and an external gear's ``bore``;
+    every prism's bolt holes, ``bolt_hole_<k>`` and ``bolt_holes``."""
     p = nodes[boundary]
     r = np.hypot(p[:, 0], p[:, 1])
     z = p[:, 2]
@@ -232,20 +303,10 @@ def region_nodes(d: Design, component: str, nodes: np.ndarray, boundary: np.ndar
             sets = []
             in_z = (z > q.z0 - tol) & (z < q.z1 + tol)
             for k, (cx, cy) in enumerate(q.section.hole_centres()):
-                d = np.hypot(p[:, 0] - cx, p[:, 1] - cy)
-                sets.append(boundary[in_z & (np.abs(d - q.section.hole_radius) < tol)])
+                dist = np.hypot(p[:, 0] - cx, p[:, 1] - cy)
+                sets.append(boundary[in_z & (np.abs(dist - q.section.hole_radius) < tol)])
                 out[f"bolt_hole_{k}"] = sets[-1]
             out["bolt_holes"] = np.concatenate(sets)
-    if component in ("input_shaft", "output_shaft"):
-        tube = next(q for q in layout.prisms if q.name == "tube")
-        width = spec.components_assumed.bearing_seat_width_mm * 1e-3
-        outer = on_cylinder(tube.section.outer)
-        if component == "input_shaft":
-            out["bearing_seat"] = boundary[outer & (z < tube.z0 + width + tol)]
-            sun = d.layouts["sun"].z_range
-            out["gear_seat"] = boundary[outer & (z > sun[0] - tol)]
-        else:
-            out["bearing_seat"] = boundary[outer & (z > tube.z1 - width - tol)]
     return {k: np.unique(v) for k, v in out.items()}
 
 
@@ -259,23 +320,34 @@ def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coa
         raise ValueError(f"unknown mesh level {level!r}; gearbox.toml [meshing_assumed] has "
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
-    return _mesh(d, component, level, order, progress)
+    return source_mesh(_study_source(d, component, level), order, progress)
 
 
-def _mesh(d: Design, component: str, level: str, order: int, progress: bool) -> ComponentMesh:
-    """The cached mesh (:func:`_cached_mesh`), or the one built and stored (:func:`_build_mesh`) when it is
-    missing or cannot be read, by one process at a time (the lock of its JSON summary)."""
-    brep = component_brep(d, component, progress)
-    # the cache entry: keyed by the geometry, the level's settings, the order and the meshing procedure
-    key = geometry_hash(d.spec, component, d.spec.meshing_assumed[level], order, _GRADING, _MESH_VERSION)
-    stem = cache_dir() / f"mesh-{component}-{level}-o{order}-{key}"
+def _study_source(d: Design, component: str, level: str) -> MeshSource:
+    """The :class:`MeshSource` of a study component: its design's layout, the level's settings; the solid keyed by
+    the geometry, the mesh by the geometry, the level's settings, the order and the meshing procedure."""
+    spec = d.spec
+    settings = spec.meshing_assumed[level]
+    return MeshSource(d.layouts[component], level, MeshSizes.of(settings), settings.element_order,
+                      geometry_hash(spec, component),
+                      lambda order: geometry_hash(spec, component, settings, order, _GRADING, _MESH_VERSION),
+                      lambda nodes, boundary: region_nodes(d, component, nodes, boundary))
+
+
+def source_mesh(source: MeshSource, order: int, progress: bool = False) -> ComponentMesh:
+    """The cached mesh of ``source`` of element ``order`` (:func:`_cached_mesh`), or the one built and stored
+    (:func:`_build_mesh`) when it is missing or cannot be read, by one process at a time (the lock of its JSON
+    summary). Files ``mesh-<name>-<level>-o<order>-<mesh_key(order)>.*`` in the cache folder."""
+    component, level = source.name, source.level
+    brep = layout_brep(source.layout, source.solid_key, progress)
+    stem = cache_dir() / f"mesh-{component}-{level}-o{order}-{source.mesh_key(order)}"
     paths = {"npz": stem.with_suffix(".npz"), "vol": stem.with_suffix(".vol.gz"), "json": stem.with_suffix(".json")}
 
     def load() -> ComponentMesh | None:
         return _cached_mesh(paths, component, level, order, brep)
 
     def build() -> ComponentMesh:
-        return _build_mesh(d, component, level, order, paths, brep, progress)[0]
+        return _build_mesh(source, order, paths, brep, progress)[0]
 
     return load_or_build(paths["json"], load, build)
 
@@ -303,28 +375,27 @@ def _cached_mesh(paths: dict[str, Path], component: str, level: str, order: int,
                          build_time, paths["vol"], brep)
 
 
-def _build_mesh(d: Design, component: str, level: str, order: int, paths: dict[str, Path], brep: Path,
-                progress: bool):
-    """Mesh ``component`` (cache miss), store it at ``paths`` (its cache entry, :func:`_mesh`); (ComponentMesh, its
-    Netgen mesh with the OCC geometry). ``brep``: the component's solid (:func:`component_brep`).
+def _build_mesh(source: MeshSource, order: int, paths: dict[str, Path], brep: Path, progress: bool):
+    """Mesh ``source`` (cache miss), store it at ``paths`` (its cache entry, :func:`source_mesh`); (ComponentMesh,
+    its Netgen mesh with the OCC geometry). ``brep``: the component's solid (:func:`layout_brep`).
 
     Netgen meshes once per component and level: a second-order mesh is the first-order mesh (the cached
     one, or meshed and stored here) raised by ``SecondOrder()``, edge nodes on the true surfaces, the same
     topology the reduction's FE model is built on (flexgear.fe.fem raises the order the same way).
     """
-    spec = d.spec
+    component, level = source.name, source.level
     paths["json"].unlink(missing_ok=True)  # written last: until then readers find no entry, not a mixed one
     t0 = time.perf_counter()
     if order == 1:
-        ngmesh = _netgen_mesh(brep, d, component, level)
+        ngmesh = _netgen_mesh(brep, source.layout, source.sizes)
     else:
-        first = _mesh(d, component, level, 1, progress)
+        first = source_mesh(source, 1, progress)
         ngmesh = _load_netgen_mesh(first.vol_path, brep)  # as stored: the same raised mesh cold or warm
         ngmesh.SecondOrder()
     nodes, elements, surface = _arrays(ngmesh, order)
     build = time.perf_counter() - t0
     surface = _orient_outward(nodes, surface)
-    regions = region_nodes(d, component, nodes, np.unique(surface))
+    regions = source.regions(nodes, np.unique(surface))
     mesh = ComponentMesh(component, level, order, nodes, elements, surface, regions, build, paths["vol"], brep)
     tmp_vol = _private_temporary(paths["vol"], ".vol.gz")
     ngmesh.Save(str(tmp_vol))
@@ -337,7 +408,7 @@ def _build_mesh(d: Design, component: str, level: str, order: int, paths: dict[s
             "elements": mesh.n_elements, "build_time_s": build,
             "regions": {k: len(v) for k, v in regions.items()}}
     atomic_write_bytes(paths["json"], json.dumps(info, indent=1).encode())
-    role = "" if order == spec.meshing_assumed[level].element_order else " (topology for the reduction)"
+    role = "" if order == source.element_order else " (topology for the reduction)"
     _say(progress, f"  {component} ({level}): {mesh.n_elements} tetrahedra, {mesh.n_nodes} nodes, "
                    f"order {order}{role}, meshed in {build:.1f} s")
     return mesh, ngmesh

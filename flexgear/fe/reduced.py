@@ -35,6 +35,7 @@ from flexgear.design import Design, as_design
 from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.bolted import clamped_patches
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
+from flexgear.geometry.contact_lines import MeshContactGeometry
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
@@ -42,7 +43,7 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
            "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
-           "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT"]
+           "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles"]
 
 BOLT_PATCHES = "bolt_patches"
 """Name of the ring's and the output shaft's rigid interface over the clamped discs of all bolts."""
@@ -120,13 +121,25 @@ def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarr
               "ring": [(inner, -sigma, False, planets)]}[component]
     out = []
     for contact, drive, first, angles in meshes:
-        mesh, width = contact.mesh, contact.helix_width
-        radius = mesh.operating_pitch_radii[0 if first else 1]
-        for half, (n_r, n_t, n_z) in zip(contact.halves, contact.normals[drive], strict=True):
-            direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
-            circle = LoadCircle(radius, half.z - width / 2, half.z + width / 2, 0, direction,
-                                spec.gears.normal_module_m)
-            out.append((circle, angles))
+        out += [(circle, angles) for circle in band_circles(contact, drive, first, spec.gears.normal_module_m)]
+    return out
+
+
+def band_circles(contact: MeshContactGeometry, drive: int, first: bool, band: float) -> list[LoadCircle]:
+    """Load circles of order 0 on a gear's contact bands in one mesh, one per helix half: at the gear's operating
+    pitch radius, over the half's width, along the half's tooth normal in the gear's local (radial, tangential,
+    axial) frame, with the radial half-width ``band`` [m] the contact kernel reads (one normal module).
+
+    ``contact``: the mesh's contact geometry (flexgear.geometry.contact_lines.MeshContactGeometry); ``drive``: +1
+    or -1 (gear 1 pushing gear 2 counter-clockwise / clockwise about +z); ``first``: the gear is gear 1 of the
+    mesh (else gear 2: an external one sees the normal's radial and tangential parts reversed).
+    """
+    mesh, width = contact.mesh, contact.helix_width
+    radius = mesh.operating_pitch_radii[0 if first else 1]
+    out = []
+    for half, (n_r, n_t, n_z) in zip(contact.halves, contact.normals[drive], strict=True):
+        direction = (n_r, n_t, n_z) if first or mesh.internal else (-n_r, -n_t, n_z)
+        out.append(LoadCircle(radius, half.z - width / 2, half.z + width / 2, 0, direction, band))
     return out
 
 

@@ -56,6 +56,7 @@ __all__ = [
     "gear_profiles",
     "component_layout",
     "gear_set_layout",
+    "toothed_prisms",
     "section_integrals",
     "exact_mass_properties",
     "layout_mass_properties",
@@ -154,8 +155,9 @@ def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
 class Section:
     """Transverse section with n-fold symmetry about the axis (radii in m).
 
-    ``gear`` None: annulus inner..outer; "sun"/"planet": external toothed outline with a bore of
-    radius ``inner``; "ring": rim of radius ``outer`` with the internal toothed outline inside.
+    ``gear`` None: annulus inner..outer; "ring": rim of radius ``outer`` with the internal toothed outline
+    inside; any other name ("sun", "planet", a single gear's name, flexgear.geometry.gear_body): external
+    toothed outline with a bore of radius ``inner``. The name is the key of the outline's tooth profile.
     ``holes`` circular holes of radius ``hole_radius`` equally spaced on ``hole_circle_radius``.
     """
 
@@ -226,12 +228,26 @@ def _gear_half_length(spec: GearboxSpec) -> float:
 def _gear_prisms(spec: GearboxSpec, name: str, gear: Gear, inner: float, outer: float) -> list[Prism]:
     """Toothed prisms (one or two helices) and, for a double helix, the grooved gap between them."""
     a = spec.gears_assumed
-    twist = _HANDS[name] * math.tan(gear.helix_angle) / gear.reference_radius
+    return toothed_prisms(name, gear, inner, outer, _HANDS[name], a.helix_layout, a.face_width_m, a.half_gap_m,
+                          spec.components_assumed.relief_groove_depth_mm * 1e-3)
+
+
+def toothed_prisms(name: str, gear: Gear, inner: float, outer: float, hand: float, helix_layout: str,
+                   face_width: float, half_gap: float, groove_depth: float) -> list[Prism]:
+    """The toothed prisms of ``gear`` about its axial mid-plane: one helix over the ``face_width`` [m] ("single"),
+    or two halves of opposite hand, each half the face width, with a relief groove ``groove_depth`` [m] beyond
+    the root circle over the ``half_gap`` [m] between them ("double"); ``hand`` (+1 / -1) of the helix at +z.
+
+    The sections are named ``name`` (the key of the gear's tooth profile; "ring" marks an internal outline, see
+    :class:`Section`); ``inner``, ``outer`` [m]: the bore radius of an external gear (``outer`` unused), the
+    outer rim radius of an internal one (``inner`` 0).
+    """
+    twist = hand * math.tan(gear.helix_angle) / gear.reference_radius
     section = Section(inner, outer, name)
-    if a.helix_layout == "single":
-        return [Prism("teeth", -a.face_width_m / 2, a.face_width_m / 2, section, twist)]
-    g, b = a.half_gap_m, a.face_width_m / 2
-    depth = spec.components_assumed.relief_groove_depth_mm * 1e-3
+    if helix_layout == "single":
+        return [Prism("teeth", -face_width / 2, face_width / 2, section, twist)]
+    g, b = half_gap, face_width / 2
+    depth = groove_depth
     groove = Section(inner, gear.root_radius - depth) if not gear.internal else Section(gear.root_radius + depth, outer)
     prisms = [Prism("teeth_lower", -g / 2 - b, -g / 2, section, -twist)]
     if g > 0:
