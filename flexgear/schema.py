@@ -244,9 +244,9 @@ class MeshingSettings:
     body_size_mm: float = _derived(0.0, lo_open=True)
     element_order: int = _num(1, 2, integer=True, default=2)
     # Netgen curvaturesafety: element size <= curvature radius / this on curved faces and edges.
-    elements_per_curvature_radius: float = _num(0.0, lo_open=True, default=0.3)
+    elements_per_curvature_radius: float = _num(0.0, lo_open=True, default=0.3, derived=True)
     # Netgen optsteps2d and optsteps3d: smoothing/swapping passes after surface and volume meshing.
-    optimisation_steps: int = _num(0, 10, integer=True, default=3)
+    optimisation_steps: int = _num(0, 10, integer=True, default=3, derived=True)
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -21,9 +21,11 @@ class SpecError(ValueError):
 
 
 def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
-         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING) -> Any:
-    """Field with a numeric range check (validated on load); optional when ``default`` is given."""
-    return field(default=default, metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc})
+         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING, derived: bool = False) -> Any:
+    """Field with a numeric range check (validated on load); optional when ``default`` is given. ``derived``: a
+    value left out of the file follows the gear data where :mod:`flexgear.sizing` gives one, else ``default``."""
+    meta = {"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc}
+    return field(default=default, metadata={**meta, "derived": True} if derived else meta)
 
 
 def _derived(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, doc: str = "") -> Any:

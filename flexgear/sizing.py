@@ -19,8 +19,9 @@ With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`f
 - shafts: input shaft outer diameter the sun's bore, inner 0.6 of it, length 3 sun bores (48.6/29.2/146 vs
   50/30/150); output shaft outer diameter a quarter of the ring flange's, inner 0.78 of it, length as the input
   shaft's (94/73/146 vs 90/70/150); bearing seats 0.4 sun bores wide (19.5 vs 20);
-- mesh levels: ``coarse`` teeth 1.9 m, body 3.8 m (4.03/8.06 vs 4/8); ``default`` teeth 0.95 m, body 2.8 m
-  (2.0/5.9 vs 2/6);
+- mesh levels: ``coarse`` teeth 1.9 m, body 3.8 m but no coarser than the teeth allow 6 elements across the
+  input shaft (4.03/8.06 vs 4/8); ``default`` teeth 0.95 m, body 2.8 m, 8 across the shaft (2.0/5.9 vs 2/6);
+  Netgen's curvature refinement and optimisation passes as the study's levels;
 - reduction: fixed-interface cutoff 3.5 mesh orders at the load case's input speed (15.4 kHz, as the study's);
 - load case: step 1/24 of the mesh period (9.5 vs 10 us);
 - screening: settled-window blocks of z_ring / settle_final_blocks mesh cycles, rounded (17, as the study's);
@@ -40,7 +41,7 @@ from flexgear.spec import register_derived_defaults
 from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["derived_defaults", "FACE_WIDTH_PER_SUN_DIAMETER", "CUTOFF_MESH_ORDERS", "STEPS_PER_MESH_PERIOD",
-           "MESH_SIZES_PER_MODULE"]
+           "MESH_SIZES_PER_MODULE", "MESH_REFINEMENT", "ELEMENTS_PER_SHAFT_DIAMETER"]
 
 FACE_WIDTH_PER_SUN_DIAMETER = 0.6
 """Face width (all helix halves) over the sun's reference diameter: b/d_1 of a planetary sun, 0.5-0.8 in practice."""
@@ -51,6 +52,12 @@ STEPS_PER_MESH_PERIOD = 24.0
 """Time steps per mesh period: 24 resolves the third mesh harmonic with 8 steps."""
 MESH_SIZES_PER_MODULE = {"coarse": (1.9, 3.8), "default": (0.95, 2.8)}
 """(tooth, body) element size per normal module of the mesh levels every gearbox has."""
+ELEMENTS_PER_SHAFT_DIAMETER = {"coarse": 6.0, "default": 8.0}
+"""Least elements across the input shaft's diameter (body size <= d / this): a coarser shaft is meshed too
+unevenly for its axisymmetric frame (``frame_axisymmetry_tolerance``; 2.8 elements gave 3e-4 against 1e-4). The
+study's 50 mm shaft has 6.25 at its coarse level."""
+MESH_REFINEMENT = {"coarse": (0.1, 1), "default": (0.3, 3)}
+"""(elements per curvature radius, optimisation passes) of the two levels, as the study's coarse and default."""
 
 _MM = 1e-3
 
@@ -71,12 +78,25 @@ def _given(given: dict[str, Any], name: str, default: float) -> float:
     return float(value) if ok else default
 
 
+def _root_diameters_mm(g: GearSet, a: GearSetAssumed) -> tuple[float, float, float]:
+    """Root diameters [mm] of sun, planet and ring, profile-shifted to the operating centre distance; unshifted
+    sun and ring where that distance cannot be reached (the feasibility check then refuses the set by name)."""
+    try:
+        gs = gear_set_geometry_of(g, a)
+    except ValueError:
+        mt, m = g.normal_module_mm / math.cos(g.helix_angle_rad), g.normal_module_mm
+        shifts = (0.0, a.planet_shift_coefficient, 0.0)
+        return tuple(mt * z + (1 if internal else -1) * 2 * m * (a.dedendum_coefficient - x)
+                     for z, x, internal in zip((g.sun_teeth, g.planet_teeth, g.ring_teeth), shifts,
+                                               (False, False, True), strict=True))
+    return tuple(2 * getattr(gs, n).root_radius / _MM for n in ("sun", "planet", "ring"))
+
+
 def _component_sizes(g: GearSet, a: GearSetAssumed, given: dict[str, Any]) -> dict[str, float]:
     """[components_assumed] [mm] from the profile-shifted root diameters and the sizes the file ``given`` (module
     docstring): the shafts follow the sun's bore, the flange the rim and bolt holes, whether given or derived."""
     m = g.normal_module_mm
-    gs = gear_set_geometry_of(g, a)
-    df_sun, df_planet, df_ring = (2 * getattr(gs, n).root_radius / _MM for n in ("sun", "planet", "ring"))
+    df_sun, df_planet, df_ring = _root_diameters_mm(g, a)
     rim = _given(given, "ring_rim_thickness_mm", 4.0 * m)
     hole = _given(given, "ring_bolt_hole_diameter_mm", 4.0 * m)
     flange = _given(given, "ring_flange_outer_diameter_mm", df_ring + 2 * rim + 4 * hole)
@@ -98,10 +118,12 @@ def _component_sizes(g: GearSet, a: GearSetAssumed, given: dict[str, Any]) -> di
 
 def _carrier(g: GearSet, a: GearSetAssumed, material: Material) -> dict[str, float]:
     """[lumped_assumed] carrier mass [kg] and inertia [kg m^2] (module docstring)."""
-    gs = gear_set_geometry_of(g, a)
+    df_planet = _root_diameters_mm(g, a)[1] * _MM
     width = a.face_width_m * (2 if a.helix_layout == "double" else 1)
-    mass = g.planet_count * material.density_kg_m3 * math.pi * gs.planet.root_radius ** 2 * width
-    return {"carrier_mass_kg": mass, "carrier_inertia_kg_m2": 0.5 * mass * gs.centre_distance ** 2}
+    mass = g.planet_count * material.density_kg_m3 * math.pi * (df_planet / 2) ** 2 * width
+    centre = a.operating_centre_distance_m or 0.25 * g.normal_module_m / math.cos(g.helix_angle_rad) * (
+        g.sun_teeth + g.ring_teeth)
+    return {"carrier_mass_kg": mass, "carrier_inertia_kg_m2": 0.5 * mass * centre ** 2}
 
 
 def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -> dict[str, Any]:
@@ -122,7 +144,12 @@ def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -
         if level not in MESH_SIZES_PER_MODULE:
             return {}
         tooth, body = MESH_SIZES_PER_MODULE[level]
-        return {"tooth_size_mm": tooth * g.normal_module_mm, "body_size_mm": body * g.normal_module_mm}
+        curvature, passes = MESH_REFINEMENT[level]
+        shaft = built["components_assumed"].input_shaft_outer_diameter_mm
+        tooth_mm = tooth * g.normal_module_mm
+        body_mm = max(tooth_mm, min(body * g.normal_module_mm, shaft / ELEMENTS_PER_SHAFT_DIAMETER[level]))
+        return {"tooth_size_mm": tooth_mm, "body_size_mm": body_mm,
+                "elements_per_curvature_radius": curvature, "optimisation_steps": passes}
     if table == "lumped_assumed":
         return _carrier(g, a, built["material_assumed"])
     if table == "load_case":

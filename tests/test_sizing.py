@@ -105,7 +105,8 @@ def test_a_variant_that_changes_the_module_derives_the_sizes_again(tmp_path):
     components = dict.fromkeys(("input_shaft", "sun", "planets", "ring", "output_shaft"), "rigid")
     base = {"name": "rigid", "gearbox": "gearbox.toml", "components": components}
     (tmp_path / "a.toml").write_text(to_toml(base))
-    over = dict(base, overrides={"gears": {"normal_module_mm": 6.0}, "components_assumed": {"sun_bore_diameter_mm": 90}})
+    over = dict(base, overrides={"gears": {"normal_module_mm": 6.0},
+                                 "components_assumed": {"sun_bore_diameter_mm": 90}})
     (tmp_path / "b.toml").write_text(to_toml(over))
     a, b = load_variant(tmp_path / "a.toml").gearbox, load_variant(tmp_path / "b.toml").gearbox
     assert b.components_assumed.sun_bore_diameter_mm == 90.0
