@@ -12,7 +12,8 @@ interfaces:
 
 Mesh sizes per level come from ``[meshing_assumed.<level>]`` of gearbox.toml: ``tooth_size_mm``
 on the tooth and bolt-hole faces, ``body_size_mm`` elsewhere, ``element_order`` 1 or 2. Second
-order nodes are placed on the true (OCC) surfaces by Netgen.
+order nodes are placed on the true (OCC) surfaces by Netgen. Any other layout (a single gear body,
+flexgear.fe.toothed) is meshed and cached the same way from a :class:`MeshSource` (:func:`source_mesh`).
 
 Cache (``meshes/``, keyed by a hash of every input): the solid as ``.brep`` with its digest
 (``.brep.sha256``), the Netgen mesh as ``.vol.gz`` (reload with :meth:`ComponentMesh.ngsolve_mesh`, which
