@@ -208,7 +208,7 @@ def band(spec, body: str, level: str, cutoff_orders: list[float], band_orders: f
     """Free-free modes below ``band_orders`` x f_mesh of ``body`` reduced with each fixed-interface cutoff against
     full FE (module docstring, ``--band``)."""
     from flexgear.fe.attachment import modal_basis
-    from flexgear.fe.cms import _FreeBodySolver, reduction_basis
+    from flexgear.fe.cms import FreeBodySolver, reduction_basis
     from flexgear.fe.spectrum import lowest_eigenpairs
     from flexgear.modal import mesh_frequency_hz
 
@@ -217,7 +217,7 @@ def band(spec, body: str, level: str, cutoff_orders: list[float], band_orders: f
     t0 = time.process_time()
     fe, itfs, circles, rigid = _body_fe(spec, body, level)
     m = fe.mass_operator()
-    solver = None if rigid else _FreeBodySolver(fe)
+    solver = None if rigid else FreeBodySolver(fe)
     free = None if rigid else solver.constrained((m @ solver.R).T)
     if rigid:  # the reference holds the rigid patches rigid too
         full = _patch_reference(fe, itfs, rigid, 1.02 * f_band)

@@ -188,7 +188,7 @@ def checks(a: argparse.Namespace) -> None:
     from flexgear.harmonic import turning_pattern, turning_response
     from flexgear.study.compare import harmonic_amplitudes
     from flexgear.study.harmonic_check import line_amplitude, periodic_peak_factor, sideband_rss
-    from flexgear.study.indicators import _kv
+    from flexgear.study.indicators import dynamic_factor
 
     print(load_average())
     worst, judged_all = 0.0, []
@@ -255,8 +255,8 @@ def checks(a: argparse.Namespace) -> None:
             planets = spec.gears.planet_count
             forces = [np.stack([sig[f"{kind}_mesh_force_{i + 1}_n"].to_numpy() for i in range(planets)], axis=1)
                       for kind in ("outer", "inner")]
-            kv_t = _kv(*(f[-k:] for f in forces))
-            kv_b = _kv(*(f[-2 * k:-k] for f in forces))
+            kv_t = dynamic_factor(*(f[-k:] for f in forces))
+            kv_b = dynamic_factor(*(f[-2 * k:-k] for f in forces))
             kv_f = float(freq.dynamic_factor().loc[n])
             kv_1 = float(freq.angles[n][0].dynamic_factor().iloc[0])
             rel = (kv_f - 1.0) / (kv_t - 1.0) - 1.0

@@ -156,7 +156,7 @@ def checks_section(level: str, bolted: bool) -> dict:
     import numpy as np
 
     import flexgear as fg
-    from flexgear.fe.cms import _rbe3_rows, full_free_modes, rbe3_weights
+    from flexgear.fe.cms import full_free_modes, rbe3_rows, rbe3_weights
     from flexgear.fe.compliance import free_body_solver
     from flexgear.fe.fem import rigid_body_modes
     from flexgear.fe.reduced import component_contacts, component_load_circles
@@ -193,7 +193,7 @@ def checks_section(level: str, bolted: bool) -> dict:
     c_red = fg.static_compliance(body, points, normals, "bearing_seat", kernel=kernel)
     out["contact_compliance_error"] = float(np.abs(c_red - c_full).max() / np.abs(c_full).max())
     ring_side = tied.interface("ring", ring_seat(ring, spec))
-    rows_load, rows_held = _rbe3_rows(fe, seat), _rbe3_rows(fe, ring_side)
+    rows_load, rows_held = rbe3_rows(fe, seat), rbe3_rows(fe, ring_side)
     u = solver.constrained(rows_held).solve(rows_load.T.toarray(), np.zeros((6, 6)))
     s_full = np.diag(rows_load @ u)
     rig = rigid_body_modes(body.nodes).reshape(len(body.nodes), 3, 6)

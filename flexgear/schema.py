@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flexgear.schema_fields import SpecError, _choice, _derived, _num
+from flexgear.schema_fields import SpecError, choice_field, derived_field, num_field
 from flexgear.schema_screening import (
     IndicatorTolerance,
     IndicatorWeights,
@@ -49,14 +49,14 @@ COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"
 class GearSet:
     """Table 1 of the study (and the planet count and arrangement of section 2.1)."""
 
-    sun_teeth: int = _num(3, integer=True)
-    planet_teeth: int = _num(3, integer=True)
-    ring_teeth: int = _num(3, integer=True)
-    planet_count: int = _num(1, 12, integer=True)
-    normal_module_mm: float = _num(0.0, lo_open=True)
-    helix_angle_deg: float = _num(0.0, 45.0)
-    normal_pressure_angle_deg: float = _num(10.0, 30.0)
-    arrangement: str = _choice("star", "planetary", default="star")
+    sun_teeth: int = num_field(3, integer=True)
+    planet_teeth: int = num_field(3, integer=True)
+    ring_teeth: int = num_field(3, integer=True)
+    planet_count: int = num_field(1, 12, integer=True)
+    normal_module_mm: float = num_field(0.0, lo_open=True)
+    helix_angle_deg: float = num_field(0.0, 45.0)
+    normal_pressure_angle_deg: float = num_field(10.0, 30.0)
+    arrangement: str = choice_field("star", "planetary", default="star")
 
     @property
     def normal_module_m(self) -> float:
@@ -76,16 +76,16 @@ class GearSetAssumed:
     """Gear data the study does not give (documented in gearbox.toml). Fields marked ``derived`` follow the gear
     data when the file leaves them out (:mod:`flexgear.sizing`); the others have fixed defaults."""
 
-    face_width_mm: float = _derived(0.0, lo_open=True, doc="mm per helix half")
-    helix_layout: str = _choice("double", "single", default="single")
-    half_gap_mm: float = _derived(0.0, doc="mm, half the axial gap between the helix halves")
-    operating_centre_distance_mm: float = _num(0.0, default=0.0, doc="mm; 0 = mean of the standard distances")
-    planet_shift_coefficient: float = _num(-1.0, 1.5, default=0.0)
-    addendum_coefficient: float = _num(0.5, 1.5, default=1.0, doc="ISO 53 basic rack")
-    dedendum_coefficient: float = _num(0.8, 2.0, default=1.25, doc="ISO 53 basic rack")
-    root_fillet_coefficient: float = _num(0.0, 0.6, default=0.3)
-    normal_backlash_mm: float = _derived(0.0, doc="mm along the normal, per mesh")
-    outer_inner_mesh_phase: float = _num(0.0, 1.0, default=0.0)
+    face_width_mm: float = derived_field(0.0, lo_open=True, doc="mm per helix half")
+    helix_layout: str = choice_field("double", "single", default="single")
+    half_gap_mm: float = derived_field(0.0, doc="mm, half the axial gap between the helix halves")
+    operating_centre_distance_mm: float = num_field(0.0, default=0.0, doc="mm; 0 = mean of the standard distances")
+    planet_shift_coefficient: float = num_field(-1.0, 1.5, default=0.0)
+    addendum_coefficient: float = num_field(0.5, 1.5, default=1.0, doc="ISO 53 basic rack")
+    dedendum_coefficient: float = num_field(0.8, 2.0, default=1.25, doc="ISO 53 basic rack")
+    root_fillet_coefficient: float = num_field(0.0, 0.6, default=0.3)
+    normal_backlash_mm: float = derived_field(0.0, doc="mm along the normal, per mesh")
+    outer_inner_mesh_phase: float = num_field(0.0, 1.0, default=0.0)
 
     @property
     def face_width_m(self) -> float:
@@ -109,9 +109,9 @@ class Material:
     """Gear and shaft material (assumed: through-hardened gear steel)."""
 
     # ranges of any engineering solid: outside them the value is a unit slip (g/cm^3, GPa, MPa)
-    density_kg_m3: float = _num(500.0, 25000.0, default=7850.0)
-    youngs_modulus_pa: float = _num(1e8, 1e13, default=2.1e11)
-    poisson_ratio: float = _num(0.0, 0.5, default=0.3)
+    density_kg_m3: float = num_field(500.0, 25000.0, default=7850.0)
+    youngs_modulus_pa: float = num_field(1e8, 1e13, default=2.1e11)
+    poisson_ratio: float = num_field(0.0, 0.5, default=0.3)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -119,21 +119,21 @@ class ComponentsAssumed:
     """Bores, rim, flange and shaft dimensions [mm] (assumed: the study gives no drawing). Every size left out of
     the file follows the gear set (:mod:`flexgear.sizing`)."""
 
-    sun_bore_diameter_mm: float = _derived(0.0, lo_open=True)
-    planet_bore_diameter_mm: float = _derived(0.0, lo_open=True, doc="mm, the planet bearing's seat")
-    ring_rim_thickness_mm: float = _derived(0.0, lo_open=True, doc="mm, radial, below the tooth root")
-    ring_flange_outer_diameter_mm: float = _derived(0.0, lo_open=True)
-    ring_flange_thickness_mm: float = _derived(0.0, lo_open=True)
-    ring_bolt_count: int = _num(1, integer=True, default=12)
-    ring_bolt_hole_diameter_mm: float = _derived(0.0, lo_open=True)
-    input_shaft_outer_diameter_mm: float = _derived(0.0, lo_open=True)
-    input_shaft_inner_diameter_mm: float = _derived(0.0)
-    input_shaft_length_mm: float = _derived(0.0, lo_open=True)
-    output_shaft_outer_diameter_mm: float = _derived(0.0, lo_open=True)
-    output_shaft_inner_diameter_mm: float = _derived(0.0)
-    output_shaft_length_mm: float = _derived(0.0, lo_open=True)
-    relief_groove_depth_mm: float = _derived(0.0, doc="mm beyond the root circle")
-    bearing_seat_width_mm: float = _derived(0.0, lo_open=True)
+    sun_bore_diameter_mm: float = derived_field(0.0, lo_open=True)
+    planet_bore_diameter_mm: float = derived_field(0.0, lo_open=True, doc="mm, the planet bearing's seat")
+    ring_rim_thickness_mm: float = derived_field(0.0, lo_open=True, doc="mm, radial, below the tooth root")
+    ring_flange_outer_diameter_mm: float = derived_field(0.0, lo_open=True)
+    ring_flange_thickness_mm: float = derived_field(0.0, lo_open=True)
+    ring_bolt_count: int = num_field(1, integer=True, default=12)
+    ring_bolt_hole_diameter_mm: float = derived_field(0.0, lo_open=True)
+    input_shaft_outer_diameter_mm: float = derived_field(0.0, lo_open=True)
+    input_shaft_inner_diameter_mm: float = derived_field(0.0)
+    input_shaft_length_mm: float = derived_field(0.0, lo_open=True)
+    output_shaft_outer_diameter_mm: float = derived_field(0.0, lo_open=True)
+    output_shaft_inner_diameter_mm: float = derived_field(0.0)
+    output_shaft_length_mm: float = derived_field(0.0, lo_open=True)
+    relief_groove_depth_mm: float = derived_field(0.0, doc="mm beyond the root circle")
+    bearing_seat_width_mm: float = derived_field(0.0, lo_open=True)
 
 
 @dataclass(frozen=True)
@@ -145,10 +145,10 @@ class Bearing:
     stiffness-proportional, c = k · damping_per_stiffness_s.
     """
 
-    radial_stiffness_n_per_m: float = _num(0.0)
-    axial_stiffness_n_per_m: float = _num(0.0)
-    tilt_stiffness_nm_per_rad: float = _num(0.0)
-    damping_per_stiffness_s: float = _num(0.0, default=1e-5)
+    radial_stiffness_n_per_m: float = num_field(0.0)
+    axial_stiffness_n_per_m: float = num_field(0.0)
+    tilt_stiffness_nm_per_rad: float = num_field(0.0)
+    damping_per_stiffness_s: float = num_field(0.0, default=1e-5)
 
 
 @dataclass(frozen=True)
@@ -164,11 +164,11 @@ class Bearings:
 class Contact:
     """Gear contact of section 2.1 (ADAMS impact function), one value for both mesh types."""
 
-    stiffness: float = _num(0.0, lo_open=True, doc="N/m^exponent", default=1e8)
-    exponent: float = _num(1.0, 3.0, default=1.5)
-    damping_fraction_of_stiffness: float = _num(0.0, default=1e-3)
-    penetration_depth_m: float = _num(0.0, lo_open=True, default=1e-4)
-    friction_coefficient: float = _num(0.0, 1.0, default=0.02)
+    stiffness: float = num_field(0.0, lo_open=True, doc="N/m^exponent", default=1e8)
+    exponent: float = num_field(1.0, 3.0, default=1.5)
+    damping_fraction_of_stiffness: float = num_field(0.0, default=1e-3)
+    penetration_depth_m: float = num_field(0.0, lo_open=True, default=1e-4)
+    friction_coefficient: float = num_field(0.0, 1.0, default=0.02)
     # "impact": the study's ADAMS law (section 2.1, the fields above, whose defaults are the study's values);
     # "iso6336": linear mesh stiffness of ISO 6336-1 from the gear geometry (flexgear.laws.iso6336) with eq. 13
     # damping ([contact_assumed] mesh_damping_ratio), the default: it follows any gear set
@@ -179,9 +179,9 @@ class Contact:
 class ContactAssumed:
     """Contact modelling choices the study does not give."""
 
-    stiffness_harmonics: int = _num(0, 10, integer=True, default=3)
-    stiffness_variation: str = _choice("contact_lines", "constant", default="contact_lines")
-    friction_regularisation_m_per_s: float = _num(0.0, lo_open=True, default=0.01)
+    stiffness_harmonics: int = num_field(0, 10, integer=True, default=3)
+    stiffness_variation: str = choice_field("contact_lines", "constant", default="contact_lines")
+    friction_regularisation_m_per_s: float = num_field(0.0, lo_open=True, default=0.01)
     mesh_damping_ratio: float = field(default=0.10, metadata={"lo": 0.0, "hi": 1.0,
                                                               "doc": "xi of eq. 13 (iso6336 law)"})
     application_factor: float = field(default=1.0, metadata={"lo": 1.0, "doc": "K_A of ISO 6336-1 (iso6336 law)"})
@@ -191,16 +191,16 @@ class ContactAssumed:
 class LoadCase:
     """Table 5: input speed and load torque as STEP ramps."""
 
-    input_speed_rpm: float = _num()
-    load_torque_nm: float = _num()
-    ramp_time_s: float = _num(0.0, lo_open=True)
-    end_time_s: float = _num(0.0, lo_open=True)
-    step_size_s: float = _derived(0.0, lo_open=True, doc="s, a 24th of the mesh period when left out")
+    input_speed_rpm: float = num_field()
+    load_torque_nm: float = num_field()
+    ramp_time_s: float = num_field(0.0, lo_open=True)
+    end_time_s: float = num_field(0.0, lo_open=True)
+    step_size_s: float = derived_field(0.0, lo_open=True, doc="s, a 24th of the mesh period when left out")
     # "time": stop at end_time_s; "settled": from end_time_s on, continue in chunks of settle_chunk_s until the
     # settling test (flexgear.settling, [screening] settle_*) passes or settle_max_time_s is reached
-    end: str = _choice("time", "settled", default="time")
-    settle_chunk_s: float = _num(0.0, lo_open=True, default=0.1)
-    settle_max_time_s: float = _num(0.0, lo_open=True, default=2.0)
+    end: str = choice_field("time", "settled", default="time")
+    settle_chunk_s: float = num_field(0.0, lo_open=True, default=0.1)
+    settle_max_time_s: float = num_field(0.0, lo_open=True, default=2.0)
 
     @property
     def input_speed_rad_s(self) -> float:
@@ -211,23 +211,23 @@ class LoadCase:
 class SolverSettings:
     """Time-integration settings (assumed; the study used ADAMS GSTIFF)."""
 
-    spectral_radius: float = _num(0.0, 1.0, default=0.8)
-    newton_max_modified_iterations: int = _num(1, 50, integer=True, default=3)
-    newton_relative_tolerance: float = _num(0.0, 1e-2, lo_open=True, default=1e-6)
-    record_every_steps: int = _num(1, integer=True, default=1)
+    spectral_radius: float = num_field(0.0, 1.0, default=0.8)
+    newton_max_modified_iterations: int = num_field(1, 50, integer=True, default=3)
+    newton_relative_tolerance: float = num_field(0.0, 1e-2, lo_open=True, default=1e-6)
+    record_every_steps: int = num_field(1, integer=True, default=1)
     # "production": the package's formulation (linear body frames and floating frames about the prescribed spin,
     # linear joint and seat equations, Jacobian economy); "reference": Exudyn's nonlinear objects (ObjectRigidBody,
     # ObjectFFRFreducedOrder, ObjectJointGeneric, marker seats), for the tests that check the production one
-    formulation: str = _choice("production", "reference", default="production")
+    formulation: str = choice_field("production", "reference", default="production")
     # divergence guard (flexgear.mbs.run.RunGuard)
-    wall_time_budget_s: float = _num(0.0, lo_open=True, default=7200.0)
-    runaway_speed_factor: float = _num(1.0, lo_open=True, default=3.0)
+    wall_time_budget_s: float = num_field(0.0, lo_open=True, default=7200.0)
+    runaway_speed_factor: float = num_field(1.0, lo_open=True, default=3.0)
     # interval [s] of the spin-term updates in the ramps (flexgear.mbs.spin.SpinSchedule)
-    spin_update_interval_s: float = _num(0.0, lo_open=True, default=5e-4)
+    spin_update_interval_s: float = num_field(0.0, lo_open=True, default=5e-4)
     # bodies axisymmetric within this relative tolerance take the linear frame (flexgear.mbs.bodies.add_linear_frame)
-    frame_axisymmetry_tolerance: float = _num(0.0, 1.0, default=1e-4)
+    frame_axisymmetry_tolerance: float = num_field(0.0, 1.0, default=1e-4)
     # a Jacobian's cost in Newton iterations (flexgear.mbs.newton.JacobianEconomy)
-    jacobian_cost_iterations: float = _num(1.0, default=12.0)
+    jacobian_cost_iterations: float = num_field(1.0, default=12.0)
 
     @property
     def reference(self) -> bool:
@@ -240,13 +240,13 @@ class MeshingSettings:
     """Mesh sizes per level (assumed); the levels ``coarse`` and ``default`` exist in every gearbox, their sizes
     following the normal module when the file leaves them out (:mod:`flexgear.sizing`)."""
 
-    tooth_size_mm: float = _derived(0.0, lo_open=True)
-    body_size_mm: float = _derived(0.0, lo_open=True)
-    element_order: int = _num(1, 2, integer=True, default=2)
+    tooth_size_mm: float = derived_field(0.0, lo_open=True)
+    body_size_mm: float = derived_field(0.0, lo_open=True)
+    element_order: int = num_field(1, 2, integer=True, default=2)
     # Netgen curvaturesafety: element size <= curvature radius / this on curved faces and edges.
-    elements_per_curvature_radius: float = _num(0.0, lo_open=True, default=0.3, derived=True)
+    elements_per_curvature_radius: float = num_field(0.0, lo_open=True, default=0.3, derived=True)
     # Netgen optsteps2d and optsteps3d: smoothing/swapping passes after surface and volume meshing.
-    optimisation_steps: int = _num(0, 10, integer=True, default=3, derived=True)
+    optimisation_steps: int = num_field(0, 10, integer=True, default=3, derived=True)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -254,13 +254,13 @@ class ReductionSettings:
     """Component-mode synthesis settings for flexible bodies (assumed)."""
 
     # every fixed-interface mode below this frequency [Hz] joins each body's basis
-    fixed_interface_cutoff_hz: float = _derived(0.0, lo_open=True, doc="Hz, 3.5 mesh orders when left out")
-    modal_stiffness_damping_s: float = _num(0.0, default=1e-5)
-    contact_fourier_order: int = _num(1, 60, integer=True, default=8)
+    fixed_interface_cutoff_hz: float = derived_field(0.0, lo_open=True, doc="Hz, 3.5 mesh orders when left out")
+    modal_stiffness_damping_s: float = num_field(0.0, default=1e-5)
+    contact_fourier_order: int = num_field(1, 60, integer=True, default=8)
     # Fourier order of the attachment load patterns on each gear's contact bands (0: none).
-    attachment_order: int = _num(0, 60, integer=True, default=8)
+    attachment_order: int = num_field(0, 60, integer=True, default=8)
     # gears: modes above this multiple of the mesh frequency become static residual compliance (0: all dynamic)
-    dynamic_cutoff_mesh_orders: float = _num(0.0, 1000.0, default=0.0)
+    dynamic_cutoff_mesh_orders: float = num_field(0.0, 1000.0, default=0.0)
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -270,12 +270,12 @@ class LumpedAssumed:
     See ``[lumped_assumed]`` in gearbox.toml for each value's source.
     """
 
-    mesh_stiffness_per_width_n_per_mm_um: float = _num(0.0, lo_open=True, doc="C_gamma of eq. 10", default=20.0)
-    mesh_damping_ratio: float = _num(0.0, 1.0, doc="xi of eq. 13", default=0.10)
-    integration_substeps: int = _num(1, 64, integer=True, default=2)
-    friction_table_points: int = _num(16, 65536, integer=True, default=512)
-    carrier_mass_kg: float = _derived(0.0, lo_open=True)
-    carrier_inertia_kg_m2: float = _derived(0.0, lo_open=True)
+    mesh_stiffness_per_width_n_per_mm_um: float = num_field(0.0, lo_open=True, doc="C_gamma of eq. 10", default=20.0)
+    mesh_damping_ratio: float = num_field(0.0, 1.0, doc="xi of eq. 13", default=0.10)
+    integration_substeps: int = num_field(1, 64, integer=True, default=2)
+    friction_table_points: int = num_field(16, 65536, integer=True, default=512)
+    carrier_mass_kg: float = derived_field(0.0, lo_open=True)
+    carrier_inertia_kg_m2: float = derived_field(0.0, lo_open=True)
 
     @property
     def mesh_stiffness_per_width_n_per_m2(self) -> float:
@@ -287,7 +287,7 @@ class LumpedAssumed:
 class JointsAssumed:
     """The bolted joint of the ring and the output shaft (section 2.1: 12 bolts), flexgear.fe.bolted."""
 
-    bolt_clamp_diameter_mm: float = _derived(0.0, lo_open=True, doc="mm, clamped disc under each bolt head")
+    bolt_clamp_diameter_mm: float = derived_field(0.0, lo_open=True, doc="mm, clamped disc under each bolt head")
 
 
 _REFERENCE = 'the production formulation is the only one; formulation = "reference" selects Exudyn\'s'

@@ -8,7 +8,7 @@ from dataclasses import field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SpecError", "_num", "_derived", "_choice", "_text"]
+__all__ = ["SpecError", "num_field", "derived_field", "choice_field", "text_field"]
 
 
 class SpecError(ValueError):
@@ -20,27 +20,29 @@ class SpecError(ValueError):
         super().__init__(f"{path}: field '{fieldname}': {allowed}{got_text}")
 
 
-def _num(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
-         integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING, derived: bool = False) -> Any:
+def num_field(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False,
+              integer: bool = False, doc: str = "", default: Any = dataclasses.MISSING, derived: bool = False) -> Any:
     """Field with a numeric range check (validated on load); optional when ``default`` is given. ``derived``: a
     value left out of the file follows the gear data where :mod:`flexgear.sizing` gives one, else ``default``."""
     meta = {"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc}
     return field(default=default, metadata={**meta, "derived": True} if derived else meta)
 
 
-def _derived(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, doc: str = "") -> Any:
+def derived_field(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, doc: str = "") -> Any:
     """Numeric field that a gearbox file may leave out: its value then follows the gear data
     (:mod:`flexgear.sizing`, registered with :func:`flexgear.spec.register_derived_defaults`). Required when the
     dataclass is built in code."""
     return field(metadata={"lo": lo, "hi": hi, "lo_open": lo_open, "integer": False, "doc": doc, "derived": True})
 
 
-def _choice(*choices: str, doc: str = "", default: str | None = None) -> Any:
+def choice_field(*choices: str, doc: str = "", default: str | None = None) -> Any:
+    """Field whose value is one of ``choices`` (validated on load); optional when ``default`` is given."""
     meta = {"choices": choices, "doc": doc}
     return field(metadata=meta) if default is None else field(default=default, metadata=meta)
 
 
-def _text(doc: str = "", default: str | None = None) -> Any:
+def text_field(doc: str = "", default: str | None = None) -> Any:
+    """Free-text field; optional when ``default`` is given."""
     if default is None:
         return field(metadata={"doc": doc})
     return field(default=default, metadata={"doc": doc})

@@ -6,7 +6,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
-from flexgear.schema_fields import _choice, _derived, _num, _text
+from flexgear.schema_fields import choice_field, derived_field, num_field, text_field
 
 __all__ = ["IndicatorWeights", "IndicatorTolerance", "LoadTolerance", "LevelTolerance", "ErrorLevelTolerance",
            "ReferenceIndicators", "ScreeningSettings", "DEFAULT_PURPOSES", "PURPOSE_NAMES"]
@@ -19,18 +19,18 @@ class IndicatorWeights:
     Section 2.2: "taking 20 % of each of the five simulation indicators".
     """
 
-    input_speed: float = _num(0.0, 1.0, default=0.2)
-    output_speed: float = _num(0.0, 1.0, default=0.2)
-    transmission_ratio: float = _num(0.0, 1.0, default=0.2)
-    outer_mesh_force: float = _num(0.0, 1.0, default=0.2)
-    inner_mesh_force: float = _num(0.0, 1.0, default=0.2)
+    input_speed: float = num_field(0.0, 1.0, default=0.2)
+    output_speed: float = num_field(0.0, 1.0, default=0.2)
+    transmission_ratio: float = num_field(0.0, 1.0, default=0.2)
+    outer_mesh_force: float = num_field(0.0, 1.0, default=0.2)
+    inner_mesh_force: float = num_field(0.0, 1.0, default=0.2)
 
 
 @dataclass(frozen=True, kw_only=True)
 class _Tolerance:
     """Weight of one indicator in the reference screening and its TEa, in the unit its subclass names."""
 
-    weight: float = _num(0.0, 1.0)
+    weight: float = num_field(0.0, 1.0)
     scale = ""
     tea_field = ""
 
@@ -48,7 +48,7 @@ class _Tolerance:
 class IndicatorTolerance(_Tolerance):
     """TEa in % of the reference's value (a quantity far from zero: speeds, ratio, mean forces)."""
 
-    tea_pct: float = _num(0.0, 1000.0, lo_open=True)
+    tea_pct: float = num_field(0.0, 1000.0, lo_open=True)
     scale, tea_field = "relative", "tea_pct"
 
 
@@ -56,7 +56,7 @@ class IndicatorTolerance(_Tolerance):
 class LoadTolerance(_Tolerance):
     """TEa in % of the mean tooth load (a load factor or an alternating load, as a tooth-stress rating sees it)."""
 
-    tea_pct_of_load: float = _num(0.0, 1000.0, lo_open=True)
+    tea_pct_of_load: float = num_field(0.0, 1000.0, lo_open=True)
     scale, tea_field = "load", "tea_pct_of_load"
 
 
@@ -64,7 +64,7 @@ class LoadTolerance(_Tolerance):
 class LevelTolerance(_Tolerance):
     """TEa in dB of a vibration level (20 log10 of the amplitude ratio)."""
 
-    tea_db: float = _num(0.0, 200.0, lo_open=True)
+    tea_db: float = num_field(0.0, 200.0, lo_open=True)
     scale, tea_field = "db", "tea_db"
 
 
@@ -73,8 +73,8 @@ class ErrorLevelTolerance(_Tolerance):
     """TEa in dB of a transmission-error harmonic (20 log10 of the amplitude ratio); amplitudes below ``floor_um``
     [um] count as ``floor_um`` (below what a transmission-error measurement resolves: both "no ripple")."""
 
-    tea_db: float = _num(0.0, 200.0, lo_open=True)
-    floor_um: float = _num(0.0, 1000.0, lo_open=True)
+    tea_db: float = num_field(0.0, 200.0, lo_open=True)
+    floor_um: float = num_field(0.0, 1000.0, lo_open=True)
     scale, tea_field = "db", "tea_db"
 
     @property
@@ -133,29 +133,29 @@ class ScreeningSettings:
     See ``[screening]`` in gearbox.toml and :mod:`flexgear.study.screening` for each value's meaning.
     """
 
-    allowable_total_error_pct: float = _num(0.0, 100.0, lo_open=True, default=1.0)
-    lines: str = _choice("westgard", "six_sigma", default="westgard")
-    window: str = _choice("settled", "after_ramps", "fixed", default="settled")
-    after_ramp_delay_s: float = _num(0.0, default=0.0)
+    allowable_total_error_pct: float = num_field(0.0, 100.0, lo_open=True, default=1.0)
+    lines: str = choice_field("westgard", "six_sigma", default="westgard")
+    window: str = choice_field("settled", "after_ramps", "fixed", default="settled")
+    after_ramp_delay_s: float = num_field(0.0, default=0.0)
     # window = "fixed" only: from the ramps' end to the load case's end when left out (flexgear.sizing)
-    window_start_s: float = _derived(0.0)
-    window_end_s: float = _derived(0.0, lo_open=True)
-    short_run_fraction: float = _num(0.0, 1.0, lo_open=True, default=0.5)
-    sample_count: int = _num(2, 10000, integer=True, default=10)
-    selection: str = _choice("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable",
-                             default="fastest_in_best_zone")
+    window_start_s: float = derived_field(0.0)
+    window_end_s: float = derived_field(0.0, lo_open=True)
+    short_run_fraction: float = num_field(0.0, 1.0, lo_open=True, default=0.5)
+    sample_count: int = num_field(2, 10000, integer=True, default=10)
+    selection: str = choice_field("fastest_in_best_zone", "closest_to_origin", "fastest_acceptable",
+                                  default="fastest_in_best_zone")
     weights: IndicatorWeights = field(default_factory=IndicatorWeights)
     reference_indicators: ReferenceIndicators = field(default_factory=ReferenceIndicators)
     # settled window (flexgear.settling.settled_start): blocks of whole mesh cycles, tolerances in %; the block
     # follows the ring's tooth count when left out (flexgear.sizing)
     settle_block_mesh_cycles: int = field(metadata={"lo": 1, "hi": 100000, "integer": True, "derived": True})
-    settle_final_blocks: int = _num(1, 1000, integer=True, default=8)
-    settle_mean_tolerance_pct: float = _num(0.0, 100.0, lo_open=True, default=0.05)
-    settle_amplitude_tolerance_pct: float = _num(0.0, 100.0, lo_open=True, default=5.0)
+    settle_final_blocks: int = num_field(1, 1000, integer=True, default=8)
+    settle_mean_tolerance_pct: float = num_field(0.0, 100.0, lo_open=True, default=0.05)
+    settle_amplitude_tolerance_pct: float = num_field(0.0, 100.0, lo_open=True, default=5.0)
     # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
-    reference: str = _text(default="")
+    reference: str = text_field(default="")
     # numerical error bars: the reference's final state solved over this window at h and at h/2 (0: none)
-    error_window_s: float = _num(0.0, default=0.05)
+    error_window_s: float = num_field(0.0, default=0.05)
     # reference mode: purpose -> the indicators judged for it, each alone (flexgear.study.purposes)
     purposes: dict[str, tuple[str, ...]] = field(default_factory=lambda: dict(DEFAULT_PURPOSES),
                                                   metadata={"purposes": True})

@@ -159,12 +159,12 @@ def section_interface(fe, name: str, z0: float, z1: float) -> Interface:
 def interface_compliance(fe_or_body, load, held) -> np.ndarray:
     """6 x 6 compliance of the RBE3 motion of interface ``load`` under its RBE3 loads, ``held`` held:
     full FE by the constrained solve, a reduced body by its modes (u = Phi_h q, as flexgear.fe.compliance)."""
-    from flexgear.fe.cms import ReducedBody, _rbe3_rows, rbe3_weights
+    from flexgear.fe.cms import ReducedBody, rbe3_rows, rbe3_weights
     from flexgear.fe.fem import rigid_body_modes
 
     if not isinstance(fe_or_body, ReducedBody):
-        c_load = _rbe3_rows(fe_or_body, load)
-        u = free_body_solver(fe_or_body).constrained(_rbe3_rows(fe_or_body, held)).solve(
+        c_load = rbe3_rows(fe_or_body, load)
+        u = free_body_solver(fe_or_body).constrained(rbe3_rows(fe_or_body, held)).solve(
             c_load.T.toarray(), np.zeros((6, 6)))
         return c_load @ u
     body = fe_or_body
@@ -204,7 +204,7 @@ def test_spinning_ring_centrifugal_growth_matches_thin_ring_solution():
     """Radial growth of a free slender ring spinning at omega: u = rho omega^2 R^3 / E (membrane hoop stress
     sigma = rho omega^2 R^2), full FE and the reduced body (free-free modes, the floating frame's
     centrifugal modal force Phi^T M (omega^2 x_perp)) with a radial load circle in its basis."""
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
     from flexgear.fe.fem import rigid_body_modes
 
     fe = fe_model(ring_mesh(0.004), STEEL, order=2)
@@ -212,7 +212,7 @@ def test_spinning_ring_centrifugal_growth_matches_thin_ring_solution():
     x_perp = fe.nodes * [1.0, 1.0, 0.0]
     load = (omega**2 * (fe.mass_scalar @ x_perp)).ravel()  # self-equilibrated body force [N]
     rigid = rigid_body_modes(fe.nodes)
-    full = _FreeBodySolver(fe).constrained((fe.M @ rigid).T).solve(load[:, None], np.zeros((6, 1)))[:, 0]
+    full = FreeBodySolver(fe).constrained((fe.M @ rigid).T).solve(load[:, None], np.zeros((6, 1)))[:, 0]
     circle = fg.LoadCircle(RING_R + RING_T / 2, -RING_B / 2, RING_B / 2, 2)
     body = fg.reduce(fe, [interface(fe, "top")], 10, n_compare=0, load_circles=[circle])
     reduced = body.modes @ ((body.modes.T @ load) / body.stiffness)

@@ -18,10 +18,10 @@ def test_cholesky_solves_the_stiffness_system_as_superlu_does():
     """K_ff (a ring's stiffness with the six support coordinates of flexgear.fe.cms removed) is positive
     definite: the Cholesky solution of K_ff u = f has a round-off residual and equals SuperLU's to round-off
     times the condition number, for one and several loads."""
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
 
     fe = fe_model(ring_mesh(0.004), STEEL, 2)
-    free = _FreeBodySolver(fe).free
+    free = FreeBodySolver(fe).free
     k_ff = fe.K[free][:, free]
     loads = np.random.default_rng(3).standard_normal((len(free), 3))
     expected = sla.splu(k_ff.tocsc()).solve(loads)
@@ -42,10 +42,10 @@ def test_cholesky_refuses_a_coordinate_without_stiffness():
     makes K singular: the factorisation says so instead of returning a solution."""
     import scipy.sparse as sp
 
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
 
     fe = fe_model(ring_mesh(0.004), STEEL, 1)
-    free = _FreeBodySolver(fe).free
+    free = FreeBodySolver(fe).free
     k_ff = fe.K[free][:, free]
     SparseCholesky(k_ff)  # positive definite: factorises
     k = sp.block_diag([k_ff, sp.csr_matrix((1, 1))], format="csr")  # one more coordinate, without stiffness
@@ -66,9 +66,9 @@ def test_cholesky_solves_a_block_of_columns_in_one_call():
 
     assert _cholmod() is not None
     fe = fe_model(ring_mesh(0.004), STEEL, 1)
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
 
-    free = _FreeBodySolver(fe).free
+    free = FreeBodySolver(fe).free
     chol = SparseCholesky(fe.K[free][:, free])
     loads = np.random.default_rng(4).standard_normal((len(free), 9))
     block = chol.solve(loads)

@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 import scipy.sparse.linalg as sla
 
-from flexgear.fe.cms import _FreeBodySolver, _rbe3_rows, full_free_modes, interface, reduce
+from flexgear.fe.cms import FreeBodySolver, full_free_modes, interface, rbe3_rows, reduce
 from flexgear.fe.fem import fe_model, kron3_operator
 from flexgear.fe.reduced import cached_reduced_body
 from flexgear.mbs.flexible import add_flexible_body
@@ -131,7 +131,7 @@ def test_mass_operator_equals_the_assembled_mass_matrix(coarse_ring_fe):
 
 def test_constrained_solve_without_load_equals_a_zero_load(coarse_ring_fe):
     """solve(None, e) skips the K_ff solve of a zero load and returns the very same displacements."""
-    con = _FreeBodySolver(coarse_ring_fe).constrained(_rbe3_rows(coarse_ring_fe, interface(coarse_ring_fe, "top")))
+    con = FreeBodySolver(coarse_ring_fe).constrained(rbe3_rows(coarse_ring_fe, interface(coarse_ring_fe, "top")))
     e = np.random.default_rng(4).standard_normal((6, 10))
     np.testing.assert_array_equal(con.solve(None, e), con.solve(np.zeros((coarse_ring_fe.n_dof, 10)), e))
 
@@ -197,8 +197,8 @@ def test_tube_static_bending_matches_beam_theory_and_full_fe():
     # is exact for static interface loads, so it must equal the full FE model under the same
     # distributing (RBE3) root constraint; that root is a little softer than a clamp (warping).
     body = reduce(fe, ["root", "tip"], 6, n_compare=0)
-    solver = _FreeBodySolver(fe)
-    u_rbe3 = solver.constrained(_rbe3_rows(fe, body.interface("root"))).solve(load, np.zeros((6, 1)))[:, 0]
+    solver = FreeBodySolver(fe)
+    u_rbe3 = solver.constrained(rbe3_rows(fe, body.interface("root"))).solve(load, np.zeros((6, 1)))[:, 0]
     full_rbe3 = tip.weights @ u_rbe3[3 * tip.nodes]
 
     sc = exu.SystemContainer()

@@ -211,13 +211,13 @@ FRICTION_CYCLE_SAMPLES = 64
 
 @pytest.mark.parametrize("drive_sign", [1.0, -1.0])
 def test_friction_excitation_is_the_time_models_friction_over_a_mesh_cycle(gearbox, drive_sign):
-    from flexgear.harmonic.base import _excited
+    from flexgear.harmonic.base import excited_spec
     from flexgear.harmonic.friction import friction_harmonics
     from flexgear.laws.compiled import mesh_friction_forces
     from flexgear.mbs.gearbox import mesh_contacts
 
     harmonics = gearbox.contact_assumed.stiffness_harmonics
-    spec = _excited(gearbox, harmonics)
+    spec = excited_spec(gearbox, harmonics)
     speed = drive_sign * spec.load_case.input_speed_rad_s
     contacts = mesh_contacts(spec, drive_sign)
     delta0 = 1e-5  # a fixed deflection [m]: any loaded one

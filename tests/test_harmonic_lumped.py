@@ -111,18 +111,19 @@ def test_friction_excitation_is_the_time_models_friction_force_series(gearbox):
     At mu = 0 the excitation is the stiffness excitation alone, unchanged."""
     from dataclasses import replace
 
-    from flexgear.harmonic.base import RPM, _excited, excitation
+    from flexgear.harmonic.base import RPM, excitation, excited_spec
     from flexgear.harmonic.lumped import lumped_linear
     from flexgear.harmonic.lumped_friction import nominal_spin_rates
-    from flexgear.lumped.run import _T_RAMP, _W_IN, build_lumped_model, lumped_rhs
+    from flexgear.lumped.kernel_layout import T_RAMP, W_IN
+    from flexgear.lumped.run import build_lumped_model, lumped_rhs
 
     harm = 4
     spec = gearbox.with_fields("contact", law="iso6336", friction_coefficient=0.06)
     spec = spec.with_fields("contact_assumed", stiffness_variation="contact_lines")
     spec = spec.with_fields("lumped_assumed", friction_table_points=64)
     dry = spec.with_fields("contact", friction_coefficient=0.0)
-    model = build_lumped_model(_excited(spec, harm))
-    w = float(model.fp[_W_IN])  # the time model's prescribed input speed [rad/s]
+    model = build_lumped_model(excited_spec(spec, harm))
+    w = float(model.fp[W_IN])  # the time model's prescribed input speed [rad/s]
     speed = w / RPM
     lin = lumped_linear(spec, harm)
     op, op0 = lin.operating(speed), lumped_linear(dry, harm).operating(speed)
@@ -132,7 +133,7 @@ def test_friction_excitation_is_the_time_models_friction_force_series(gearbox):
         np.testing.assert_array_equal(a, b)
     series = excitation(op, harm)[1] - excitation(op0, harm)[1]  # (H, n_f)
 
-    rhs, rhs0 = lumped_rhs(model), lumped_rhs(build_lumped_model(_excited(dry, harm)))
+    rhs, rhs0 = lumped_rhs(model), lumped_rhs(build_lumped_model(excited_spec(dry, harm)))
     free, s = model.free, model.system
     mass = s.mass[free]
     assert np.all(mass > 0.0)
@@ -144,7 +145,7 @@ def test_friction_excitation_is_the_time_models_friction_force_series(gearbox):
     sense = np.sign(rate)
     static_phase = np.array([model.phase_coef[m] * lin.static[pos[int(i)]] if int(i) in pos else 0.0
                              for m, i in enumerate(model.phase_index)])
-    t0 = model.fp[_T_RAMP]  # the ramp done: input angle w (t - t_ramp / 2)
+    t0 = model.fp[T_RAMP]  # the ramp done: input angle w (t - t_ramp / 2)
     psi0 = abs(rate[0]) * w * 0.5 * t0  # global mesh phase at t0 [cycles]
     phase0 = model.phase_coef * r[model.phase_index] * w * 0.5 * t0 + static_phase + model.phase_offset
     npts = model.tables.shape[1]

@@ -14,7 +14,7 @@ from test_attachment import interface_compliance
 import flexgear as fg
 from flexgear.fe.bolted import clamped_patches
 from flexgear.fe.cholesky import SparseCholesky
-from flexgear.fe.cms import _rbe3_rows
+from flexgear.fe.cms import rbe3_rows
 from flexgear.fe.joined import body_matrices, joint_rows
 
 pytestmark = pytest.mark.heavy
@@ -103,7 +103,7 @@ def test_compliance_within_2_percent_of_full_fe(gearbox, part):
         assert reduced.sum(axis=1) == pytest.approx(full.sum(axis=1), rel=0.02)
     else:
         seat = body.interface("bearing_seat")
-        rows = _rbe3_rows(fe, seat)
+        rows = rbe3_rows(fe, seat)
         full = clamped.compliance(rows.T.toarray())
         reduced = interface_compliance(body, seat, body.interface("bolt_patches"))
         assert np.diag(reduced) == pytest.approx(np.diag(full), rel=0.02)

@@ -173,7 +173,7 @@ def test_linear_runup_at_constant_speed_is_the_harmonic_solve():
     of the forcing the modes see, (2 pi h f_m dt)^2 / 12 of the modes' part Y_h - a^T M^-1 f_h of the output (the
     direct part a^T M^-1 u is exact at the samples), plus the track window's side lobes (-92 dB) of the other
     harmonics."""
-    from flexgear.harmonic.base import ACCEL_INDICATORS, _Operating, _solve, excitation
+    from flexgear.harmonic.base import ACCEL_INDICATORS, Operating, _solve, excitation
     from flexgear.study.runup import SIDE_LOBE_DB
     from flexgear.study.runup_linear import LinearSystem, linear_response
 
@@ -185,9 +185,9 @@ def test_linear_runup_at_constant_speed_is_the_harmonic_solve():
     coef = np.array([[0.05 - 0.02j, 0.01 + 0.004j], [0.03 + 0.04j, -0.006 + 0.002j]])  # C_h, h = 1, 2
     accel = np.array([[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0], [0.5, 0.0, 0.5]])
     f_m, harmonics = 1000.0, 2
-    op = _Operating(mass, damping + gyro, k, rows, np.full(2, 1e8), np.zeros(2), np.array([900.0, 1100.0]), coef,
-                    np.arange(2), ("outer_mesh_force_1_n", "inner_mesh_force_1_n"), accel, np.zeros(3),
-                    2 * math.pi * f_m)
+    op = Operating(mass, damping + gyro, k, rows, np.full(2, 1e8), np.zeros(2), np.array([900.0, 1100.0]), coef,
+                   np.arange(2), ("outer_mesh_force_1_n", "inner_mesh_force_1_n"), accel, np.zeros(3),
+                   2 * math.pi * f_m)
     steady = _solve(op, harmonics)
     system = LinearSystem(mass, damping + gyro, k, excitation(op, harmonics)[1], accel)
     t = np.arange(0.0, 0.2, DT)  # > 30 time constants 1 / (zeta omega) of the slowest decaying mode

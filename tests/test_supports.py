@@ -89,19 +89,20 @@ def test_loaded_transmission_error_equals_lumped_static_solution(iso_runs):
     Static lumped problem (flexgear.lumped.run.static_mesh_forces' system): the ring lags by theta_r; TE =
     r_b,ring |theta_r| (planet bearings about 7 um, mesh deflections about 1.7 and 1.3 um along the normals).
     """
-    from flexgear.lumped.run import _LOAD_SIGN, _OUT_SPIN, _T_LOAD, build_lumped_model
+    from flexgear.lumped.kernel_layout import LOAD_SIGN, OUT_SPIN, T_LOAD
+    from flexgear.lumped.run import build_lumped_model
 
     gb, mbs, _ = iso_runs
     model = build_lumped_model(gb)
     s = model.system
     load = np.zeros(s.n)
-    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    load[model.ip[OUT_SPIN]] = model.fp[LOAD_SIGN] * model.fp[T_LOAD]
     q = np.zeros(s.n)
     k = s.stiffness()
     q[model.free] = np.linalg.solve(k[np.ix_(model.free, model.free)], load[model.free])
     from flexgear.geometry.involute import gear_set_geometry
 
-    te_static = gear_set_geometry(gb).ring.base_radius * abs(q[model.ip[_OUT_SPIN]])
+    te_static = gear_set_geometry(gb).ring.base_radius * abs(q[model.ip[OUT_SPIN]])
     te = _window(mbs).transmission_error_m.mean()
     assert 5e-6 < te_static < 5e-5
     assert te == pytest.approx(te_static, rel=0.02)

@@ -31,7 +31,8 @@ from flexgear.design import Design, as_design
 from flexgear.fe.fem import FEModel, rigid_body_modes, surface_faces
 from flexgear.spec import GearboxSpec
 
-__all__ = ["bolt_axes", "clamped_patches", "tie_matrix", "tied_free_modes", "ring_output_shaft_fe_modes"]
+__all__ = ["bolt_axes", "clamped_patches", "tie_matrix", "tied_free_modes", "ring_output_shaft_fe_modes",
+           "shape_functions", "locate_in_triangles", "isoparametric_coordinates"]
 
 _TOL = 1e-6  # m: nodes on an exact plane or cylinder of the OCC geometry
 
@@ -67,7 +68,7 @@ def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float
     return out
 
 
-def _shape_functions(bary: np.ndarray, n_nodes: int) -> np.ndarray:
+def shape_functions(bary: np.ndarray, n_nodes: int) -> np.ndarray:
     """Triangle shape functions at barycentric ``bary`` (k, 3): linear (3) or quadratic (6, mid-nodes 01, 12, 20)."""
     if n_nodes == 3:
         return bary
@@ -76,7 +77,7 @@ def _shape_functions(bary: np.ndarray, n_nodes: int) -> np.ndarray:
                             4 * l0 * l1, 4 * l1 * l2, 4 * l2 * l0])
 
 
-def _locate(points: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def locate_in_triangles(points: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Face index and barycentric coordinates (k, 3) of each in-plane point (k, 2) in triangles (t, 3, 2).
 
     The triangle whose smallest barycentric coordinate is largest: the one holding the point, or for a point
@@ -95,7 +96,7 @@ def _locate(points: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.nda
     return face, np.column_stack([l0[rows, face], l1[rows, face], l2[rows, face]])
 
 
-def _isoparametric(points: np.ndarray, nodes: np.ndarray, bary: np.ndarray, steps: int = 8) -> np.ndarray:
+def isoparametric_coordinates(points: np.ndarray, nodes: np.ndarray, bary: np.ndarray, steps: int = 8) -> np.ndarray:
     """Barycentric coordinates (k, 3) with sum_a N_a(l) x_a = x for each point x (k, 2) in its face's nodes
     (k, 3 | 6, 2): Newton's method on (l1, l2) from the corners' affine guess ``bary``. On a curved (quadratic)
     face the affine guess misses by the edge's sagitta, and the tie would not carry a rigid rotation exactly.
@@ -103,7 +104,7 @@ def _isoparametric(points: np.ndarray, nodes: np.ndarray, bary: np.ndarray, step
     lam = bary[:, 1:].copy()
     for _ in range(steps):
         full = np.column_stack([1.0 - lam.sum(axis=1), lam])
-        resid = np.einsum("ka,kad->kd", _shape_functions(full, nodes.shape[1]), nodes) - points
+        resid = np.einsum("ka,kad->kd", shape_functions(full, nodes.shape[1]), nodes) - points
         jac = np.stack([_shape_derivative(full, nodes, j) for j in (1, 2)], axis=2)  # (k, 2 coords, 2 params)
         lam -= np.linalg.solve(jac, resid[:, :, None])[:, :, 0]
     return np.column_stack([1.0 - lam.sum(axis=1), lam])
@@ -140,11 +141,11 @@ def tie_matrix(master: FEModel, slave: FEModel, slave_nodes: np.ndarray, z_plane
     if not len(faces):
         raise ValueError(f"tie_matrix: the master has no boundary face on the plane z = {z_plane:.4f} m")
     points = slave.nodes[slave_nodes, :2]
-    face, bary = _locate(points, master.nodes[faces[:, :3], :2])
-    bary = _isoparametric(points, master.nodes[faces[face], :2], bary)
+    face, bary = locate_in_triangles(points, master.nodes[faces[:, :3], :2])
+    bary = isoparametric_coordinates(points, master.nodes[faces[face], :2], bary)
     if bary.min() < -max_outside:
         raise ValueError(f"tie_matrix: a slave node lies outside the master face (barycentric {bary.min():.3f})")
-    weights = _shape_functions(bary, faces.shape[1])
+    weights = shape_functions(bary, faces.shape[1])
     n_m, n_all = master.n_nodes, master.n_nodes + slave.n_nodes
     tied = np.zeros(n_all, bool)
     tied[n_m + np.asarray(slave_nodes)] = True

@@ -55,7 +55,7 @@ from flexgear.fe.spectrum import lowest_eigenpairs, shift_invert_pairs
 from flexgear.geometry.massprops import MassProperties
 
 __all__ = ["Interface", "ReducedBody", "BasisParts", "interface", "rbe3_weights", "reduce", "reduction_basis",
-           "full_free_modes", "ffrf_invariants"]
+           "full_free_modes", "ffrf_invariants", "FreeBodySolver", "rbe3_rows"]
 
 _SOLVE_BLOCK = 8  # columns per block of constrained static solves (memory: 6 work arrays of 3n x 8)
 
@@ -115,7 +115,7 @@ def rbe3_weights(nodes: np.ndarray, itf: Interface) -> np.ndarray:
     return rows
 
 
-def _rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
+def rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
     """Rows (6, 3n) of C: weighted mean translation and least-squares rotation of the interface."""
     rows = rbe3_weights(fe.nodes, itf)
     cols = (3 * itf.nodes[:, None, None] + np.arange(3)[None, None, :]).repeat(6, axis=1)
@@ -123,7 +123,7 @@ def _rbe3_rows(fe: FEModel, itf: Interface) -> sp.csr_matrix:
     return sp.csr_matrix((rows.ravel(), (rr.ravel(), cols.ravel())), shape=(6, fe.n_dof))
 
 
-class _FreeBodySolver:
+class FreeBodySolver:
     """Constrained static solves and shift-invert operators for a free body with one factorisation.
 
     Solves min 1/2 u^T K u - g^T u subject to C u = e for a free (singular) K, see module docstring.
@@ -155,7 +155,7 @@ class _FreeBodySolver:
 class _Constrained:
     """Saddle-point data for one constraint matrix C (p, 3n) of full row rank."""
 
-    def __init__(self, s: _FreeBodySolver, c):
+    def __init__(self, s: FreeBodySolver, c):
         self.s = s
         c = sp.csr_matrix(c) if sp.issparse(c) else np.asarray(c)
         self.c_f = c[:, s.free]
@@ -208,9 +208,9 @@ class _Constrained:
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
-def full_free_modes(fe: FEModel, k: int, solver: _FreeBodySolver | None = None) -> tuple[np.ndarray, np.ndarray]:
+def full_free_modes(fe: FEModel, k: int, solver: FreeBodySolver | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Lowest k flexible free-free modes of the full FE model: frequencies [Hz] and shapes (3n, k)."""
-    solver = solver or _FreeBodySolver(fe)
+    solver = solver or FreeBodySolver(fe)
     m = fe.mass_operator()
     lam, vec = solver.constrained((m @ solver.R).T).eigen(fe, k, m)
     return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), vec
@@ -331,7 +331,7 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     # K_ii's lower triangle, all the factorisation reads (the rows and columns kept are ascending)
     chol = SparseCholesky(sp.tril(fe.K, format="csr")[idofs][:, idofs])
     soft = [i for i in interfaces if i.name not in rigid]
-    c = sp.vstack([_rbe3_rows(fe, i) for i in soft]).tocsc()[:, idofs] if soft else sp.csc_matrix((0, len(idofs)))
+    c = sp.vstack([rbe3_rows(fe, i) for i in soft]).tocsc()[:, idofs] if soft else sp.csc_matrix((0, len(idofs)))
     z = chol.solve(c.T.toarray()) if soft else np.zeros((len(idofs), 0))
     schur = la.lu_factor(c @ z) if soft else None
 
@@ -378,13 +378,13 @@ class BasisParts:
     static: np.ndarray
     fixed: np.ndarray
     attached: np.ndarray
-    solver: _FreeBodySolver | None = None
+    solver: FreeBodySolver | None = None
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
 def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int | None, kind: str = "rbe3",
                     load_circles: list[LoadCircle] | None = None,
-                    solver: _FreeBodySolver | None = None, rigid: tuple[str, ...] = (),
+                    solver: FreeBodySolver | None = None, rigid: tuple[str, ...] = (),
                     max_hz: float | None = None) -> BasisParts:
     """Static, fixed-interface and attachment modes of ``fe`` (see :func:`reduce`), one factorisation
     (``solver``: the free body's, if already made)."""
@@ -394,8 +394,8 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int | None, kin
     rigid_set = {i.name for i in itfs} if kind == "rbe2" else set(rigid)
     if rigid_set:
         return BasisParts(*_rigid_patch_basis(fe, itfs, rigid_set, n_modes, patterns, max_hz))
-    solver = solver or _FreeBodySolver(fe)
-    con = solver.constrained(sp.vstack([_rbe3_rows(fe, i) for i in itfs]))
+    solver = solver or FreeBodySolver(fe)
+    con = solver.constrained(sp.vstack([rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(None, np.eye(con.p))
     m = fe.mass_operator()
     vec = lowest_eigenpairs(lambda k, found: con.eigen(fe, k, m, found), n_modes, max_hz,
@@ -433,7 +433,7 @@ def reduce(fe: FEModel, interfaces: list[Interface | str], n_modes: int | None =
     parts = reduction_basis(fe, itfs, n_modes, kind, load_circles, rigid=tuple(rigid), max_hz=max_hz)
     t_full, full = time.perf_counter(), np.zeros(0)
     if n_compare:  # here, while the factor exists: it is freed before the dense work on the basis
-        full = full_free_modes(fe, n_compare, parts.solver or _FreeBodySolver(fe))[0]
+        full = full_free_modes(fe, n_compare, parts.solver or FreeBodySolver(fe))[0]
     t_full = time.perf_counter() - t_full
     n_attached, n_fixed = parts.attached.shape[1], parts.fixed.shape[1]
     basis = np.hstack([parts.static, parts.fixed, parts.attached])

@@ -23,7 +23,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from flexgear.fe.attachment import LoadCircle, kernel_load
-from flexgear.fe.cms import Interface, ReducedBody, _FreeBodySolver, _rbe3_rows, interface, rbe3_weights
+from flexgear.fe.cms import FreeBodySolver, Interface, ReducedBody, interface, rbe3_rows, rbe3_weights
 from flexgear.fe.fem import FEModel, rigid_body_modes
 
 __all__ = ["static_compliance", "surface_node_areas", "point_loads", "free_body_solver"]
@@ -73,10 +73,10 @@ def _kernel_loads(nodes: np.ndarray, circles: Sequence[LoadCircle], points, dire
     return np.stack(cols, axis=1)
 
 
-def free_body_solver(fe: FEModel) -> _FreeBodySolver:
+def free_body_solver(fe: FEModel) -> FreeBodySolver:
     """The free-body factorisation of ``fe`` (flexgear.fe.cms), kept for the next call on the same model."""
     if _SOLVER[0] is not fe:
-        _SOLVER[:] = [fe, _FreeBodySolver(fe)]
+        _SOLVER[:] = [fe, FreeBodySolver(fe)]
     return _SOLVER[1]
 
 
@@ -131,7 +131,7 @@ def static_compliance(model: FEModel | ReducedBody, points, directions,
         return 0.5 * (out + out.T)
     if not isinstance(model, FEModel):
         raise TypeError(f"static_compliance: model must be an FEModel or a ReducedBody, got {type(model).__name__}")
-    rows = sp.vstack([sp.csr_matrix(_rbe3_rows(model, itf)) for itf in itfs]).tocsr()
+    rows = sp.vstack([sp.csr_matrix(rbe3_rows(model, itf)) for itf in itfs]).tocsr()
     con = free_body_solver(model).constrained(rows)
     u = con.solve(f, np.zeros((rows.shape[0], f.shape[1])))
     c = f.T @ u

@@ -10,7 +10,7 @@ import trimesh
 
 from flexgear.fe.mesh import component_mesh
 from flexgear.fe.surface import surface_mesh
-from flexgear.geometry.check import _MM, _section, nominal_placements
+from flexgear.geometry.check import MM_PER_M, nominal_placements, transverse_section
 from flexgear.geometry.involute import gear_set_geometry
 from flexgear.geometry.layout import component_layout
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
@@ -75,7 +75,7 @@ def render_assembly_png(spec: GearboxSpec, path: str | Path, level: str = "coars
             continue  # hides the gears; drawn in the section view instead
         keep = tm.vertices[tm.faces].mean(axis=1)
         cut = ~((keep[:, 0] > 0) & (keep[:, 1] < 0)) if name == "ring" else np.ones(len(tm.faces), bool)
-        poly = Poly3DCollection(tm.vertices[tm.faces[cut]] * _MM, linewidths=0.0)
+        poly = Poly3DCollection(tm.vertices[tm.faces[cut]] * MM_PER_M, linewidths=0.0)
         poly.set_facecolor(colours[name.split("_")[0] if name.startswith("planet") else name])
         poly.set_alpha(1.0)
         ax.add_collection3d(poly)
@@ -90,15 +90,15 @@ def render_assembly_png(spec: GearboxSpec, path: str | Path, level: str = "coars
         for place in places:
             if place.component in ("input_shaft", "output_shaft"):
                 continue
-            contours = _section(spec, place.component, place, z).to_polygons()
+            contours = transverse_section(spec, place.component, place, z).to_polygons()
             verts = np.vstack([np.vstack([c, c[:1]]) for c in contours])
             codes = np.concatenate([[MplPath.MOVETO] + [MplPath.LINETO] * (len(c) - 1) + [MplPath.CLOSEPOLY]
                                     for c in contours])
             axis.add_patch(PathPatch(MplPath(verts, codes), fc=colours[place.component], ec="k", lw=0.3))
-        centre = (0.0, 0.0) if k == 0 else (gear_set_geometry(spec).sun.reference_radius * _MM + 1.2, 0.0)
+        centre = (0.0, 0.0) if k == 0 else (gear_set_geometry(spec).sun.reference_radius * MM_PER_M + 1.2, 0.0)
         axis.set(xlim=(centre[0] - half, centre[0] + half), ylim=(centre[1] - half, centre[1] + half),
                  aspect="equal", xlabel="x [mm]", ylabel="y [mm]")
-        axis.set_title(f"transverse section z = {z * _MM:.1f} mm" if k == 0 else "sun-planet mesh (zoom)")
+        axis.set_title(f"transverse section z = {z * MM_PER_M:.1f} mm" if k == 0 else "sun-planet mesh (zoom)")
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -149,7 +149,9 @@ def _to_scipy(mat, n: int, position: np.ndarray | None = None) -> sp.csr_matrix:
 
 
 def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None = None) -> FEModel:
-    """Assemble the FE model of ``mesh`` (ngsolve.Mesh or netgen mesh) with nodal elements of ``order``.
+    """Assemble the FE model of ``mesh`` (ngsolve.Mesh or netgen mesh) with nodal elements of ``order``: a
+    first-order mesh is raised to second order (edge nodes on its geometry's surfaces), a mesh of second-order
+    elements (flexgear.fe.mesh_io.netgen_mesh of an imported file) is taken with its edge nodes as they are.
 
     ``regions``: boundary names to turn into node sets (default: every named boundary except
     "default"). Raises ValueError for an order other than 1 or 2.
@@ -159,7 +161,7 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
     if order not in (1, 2):
         raise ValueError(f"fe_model: element order must be 1 or 2, got {order!r}")
     ngmesh = mesh.ngmesh if hasattr(mesh, "ngmesh") else mesh
-    if order == 2:
+    if order == 2 and len(ngmesh.Elements3D()[0].points) == 4:  # a second-order mesh (of a file) is used as is
         ngmesh = ngmesh.Copy()
         ngmesh.SecondOrder()
     m = ngs.Mesh(ngmesh)

@@ -61,11 +61,13 @@ __all__ = [
     "build_meshes",
     "region_nodes",
     "layout_regions",
+    "MESH_VERSION",
+    "GRADING",
 ]
 
-_MESH_VERSION = 2
+MESH_VERSION = 2
 """Bump when the meshing procedure changes without a config value changing (enters the cache key)."""
-_GRADING = 0.3
+GRADING = 0.3
 """Netgen mesh grading (0..1): how fast elements grow away from the teeth."""
 _REGION_TOL = 1e-6
 """Distance [m] within which a boundary node belongs to a region's surface (Netgen places nodes
@@ -240,7 +242,7 @@ def _netgen_mesh(brep: Path, layout: ComponentLayout, sizes: MeshSizes):
     geo = OCCGeometry(str(brep))
     mp = nm.MeshingParameters(
         maxh=sizes.body, curvaturesafety=sizes.elements_per_curvature_radius,
-        grading=_GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=sizes.optimisation_steps,
+        grading=GRADING, segmentsperedge=0.0, closeedgefac=None, optsteps2d=sizes.optimisation_steps,
         optsteps3d=sizes.optimisation_steps)
     _refine_teeth(geo, layout, sizes.tooth, mp)
     return geo.GenerateMesh(mp=mp)
@@ -331,7 +333,7 @@ def _study_source(d: Design, component: str, level: str) -> MeshSource:
     settings = spec.meshing_assumed[level]
     return MeshSource(d.layouts[component], level, MeshSizes.of(settings), settings.element_order,
                       geometry_hash(spec, component),
-                      lambda order: geometry_hash(spec, component, settings, order, _GRADING, _MESH_VERSION),
+                      lambda order: geometry_hash(spec, component, settings, order, GRADING, MESH_VERSION),
                       lambda nodes, boundary: region_nodes(d, component, nodes, boundary))
 
 

@@ -43,7 +43,8 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
            "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
-           "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles"]
+           "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles",
+           "read_cached"]
 
 BOLT_PATCHES = "bolt_patches"
 """Name of the ring's and the output shaft's rigid interface over the clamped discs of all bolts."""
@@ -223,7 +224,7 @@ def component_mass_properties(spec: GearboxSpec | Design, component: str, level:
     """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
     when the body is there (a rigid twin needs no modes), else from the body built and cached."""
     key, build = _component_reduction(spec, component, level, progress)
-    props = _read_cached(key, _load_mass_properties)
+    props = read_cached(key, _load_mass_properties)
     return props if props is not None else cached_reduced_body(key, build).props
 
 
@@ -231,7 +232,7 @@ def cached_component_frequencies(spec: GearboxSpec | Design, component: str,
                                  level: str = "coarse") -> np.ndarray | None:
     """Free-free frequencies [Hz] of :func:`component_reduced_body`, read alone from the cache; None when the
     body is not cached yet (nothing is built)."""
-    return _read_cached(_component_reduction(spec, component, level, False)[0], _load_frequencies)
+    return read_cached(_component_reduction(spec, component, level, False)[0], _load_frequencies)
 
 
 def _load_mass_properties(path: Path) -> MassProperties:
@@ -247,7 +248,7 @@ def _load_frequencies(path: Path) -> np.ndarray:
         return np.asarray(z["frequencies_hz"], float)
 
 
-def _read_cached(key: str, read: Callable[[Path], object]) -> object | None:
+def read_cached(key: str, read: Callable[[Path], object]) -> object | None:
     """``read(path)`` of the reduced body cached under ``key``; None if it is missing or cannot be read (a
     damaged file is reported and rebuilt by :func:`cached_reduced_body`)."""
     path = reduced_cache_path(key)

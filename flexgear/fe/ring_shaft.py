@@ -35,12 +35,12 @@ from flexgear.fe.cms import Interface, ReducedBody
 from flexgear.fe.fem import FEModel
 from flexgear.fe.reduced import (
     RING_SEAT,
-    _read_cached,
     cached_reduced_body,
     component_interfaces,
     component_load_circles,
     component_reduced_body,
     patch_union,
+    read_cached,
 )
 from flexgear.fe.tied import Tie, TiedFE, reduce, tie_parts
 from flexgear.geometry.layout import geometry_hash
@@ -144,7 +144,7 @@ def tied_pair_mass_properties(spec: GearboxSpec, level: str = "coarse", progress
         with np.load(path, allow_pickle=False) as z:
             return MassProperties(float(z["mass"]), z["com"], z["inertia"])
 
-    props = _read_cached(_tied_key(spec, level), read)
+    props = read_cached(_tied_key(spec, level), read)
     return props if props is not None else tied_pair_body(spec, level, progress, fe_source).props
 
 

@@ -32,7 +32,7 @@ import numpy as np
 import scipy.sparse as sp
 
 from flexgear.fe.attachment import LoadCircle
-from flexgear.fe.bolted import _isoparametric, _locate, _shape_functions
+from flexgear.fe.bolted import isoparametric_coordinates, locate_in_triangles, shape_functions
 from flexgear.fe.cms import Interface, ReducedBody
 from flexgear.fe.cms import reduce as _reduce_fe
 from flexgear.fe.fem import FEModel, surface_faces
@@ -97,11 +97,11 @@ def tie_weights(master: FEModel, points: np.ndarray, plane_point, plane_normal=(
         raise ValueError(f"tie: the master has no boundary face on the plane through {origin} normal {normal}")
     local = (points - origin) @ axes
     corners = (master.nodes[faces[:, :3]] - origin) @ axes
-    face, bary = _locate(local, corners)
-    bary = _isoparametric(local, (master.nodes[faces[face]] - origin) @ axes, bary)
+    face, bary = locate_in_triangles(local, corners)
+    bary = isoparametric_coordinates(local, (master.nodes[faces[face]] - origin) @ axes, bary)
     if bary.min() < -max_outside:
         raise ValueError(f"tie: a slave node lies outside the master face (barycentric {bary.min():.3f})")
-    return faces[face], _shape_functions(bary, faces.shape[1])
+    return faces[face], shape_functions(bary, faces.shape[1])
 
 
 @dataclass

@@ -37,11 +37,11 @@ import numpy as np
 from flexgear.fe.attachment import LoadCircle
 from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.fe.fem import FEModel
-from flexgear.fe.mesh import _GRADING, _MESH_VERSION, ComponentMesh, MeshSizes, MeshSource, layout_regions, source_mesh
+from flexgear.fe.mesh import GRADING, MESH_VERSION, ComponentMesh, MeshSizes, MeshSource, layout_regions, source_mesh
 from flexgear.fe.reduced import band_circles, cached_reduced_body
 from flexgear.geometry.contact_lines import mesh_contact_geometry
 from flexgear.geometry.gear_body import Engagement, GearBody
-from flexgear.geometry.layout import _GEOMETRY_VERSION, helix_sweep
+from flexgear.geometry.layout import GEOMETRY_VERSION, helix_sweep
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
 from flexgear.spec import spec_hash
@@ -68,7 +68,7 @@ def _solid_key(body: GearBody) -> str:
     sweeps = [dataclasses.astuple(helix_sweep(p.twist, p.length, layout.profile))
               for p in layout.prisms if p.section.gear is not None and p.twist != 0.0]
     geometry = {f.name: getattr(body, f.name) for f in dataclasses.fields(body) if f.name not in _MESH_FIELDS}
-    return spec_hash(geometry, "toothed solid", _GEOMETRY_VERSION, _TOOTHED_VERSION, sweeps)
+    return spec_hash(geometry, "toothed solid", GEOMETRY_VERSION, _TOOTHED_VERSION, sweeps)
 
 
 def _source(body: GearBody) -> MeshSource:
@@ -77,7 +77,7 @@ def _source(body: GearBody) -> MeshSource:
     solid = _solid_key(body)
     layout = body.layout()
     return MeshSource(layout, LEVEL, sizes, body.element_order, solid,
-                      lambda order: spec_hash(solid, sizes, order, _GRADING, _MESH_VERSION),
+                      lambda order: spec_hash(solid, sizes, order, GRADING, MESH_VERSION),
                       lambda nodes, boundary: layout_regions(layout, nodes, boundary))
 
 

@@ -37,9 +37,13 @@ __all__ = [
     "measure_backlash",
     "assembly_check",
     "flank_deviation",
+    "transverse_section",
+    "MM_PER_M",
 ]
 
-_MM = 1e3  # cross sections are built in mm (manifold3d works on a fixed-point grid)
+MM_PER_M = 1e3
+"""Millimetres per metre: :func:`transverse_section` builds its cross sections in mm (manifold3d works on a
+fixed-point grid), so lengths in metres are scaled by this to meet them."""
 
 
 @dataclass(frozen=True)
@@ -71,8 +75,8 @@ def nominal_placements(spec: GearboxSpec) -> list[Placement]:
     return out
 
 
-def _section(spec: GearboxSpec, component: str, placement: Placement, z: float,
-             points_per_segment: int = 60) -> manifold3d.CrossSection:
+def transverse_section(spec: GearboxSpec, component: str, placement: Placement, z: float,
+                       points_per_segment: int = 60) -> manifold3d.CrossSection:
     """Transverse section of a placed gear at height z (teeth region), in mm."""
     layout = component_layout(spec, component)
     prism = next((p for p in layout.prisms if p.section.gear is not None and p.z0 <= z <= p.z1), None)
@@ -82,16 +86,17 @@ def _section(spec: GearboxSpec, component: str, placement: Placement, z: float,
     angle = placement.rotation + prism.twist * z
     c, s = math.cos(angle), math.sin(angle)
     pts = outline @ np.array([[c, -s], [s, c]]).T + np.array(placement.centre[:2])
-    shape = manifold3d.CrossSection([pts * _MM])
+    shape = manifold3d.CrossSection([pts * MM_PER_M])
     if layout.gear.internal:
-        rim = manifold3d.CrossSection.circle(prism.section.outer * _MM, 720)
+        rim = manifold3d.CrossSection.circle(prism.section.outer * MM_PER_M, 720)
         return rim - shape
     return shape
 
 
 def section_overlap(spec: GearboxSpec, a: Placement, b: Placement, z: float) -> float:
     """Overlap area [m^2] of two placed gears' sections at height z (0: no interference)."""
-    return (_section(spec, a.component, a, z) ^ _section(spec, b.component, b, z)).area() / _MM**2
+    overlap = transverse_section(spec, a.component, a, z) ^ transverse_section(spec, b.component, b, z)
+    return overlap.area() / MM_PER_M**2
 
 
 def measure_backlash(spec: GearboxSpec, pair: str, planet: int = 0, z: float | None = None,
@@ -108,12 +113,12 @@ def measure_backlash(spec: GearboxSpec, pair: str, planet: int = 0, z: float | N
     pl = planets[planet]
     if z is None:
         z = next(p for p in component_layout(spec, "planet").prisms if p.section.gear is not None).z1 - 1e-4
-    fixed = _section(spec, other.component, other, z)
+    fixed = transverse_section(spec, other.component, other, z)
     pitch = 2 * math.pi / gs.planet.teeth
 
     def overlaps(delta: float) -> bool:
         moved = Placement("planet", pl.rotation + delta, pl.centre)
-        return (fixed ^ _section(spec, "planet", moved, z)).area() > 0.0
+        return (fixed ^ transverse_section(spec, "planet", moved, z)).area() > 0.0
 
     if overlaps(0.0):
         raise RuntimeError(f"interference at the nominal position ({pair}, planet {planet}, z = {z} m)")

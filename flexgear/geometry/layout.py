@@ -65,10 +65,13 @@ __all__ = [
     "geometry_hash",
     "HelixSweep",
     "helix_sweep",
+    "GEOMETRY_VERSION",
 ]
 
 _HANDS = {"sun": 1.0, "planet": -1.0, "ring": -1.0}
-_GEOMETRY_VERSION = 2  # bump when the construction changes: invalidates every cache entry
+GEOMETRY_VERSION = 2
+"""Version of the geometry construction, part of every geometry cache key (:func:`geometry_hash`, the toothed
+bodies' solids): bump when the construction changes, which invalidates every cache entry."""
 
 
 
@@ -148,7 +151,7 @@ def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
     construction = () if all(w.plain for w in sweeps) else (
         ("precise_sweeps", *((w.pieces, w.scale) for w in sweeps)),)
     return spec_hash(spec.gears, spec.gears_assumed, spec.components_assumed, spec.material_assumed,
-                     _GEOMETRY_VERSION, *construction, *extra)
+                     GEOMETRY_VERSION, *construction, *extra)
 
 
 @dataclass(frozen=True)

@@ -42,6 +42,7 @@ __all__ = [
     "ToothProfile",
     "tooth_profile",
     "sector_integrals",
+    "mirror_segment",
 ]
 
 _GAUSS_NODES, _GAUSS_WEIGHTS = np.polynomial.legendre.leggauss(48)
@@ -166,7 +167,7 @@ class ToothProfile:
 
     def pitch_segments(self) -> list[Segment]:
         """One full pitch from the space centre at -pi/z to the space centre at +pi/z."""
-        mirrored = [_mirror(seg) for seg in reversed(self.half_pitch)]
+        mirrored = [mirror_segment(seg) for seg in reversed(self.half_pitch)]
         return mirrored + list(self.half_pitch)
 
     def sample(self, points_per_segment: int = 25) -> np.ndarray:
@@ -198,7 +199,7 @@ class ToothProfile:
         return next(seg for seg in self.half_pitch if isinstance(seg, InvoluteSegment))
 
 
-def _mirror(seg: Segment) -> Segment:
+def mirror_segment(seg: Segment) -> Segment:
     """Mirror image in the x axis, traversed in the opposite direction (keeps orientation)."""
     if isinstance(seg, ArcSegment):
         return ArcSegment(seg.cx, -seg.cy, seg.radius, -seg.phi1, -seg.phi0)

@@ -39,7 +39,7 @@ import netgen.occ as occ
 import numpy as np
 
 from flexgear.geometry.layout import ComponentLayout, Prism, helix_sweep
-from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, _mirror
+from flexgear.geometry.profile import ArcSegment, InvoluteSegment, ToothProfile, mirror_segment
 
 __all__ = [
     "FLANK_POINTS", "outline_edge_count", "section_face", "component_solid", "occ_mass_properties",
@@ -85,7 +85,7 @@ def _outline_pitch(profile: ToothProfile) -> list:
     full_tip = ArcSegment(0.0, 0.0, tip.radius, -tip.phi1, tip.phi1)
     full_root = ArcSegment(0.0, 0.0, root.radius, root.phi0, 2 * math.pi / profile.teeth - root.phi0)
     sides = half[1:-1]
-    return [_mirror(seg) for seg in reversed(sides)] + [full_tip] + sides + [full_root]
+    return [mirror_segment(seg) for seg in reversed(sides)] + [full_tip] + sides + [full_root]
 
 
 def outline_edge_count(profile: ToothProfile) -> int:

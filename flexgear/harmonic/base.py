@@ -16,7 +16,7 @@ import pandas as pd
 from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["Response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS", "RPM", "ACCEL_INDICATORS",
-           "excitation"]
+           "excitation", "Operating", "mesh_force_name", "sweep_speeds", "excited_spec", "series_coefficients"]
 
 DEFAULT_HARMONICS = 10
 """Mesh harmonics h = 1..H of the excitation and response."""
@@ -100,7 +100,7 @@ class Response:
 
 # --------------------------------------------------------------------------- the linear problem at one speed
 @dataclass
-class _Operating:
+class Operating:
     """The linearised model at one speed, with its excitation and outputs (all SI).
 
     ``rows`` (n_c, n): contact deflection per coordinate; ``k_t``, ``c``, ``f0`` (n_c,): tangent stiffness,
@@ -133,12 +133,11 @@ class _Operating:
     friction: np.ndarray | None = None
 
 
-_ACCEL = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
-ACCEL_INDICATORS = _ACCEL
-"""The bearing accelerations, in the order of the rows of ``_Operating.accel`` (q'' of each is accel[k] @ z'')."""
+ACCEL_INDICATORS = tuple(f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y"))
+"""The bearing accelerations, in the order of the rows of ``Operating.accel`` (q'' of each is accel[k] @ z'')."""
 
 
-def excitation(op: _Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
+def excitation(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     """The excitation at mesh harmonics h = 1..``harmonics`` (flexgear.harmonic.response): (F_h = F_0 C_h of every
     contact (n_c, H) [N], the generalised forces f_h = -g^T F_h - a^T S_h - b^T L_h summed over the contacts (H, n)
     [N or N m per coordinate], the friction terms where ``op.friction`` is set, flexgear.harmonic.friction); the time
@@ -150,7 +149,7 @@ def excitation(op: _Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     return excite, force
 
 
-def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
+def _solve(op: Operating, harmonics: int) -> dict[str, np.ndarray]:
     """Complex amplitudes (H,) of every indicator at one speed (module docstring)."""
     h = np.arange(1, harmonics + 1)
     w = h * op.omega_mesh
@@ -169,18 +168,19 @@ def _solve(op: _Operating, harmonics: int) -> dict[str, np.ndarray]:
     for m, name in enumerate(op.mesh_names):
         out[name] = contact[:, op.mesh == m].sum(axis=1)
     acc = -(w**2)[:, None] * (x @ op.accel.T)
-    for k, name in enumerate(_ACCEL):
+    for k, name in enumerate(ACCEL_INDICATORS):
         out[name] = acc[:, k]
     out["transmission_error_m"] = x @ op.te
     return out
 
 
-def _mesh_name(kind: str, i: int) -> str:
+def mesh_force_name(kind: str, i: int) -> str:
+    """Indicator name of the force of mesh ``i`` (1-based planet) of ``kind`` "outer" or "inner"."""
     return f"{kind}_mesh_force_{i}_n"
 
 
-def _sweep(operating: Callable[[float], _Operating], speeds_rpm: Sequence[float], harmonics: int, model: str,
-           per_rpm: float, t0: float) -> Response:
+def sweep_speeds(operating: Callable[[float], Operating], speeds_rpm: Sequence[float], harmonics: int, model: str,
+                 per_rpm: float, t0: float) -> Response:
     """Solve every speed and gather the table."""
     if harmonics < 1:
         raise ValueError(f"harmonics: expected >= 1, got {harmonics}")
@@ -231,7 +231,7 @@ def waveform_peak(amplitudes: np.ndarray, mean: float = 0.0) -> float:
     return float(mean + (np.exp(1j * np.outer(phi, h)) @ x).real.max())
 
 
-def _excited(spec: Any, harmonics: int) -> Any:
+def excited_spec(spec: Any, harmonics: int) -> Any:
     """The spec with ``harmonics`` stiffness harmonics from the contact lines (eq. 11-12)."""
     spec = spec.with_fields("contact_assumed", stiffness_harmonics=int(harmonics))
     if spec.contact_assumed.stiffness_variation == "constant":
@@ -239,8 +239,8 @@ def _excited(spec: Any, harmonics: int) -> Any:
     return spec
 
 
-def _series_coefficients(cos_c: np.ndarray, sin_c: np.ndarray, offset_cycles: np.ndarray,
-                         rate_sign: np.ndarray) -> np.ndarray:
+def series_coefficients(cos_c: np.ndarray, sin_c: np.ndarray, offset_cycles: np.ndarray,
+                        rate_sign: np.ndarray) -> np.ndarray:
     """Complex coefficients (n_c, H) at +h f_mesh of s(phi) - 1 = sum_h a_h cos 2 pi h phi + b_h sin 2 pi h phi,
     phi = rate t + offset: (a_h - i b_h) e^{i 2 pi h offset}, conjugated where the phase runs backwards."""
     h = np.arange(1, cos_c.shape[1] + 1)

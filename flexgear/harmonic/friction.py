@@ -15,7 +15,7 @@ in the mesh phase phi [cycles]; its complex Fourier coefficients at +h f_mesh (h
 
     S_h = c_h[ mu F(delta_0) s sigma kappa ],   L_h = c_h[ mu F(delta_0) s sigma lambda ],   sigma = tanh(...),
 
-phased by the contact's own mesh phase as the stiffness excitation (flexgear.harmonic.base._series_coefficients),
+phased by the contact's own mesh phase as the stiffness excitation (flexgear.harmonic.base.series_coefficients),
 give the friction excitation: the generalised force -(a^T S_h + b^T L_h) at harmonic h, with a, b over the linear
 model's independent coordinates (the frame rows times the basis q = B z). Left out, as flexgear.modal.linear leaves
 them out: the friction's dependence on the response (mu kappa k_t x_delta: parametric, and a tangent term of order mu
@@ -34,8 +34,8 @@ from typing import Any
 import numpy as np
 
 from flexgear.geometry.contact_lines import PeriodicSeries
-from flexgear.harmonic.base import _series_coefficients
-from flexgear.modal.linear import FRAME_NAMES, _component_name
+from flexgear.harmonic.base import series_coefficients
+from flexgear.modal.linear import FRAME_NAMES, component_name
 
 __all__ = ["SAMPLES_PER_HARMONIC", "friction_harmonics", "friction_rows"]
 
@@ -70,7 +70,7 @@ def friction_harmonics(contacts: Sequence[Any], deflections: np.ndarray, input_s
             cos_c[k, i], sin_c[k, i] = fit.cos_coeffs, fit.sin_coeffs
     offset = -np.array([c.phase_offset for c in contacts])
     sense = np.array([c.phase_per_drive_angle for c in contacts]) * math.copysign(1.0, input_speed_rad_s)
-    return np.stack([_series_coefficients(cos_c[k], sin_c[k], offset, np.sign(sense)) for k in range(2)])
+    return np.stack([series_coefficients(cos_c[k], sin_c[k], offset, np.sign(sense)) for k in range(2)])
 
 
 def friction_rows(lm: Any, contacts: Sequence[Any]) -> np.ndarray:
@@ -81,6 +81,6 @@ def friction_rows(lm: Any, contacts: Sequence[Any]) -> np.ndarray:
     full = np.zeros((2, len(contacts), len(lm.full_coordinates)))
     for i, c in enumerate(contacts):
         for body, grad in ((c.body1, c.gradient1), (c.body2, c.gradient2)):
-            cols = [index[(_component_name(body), name)] for name in FRAME_NAMES]
+            cols = [index[(component_name(body), name)] for name in FRAME_NAMES]
             full[:, i, cols] += grad[1:3]
     return full.reshape(2 * len(contacts), -1) @ lm.basis

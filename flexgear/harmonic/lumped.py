@@ -16,13 +16,13 @@ import numpy as np
 from flexgear.harmonic.base import (
     DEFAULT_HARMONICS,
     RPM,
+    Operating,
     Response,
-    _excited,
-    _mesh_name,
-    _Operating,
-    _series_coefficients,
-    _sweep,
+    excited_spec,
+    mesh_force_name,
     mesh_frequency_hz,
+    series_coefficients,
+    sweep_speeds,
 )
 from flexgear.harmonic.lumped_friction import lumped_friction
 
@@ -33,7 +33,7 @@ __all__ = ["lumped_harmonic_response", "LumpedLinear", "lumped_linear"]
 class LumpedLinear:
     """The lumped model linearised about its static equilibrium under the load (:func:`lumped_linear`).
 
-    ``operating(speed_rpm)``: the linear problem at that input speed [rpm] (flexgear.harmonic.base._Operating: M,
+    ``operating(speed_rpm)``: the linear problem at that input speed [rpm] (flexgear.harmonic.base.Operating: M,
     D + G, K over the free coordinates, contact rows, excitation, outputs); ``labels``: the free coordinates'
     names (flexgear.lumped.model.LumpedSystem.labels); ``free``: their indices among all coordinates;
     ``system``: the assembled flexgear.lumped.model.LumpedSystem; ``per_rpm``: f_mesh per input rpm [Hz/rpm];
@@ -41,7 +41,7 @@ class LumpedLinear:
     equilibrium under the load [m, rad] the model is linearised about (input spin at zero).
     """
 
-    operating: Callable[[float], _Operating]
+    operating: Callable[[float], Operating]
     labels: tuple[str, ...]
     free: np.ndarray
     system: Any
@@ -55,7 +55,7 @@ def lumped_harmonic_response(spec: Any, speeds_rpm: Sequence[float], harmonics: 
     (the linearisation: :func:`lumped_linear`)."""
     t0 = time.perf_counter()
     lin = lumped_linear(spec, harmonics)
-    return _sweep(lin.operating, speeds_rpm, harmonics, lin.name, lin.per_rpm, t0)
+    return sweep_speeds(lin.operating, speeds_rpm, harmonics, lin.name, lin.per_rpm, t0)
 
 
 def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear:
@@ -71,20 +71,11 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     bearing accelerations are in the carrier frame. With mu > 0 the tooth friction at the static mesh forces adds
     its first-order excitation (flexgear.harmonic.lumped_friction), phased as the stiffness excitation.
     """
-    from flexgear.lumped.run import (
-        _DEPTH,
-        _EXPONENT,
-        _IMPACT,
-        _IN_BODY,
-        _LOAD_SIGN,
-        _OUT_BODY,
-        _OUT_SPIN,
-        _T_LOAD,
-        build_lumped_model,
-    )
+    from flexgear.lumped.kernel_layout import DEPTH, EXPONENT, IMPACT, IN_BODY, LOAD_SIGN, OUT_BODY, OUT_SPIN, T_LOAD
+    from flexgear.lumped.run import build_lumped_model
     from flexgear.theory import theory
 
-    spec = _excited(spec, harmonics)
+    spec = excited_spec(spec, harmonics)
     model = build_lumped_model(spec)
     s = model.system
     p = s.params
@@ -95,14 +86,14 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     nf = free.size
     rows = s.mesh_G[:, free]
     nmesh = rows.shape[0]
-    impact = model.fp[_IMPACT] > 0.0
-    exponent = float(model.fp[_EXPONENT]) if impact else 1.0
-    depth = float(model.fp[_DEPTH])
+    impact = model.fp[IMPACT] > 0.0
+    exponent = float(model.fp[EXPONENT]) if impact else 1.0
+    depth = float(model.fp[DEPTH])
     k_law, c_law = model.mesh_k, model.mesh_c
 
     # static equilibrium under the load (mean stiffness, no friction): K_s q + G^T F(G q) = T (Newton)
     load = np.zeros(s.n)
-    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    load[model.ip[OUT_SPIN]] = model.fp[LOAD_SIGN] * model.fp[T_LOAD]
     ks = s.support_stiffness[np.ix_(free, free)]
     q = np.linalg.solve(s.stiffness()[np.ix_(free, free)], load[free])
     for _ in range(100):
@@ -134,28 +125,29 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     q_static[free] = q
     offset = model.phase_offset - model.phase_centre + model.phase_coef * q_static[model.phase_index]
     cos_c = np.asarray(model.harmonics, float)
-    coef = _series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
+    coef = series_coefficients(cos_c, np.zeros_like(cos_c), offset, np.sign(rate))
     friction = lumped_friction(model, free, f0, harmonics, np.sign(rate))  # None at mu = 0
 
     n_pl = p.planet_count
-    names = tuple([_mesh_name("outer", i + 1) for i in range(n_pl)] + [_mesh_name("inner", i + 1) for i in range(n_pl)])
+    names = tuple([mesh_force_name("outer", i + 1) for i in range(n_pl)]
+                  + [mesh_force_name("inner", i + 1) for i in range(n_pl)])
     pos = {int(j): k for k, j in enumerate(free)}
     accel = np.zeros((4, nf))
-    for k, b in enumerate((int(model.ip[_IN_BODY]), int(model.ip[_OUT_BODY]))):
+    for k, b in enumerate((int(model.ip[IN_BODY]), int(model.ip[OUT_BODY]))):
         for a in range(2):
             if 3 * b + a in pos:
                 accel[2 * k + a, pos[3 * b + a]] = 1.0
     th = theory(spec)
     r_out = p.ring.radius_m if star else p.carrier.radius_m
     te = np.zeros(nf)
-    out_spin = int(model.ip[_OUT_SPIN])
+    out_spin = int(model.ip[OUT_SPIN])
     if out_spin in pos:
         te[pos[out_spin]] = -r_out * math.copysign(1.0, th.output_speed)
     mass = np.diag(s.mass[free])
     base_k = ks + (rows.T * k_t) @ rows
     base_d = s.support_damping[np.ix_(free, free)] + (rows.T * c) @ rows
 
-    def operating(speed_rpm: float) -> _Operating:
+    def operating(speed_rpm: float) -> Operating:
         w_in = speed_rpm * RPM
         om = r_c * w_in
         gyro = np.zeros((nf, nf))
@@ -174,8 +166,8 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
         rubbing = {} if friction is None else {"friction_rows": friction.rows,
                                                 "friction": friction.coefficients(w_in)}
-        return _Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
-                          omega_mesh, **rubbing)
+        return Operating(mass, base_d + gyro, kk, rows, k_t, c, f0, coef, np.arange(nmesh), names, accel, te,
+                         omega_mesh, **rubbing)
 
     return LumpedLinear(operating, tuple(s.labels[j] for j in free), free, s, mesh_frequency_hz(spec, 1.0),
                         f"lumped ({Path(str(spec.source)).stem})", q)

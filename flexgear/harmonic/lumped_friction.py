@@ -17,7 +17,7 @@ T^(k) = (1/N) DFT_k(T_j) sinc^2(k / N) (the hat function's transform), and
 
     (s T)^(h) = sum_(n=-H_s..H_s) s^(n) T^(h - n),   s^(0) = 1,   s^(+-n) = (c_n / 2) e^(-+ i 2 pi n centre).
 
-Phased as the stiffness excitation (flexgear.harmonic.base._series_coefficients with the mesh's phase offset), the
+Phased as the stiffness excitation (flexgear.harmonic.base.series_coefficients with the mesh's phase offset), the
 generalised force at harmonic h is -R^T [F_t; F_1; F_2]_h with R = [-(tau rows); e_theta1; -e_theta2] over the free
 coordinates and F_X,h = mu F_0 sigma (s X)_h. Left out, as for the stiffness excitation: the friction's dependence on
 the response (through F = k delta, the parametric term of order mu) and on the rates (sigma saturates once the
@@ -31,7 +31,7 @@ from typing import Any
 
 import numpy as np
 
-from flexgear.harmonic.base import _series_coefficients
+from flexgear.harmonic.base import series_coefficients
 from flexgear.lumped.model import CENTRAL_MEMBERS
 
 __all__ = ["LumpedFriction", "lumped_friction", "nominal_spin_rates", "CHECK_SAMPLES_PER_HARMONIC"]
@@ -107,9 +107,9 @@ def lumped_friction(model: Any, free: np.ndarray, f0: np.ndarray, harmonics: int
     ``f0`` (n_m,) [N] over the ``free`` coordinates at harmonics 1..``harmonics``, each mesh's phase running with
     ``rate_sign`` (n_m,) as in the stiffness excitation (module docstring); None without
     friction (mu = 0). Raises ValueError where s(phi) F_0 vanishes (the time model drops friction where F <= 0)."""
-    from flexgear.lumped.run import _MU
+    from flexgear.lumped.kernel_layout import MU
 
-    mu = float(model.fp[_MU])
+    mu = float(model.fp[MU])
     if mu <= 0.0:
         return None
     nm = model.mesh_type.size
@@ -143,6 +143,6 @@ def lumped_friction(model: Any, free: np.ndarray, f0: np.ndarray, harmonics: int
             t_hat = _interpolant_coefficients(model.tables[model.mesh_type[m], :, k], h[:, None] - shift[None])
             unit[k, m] = t_hat @ s_hat  # (s T)^(h), h >= 1
     # real series: a_h cos + b_h sin with a_h - i b_h = 2 (s T)^(h); phased as the stiffness excitation
-    phased = [_series_coefficients(2.0 * unit[k].real, -2.0 * unit[k].imag, model.phase_offset, rate_sign)
+    phased = [series_coefficients(2.0 * unit[k].real, -2.0 * unit[k].imag, model.phase_offset, rate_sign)
               for k in range(3)]
     return LumpedFriction(rows.reshape(3 * nm, -1), np.vstack(phased), slip, np.asarray(f0, float), mu)

@@ -41,9 +41,9 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from flexgear.harmonic.base import _ACCEL, DEFAULT_HARMONICS, Response, _Operating, _sweep
+from flexgear.harmonic.base import ACCEL_INDICATORS, DEFAULT_HARMONICS, Operating, Response, sweep_speeds
 from flexgear.harmonic.lumped import LumpedLinear, lumped_linear
-from flexgear.modal.campbell_diagram import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, _crossings, track
+from flexgear.modal.campbell_diagram import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, order_crossings, track
 from flexgear.modal.eigenmodes import state_space_roots
 
 __all__ = ["lumped_campbell", "mode_contributions", "response_peaks", "peak_crossings", "PEAK_FRACTION",
@@ -82,7 +82,7 @@ class _Roots:
         return -lam.real / np.abs(lam)
 
 
-def _roots(op: _Operating, max_damping_ratio: float = MAX_DAMPING_RATIO) -> _Roots:
+def _roots(op: Operating, max_damping_ratio: float = MAX_DAMPING_RATIO) -> _Roots:
     lam, vec = state_space_roots(op.mass, op.damping, op.stiffness)
     scale = np.abs(lam).max()
     pair = np.array([int(np.argmin(np.abs(lam - lj.conjugate()))) for lj in lam])
@@ -103,19 +103,19 @@ def _multiplets(freqs: np.ndarray, rtol: float = MULTIPLET_RTOL) -> list[np.ndar
     return [np.array(g) for g in groups]
 
 
-def _indicator_row(op: _Operating, indicator: str, omega: float) -> np.ndarray:
+def _indicator_row(op: Operating, indicator: str, omega: float) -> np.ndarray:
     """r (n,) with indicator = r^T X + excitation term (module docstring)."""
     if indicator in op.mesh_names:
         sel = op.mesh == op.mesh_names.index(indicator)
         return ((op.k_t[sel] + 1j * omega * op.c[sel])[:, None] * op.rows[sel]).sum(axis=0)
-    if indicator in _ACCEL:
-        return -(omega**2) * op.accel[_ACCEL.index(indicator)]
+    if indicator in ACCEL_INDICATORS:
+        return -(omega**2) * op.accel[ACCEL_INDICATORS.index(indicator)]
     if indicator == "transmission_error_m":
         return op.te.astype(complex)
     raise KeyError(f"no modal contribution for indicator {indicator!r}")
 
 
-def _contributions(op: _Operating, roots: _Roots, indicator: str, harmonic: int) -> tuple[np.ndarray, complex]:
+def _contributions(op: Operating, roots: _Roots, indicator: str, harmonic: int) -> tuple[np.ndarray, complex]:
     """(contribution of each mode of ``roots.modes`` (its root and the conjugate), the indicator's response part
     r^T X) at harmonic ``harmonic`` (module docstring)."""
     n = op.mass.shape[0]
@@ -173,8 +173,8 @@ def _campbell_of(lin: LumpedLinear, speeds: np.ndarray, f_max_hz: float, orders:
                          "kind": classify_mode(lin.system, np.abs(full))})
     table = pd.DataFrame(rows, columns=["speed_rpm", "mode", "frequency_hz", "damping_ratio", "kind"])
     table = table.sort_values(["speed_rpm", "frequency_hz"], ignore_index=True)
-    diagram = Campbell(lin.name, table, _crossings(table, lin.per_rpm, orders), lin.per_rpm, f_max_hz, tuple(orders),
-                       mac_min)
+    diagram = Campbell(lin.name, table, order_crossings(table, lin.per_rpm, orders), lin.per_rpm, f_max_hz,
+                       tuple(orders), mac_min)
     return diagram, lines, found
 
 
@@ -222,7 +222,7 @@ def peak_crossings(spec: Any, speeds_rpm: Sequence[float], indicators: Sequence[
     """
     speeds = np.sort(np.asarray(speeds_rpm, float))
     lin = lumped_linear(spec, harmonics)
-    response = _sweep(lin.operating, speeds, harmonics, lin.name, lin.per_rpm, time.perf_counter())
+    response = sweep_speeds(lin.operating, speeds, harmonics, lin.name, lin.per_rpm, time.perf_counter())
     band = max(orders) * lin.per_rpm * speeds[-1] * (1.0 + 1e-9)
     diagram, lines, found = _campbell_of(lin, speeds, band, orders, MAC_MIN)
     crossings = diagram.crossings

@@ -59,13 +59,13 @@ from flexgear.harmonic.base import (
     DEFAULT_HARMONICS,
     INDICATOR_UNITS,
     RPM,
+    Operating,
     Response,
-    _excited,
-    _mesh_name,
-    _Operating,
-    _series_coefficients,
-    _sweep,
+    excited_spec,
+    mesh_force_name,
     mesh_frequency_hz,
+    series_coefficients,
+    sweep_speeds,
 )
 from flexgear.harmonic.reduced import MODAL_CUTOFF_RATIO
 
@@ -195,7 +195,7 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
         nodes, models = np.array([model_or_variant.speed_rpm]), [model_or_variant]
     else:
         variant = model_or_variant if not isinstance(model_or_variant, str | Path) else load_variant(model_or_variant)
-        variant = dataclasses.replace(variant, gearbox=_excited(variant.gearbox, harmonics))
+        variant = dataclasses.replace(variant, gearbox=excited_spec(variant.gearbox, harmonics))
         nodes, models = _linear_models(variant, speeds, linearization)
     spin = linearization == "spin" and len(models) == 2
     from threadpoolctl import threadpool_limits
@@ -221,15 +221,15 @@ def _check_contacts(lm: Any, names: list[str]) -> None:
 def _mbs_sweep(variant: Any, nodes: np.ndarray, models: list[Any], speeds: np.ndarray, harmonics: int,
                t0: float, spin: bool = False, modal_cutoff_ratio: float | None = None) -> Response:
     operating = _mbs_operating(variant, nodes, models, harmonics, spin, modal_cutoff_ratio)
-    return _sweep(operating, speeds, harmonics, variant.name, mesh_frequency_hz(variant.gearbox, 1.0), t0)
+    return sweep_speeds(operating, speeds, harmonics, variant.name, mesh_frequency_hz(variant.gearbox, 1.0), t0)
 
 
-def frozen_operating(models: Sequence[Any], harmonics: int = DEFAULT_HARMONICS) -> list[_Operating]:
-    """The linear problem (flexgear.harmonic.base._Operating: M, D + G, K, the contacts' excitation F_h and the
+def frozen_operating(models: Sequence[Any], harmonics: int = DEFAULT_HARMONICS) -> list[Operating]:
+    """The linear problem (flexgear.harmonic.base.Operating: M, D + G, K, the contacts' excitation F_h and the
     outputs' rows) of each flexgear.modal.linear.LinearModel of ``models`` at its own speed and operating point,
     all on the first model's independent coordinates (the matrices of each frozen at its linearisation)."""
     ref = models[0]
-    variant = dataclasses.replace(ref.variant, gearbox=_excited(ref.variant.gearbox, harmonics))
+    variant = dataclasses.replace(ref.variant, gearbox=excited_spec(ref.variant.gearbox, harmonics))
     out = []
     for lm in [ref] + [_in_coordinates(m, ref) for m in models[1:]]:
         out.append(_mbs_operating(variant, np.array([lm.speed_rpm]), [lm], harmonics)(float(lm.speed_rpm)))
@@ -238,7 +238,7 @@ def frozen_operating(models: Sequence[Any], harmonics: int = DEFAULT_HARMONICS) 
 
 def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics: int, spin: bool = False,
                    modal_cutoff_ratio: float | None = None) -> Any:
-    """The linear problem at any speed [rpm] (a callable returning flexgear.harmonic.base._Operating) from the
+    """The linear problem at any speed [rpm] (a callable returning flexgear.harmonic.base.Operating) from the
     linearisations ``models`` at ``nodes`` [rpm] (Lagrange interpolation, or the spin fit where ``spin``)."""
     from flexgear.geometry.involute import gear_set_geometry
     from flexgear.harmonic.friction import friction_harmonics, friction_rows
@@ -246,20 +246,20 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
     from flexgear.mbs.gearbox import mesh_contacts
     from flexgear.theory import theory
 
-    spec = _excited(variant.gearbox, harmonics)
+    spec = excited_spec(variant.gearbox, harmonics)
     lc = spec.load_case
     contacts = mesh_contacts(spec, math.copysign(1.0, lc.input_speed_rad_s))
     names = [c.name for c in contacts]
     for lm in models:
         _check_contacts(lm, names)
-    contact_mesh = [_mesh_name(c.name.split("_")[0], int(c.name.split("_")[2])) for c in contacts]
+    contact_mesh = [mesh_force_name(c.name.split("_")[0], int(c.name.split("_")[2])) for c in contacts]
     mesh_names = tuple(sorted(set(contact_mesh), key=lambda nm: (not nm.startswith("outer"), int(nm.split("_")[3]))))
     mesh = np.array([mesh_names.index(nm) for nm in contact_mesh])
     rate = np.array([c.phase_per_drive_angle for c in contacts]) * math.copysign(1.0, lc.input_speed_rad_s)
     cos_c = np.stack([np.asarray(c.stiffness.cos_coeffs, float)[:harmonics] for c in contacts])
     sin_c = np.stack([np.asarray(c.stiffness.sin_coeffs, float)[:harmonics] for c in contacts])
     offset = -np.array([c.phase_offset for c in contacts])
-    coef = _series_coefficients(cos_c, sin_c, offset, np.sign(rate))
+    coef = series_coefficients(cos_c, sin_c, offset, np.sign(rate))
     means = np.array([c.stiffness.mean for c in contacts])
     rubbing = any(c.friction_coefficient > 0.0 for c in contacts)
 
@@ -318,7 +318,7 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
               friction_rows(m, contacts) if rubbing else 0.0) for m in models]
     cache: dict[tuple[float, ...], tuple] = {}
 
-    def operating(speed_rpm: float) -> _Operating:
+    def operating(speed_rpm: float) -> Operating:
         at = np.flatnonzero(np.isclose(nodes, speed_rpm, rtol=0.0, atol=1e-9))
         w = np.eye(nodes.size)[at[0]] if at.size else _lagrange(nodes, speed_rpm)
         key = tuple(np.round(w, 15))
@@ -329,8 +329,8 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
             cache[key] = (*mixed[:6], *law_terms(mixed[6]), mixed[6], mixed[7] if rubbing else None)
         mass, damp, stiff, g, acc, te, f0, kt, cc, delta0, fr = cache[key]
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
-        return _Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh,
-                          friction_rows=fr, friction=rubbed(delta0, speed_rpm))
+        return Operating(mass, damp, stiff, g, kt, cc, f0, coef, mesh, mesh_names, acc, te, omega_mesh,
+                         friction_rows=fr, friction=rubbed(delta0, speed_rpm))
 
     return operating
 
@@ -360,13 +360,13 @@ def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_te
     directions = rows.T if rubs is None else np.hstack([rows.T, rubs.T])
     modal = None if modal_cutoff_ratio is None else ModalSolver(fit, directions, modal_cutoff_ratio)
 
-    def operating(speed_rpm: float) -> _Operating:
+    def operating(speed_rpm: float) -> Operating:
         w = speed_rpm * RPM
         delta0 = fit.static_deflections(w)
         f0, kt, cc = law_terms(delta0)
         omega_mesh = 2.0 * math.pi * mesh_frequency_hz(spec, speed_rpm)
         solver = None if modal is None else (lambda om, c: modal.solve(w, om, c))
-        return _Operating(fit.mass, fit.damping + fit.gyroscopic(w), fit.stiffness(w), rows, kt, cc, f0, coef, mesh,
-                          mesh_names, acc, te, omega_mesh, solver, rubs, rubbed(delta0, speed_rpm))
+        return Operating(fit.mass, fit.damping + fit.gyroscopic(w), fit.stiffness(w), rows, kt, cc, f0, coef, mesh,
+                         mesh_names, acc, te, omega_mesh, solver, rubs, rubbed(delta0, speed_rpm))
 
     return operating

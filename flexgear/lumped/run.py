@@ -56,6 +56,7 @@ from flexgear.laws.compiled import (
     tooth_friction,
 )
 from flexgear.laws.contact import mesh_laws
+from flexgear.lumped import kernel_layout as kl
 from flexgear.lumped.model import LumpedParameters, LumpedSystem, assemble, mesh_friction_tables
 from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
@@ -63,19 +64,14 @@ from flexgear.spec import GearboxSpec, spec_hash
 
 __all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces"]
 
-# layout of the float parameter vector handed to the compiled kernel
-_MU, _W_IN, _T_RAMP, _R_C, _T_LOAD, _LOAD_SIGN, _IMPACT, _EXPONENT, _DEPTH, _NFP = range(10)
-# layout of the integer parameter vector
-_IN_SPIN, _OUT_SPIN, _IN_BODY, _OUT_BODY, _NIP = range(5)
-
 
 @dataclass(frozen=True)
 class LumpedModel:
     """Everything the compiled kernel needs, as plain arrays (built by :func:`build_lumped_model`)."""
 
     system: LumpedSystem
-    fp: np.ndarray
-    ip: np.ndarray
+    fp: np.ndarray  # float parameters, laid out as flexgear.lumped.kernel_layout says
+    ip: np.ndarray  # integer parameters (the same layout module)
     free: np.ndarray  # indices of free coordinates
     presc: np.ndarray  # indices of prescribed spins
     presc_coef: np.ndarray  # q[presc] = coef * input angle(t)
@@ -107,18 +103,18 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
     r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)  # Omega_c / omega_in
     nplan = params.planet_count
     out_spin = 5 if star else 8
-    fp = np.zeros(_NFP)
-    fp[_MU] = spec.contact.friction_coefficient
-    fp[_W_IN] = lc.input_speed_rad_s
-    fp[_T_RAMP] = lc.ramp_time_s
-    fp[_R_C] = r_c
-    fp[_T_LOAD] = lc.load_torque_nm
-    fp[_LOAD_SIGN] = -math.copysign(1.0, th.ratio)
+    fp = np.zeros(kl.NFP)
+    fp[kl.MU] = spec.contact.friction_coefficient
+    fp[kl.W_IN] = lc.input_speed_rad_s
+    fp[kl.T_RAMP] = lc.ramp_time_s
+    fp[kl.R_C] = r_c
+    fp[kl.T_LOAD] = lc.load_torque_nm
+    fp[kl.LOAD_SIGN] = -math.copysign(1.0, th.ratio)
     ip = np.array([2, out_spin, 0, 1 if star else 2], dtype=np.int64)
     mesh_k, mesh_c = sysm.mesh_stiffness, sysm.mesh_damping
     if spec.contact.law == "impact":  # the multibody model's law, whole face width, on every mesh
         law = mesh_laws(d)["outer"]
-        fp[_IMPACT], fp[_EXPONENT], fp[_DEPTH] = 1.0, law.exponent, law.penetration_depth
+        fp[kl.IMPACT], fp[kl.EXPONENT], fp[kl.DEPTH] = 1.0, law.exponent, law.penetration_depth
         mesh_k, mesh_c = np.full_like(mesh_k, law.stiffness), np.full_like(mesh_c, law.damping_max)
 
     presc = np.flatnonzero(sysm.held_spin)
@@ -170,9 +166,9 @@ def _evaluate(t, y, model, work):
     q, qd, acc, f, forces, out, trig = work
     n = mass.size
     nf = free.size
-    th_in, s, sd, sdd = ramp_state(t, fp[_T_RAMP])
-    w = fp[_W_IN]
-    r_c = fp[_R_C]
+    th_in, s, sd, sdd = ramp_state(t, fp[kl.T_RAMP])
+    w = fp[kl.W_IN]
+    r_c = fp[kl.R_C]
     om, omd = r_c * w * s, r_c * w * sd  # frame speed and acceleration
     th_c = r_c * w * th_in
     q[:] = 0.0
@@ -192,8 +188,8 @@ def _evaluate(t, y, model, work):
     for b in range(3):  # ground bearings damp the absolute velocity x' + Omega J x
         f[3 * b] += ground[b] * om * q[3 * b + 1]
         f[3 * b + 1] -= ground[b] * om * q[3 * b]
-    f[ip[_OUT_SPIN]] += fp[_LOAD_SIGN] * fp[_T_LOAD] * s
-    mu = fp[_MU]
+    f[ip[kl.OUT_SPIN]] += fp[kl.LOAD_SIGN] * fp[kl.T_LOAD] * s
+    mu = fp[kl.MU]
     npts = tables.shape[1]
     for k in range(grate.size):  # A_g of each phase group (_phase_groups)
         a = 2.0 * math.pi * grate[k] * q[gidx_q[k]]
@@ -207,11 +203,11 @@ def _evaluate(t, y, model, work):
         phase = pcoefm[m] * q[pidx[m]] + poff[m]
         ca, sa = trig[0, group[m]], trig[1, group[m]]  # x = 2 pi (phase - centre) = A_g + B_m
         kf = series_value(harm[m], ca * rot_b[0, m] - sa * rot_b[1, m], sa * rot_b[0, m] + ca * rot_b[1, m])
-        if fp[_IMPACT] > 0.0:  # the impact law on the driving flank, mirrored on the back flank
+        if fp[kl.IMPACT] > 0.0:  # the impact law on the driving flank, mirrored on the back flank
             if d >= 0.0:
-                F = impact_normal_force(d, dd, km[m] * kf, fp[_EXPONENT], cm[m], fp[_DEPTH])
+                F = impact_normal_force(d, dd, km[m] * kf, fp[kl.EXPONENT], cm[m], fp[kl.DEPTH])
             elif d < -backlash[m]:
-                F = -impact_normal_force(-d - backlash[m], -dd, km[m] * kf, fp[_EXPONENT], cm[m], fp[_DEPTH])
+                F = -impact_normal_force(-d - backlash[m], -dd, km[m] * kf, fp[kl.EXPONENT], cm[m], fp[kl.DEPTH])
             else:
                 F = 0.0
         else:
@@ -254,12 +250,12 @@ def _evaluate(t, y, model, work):
     for k in range(presc.size):  # held spins keep their prescribed motion
         acc[presc[k]] = pcoef[k] * w * sd
     # recorded signals: input/output absolute speed, drive torque, accelerations of the bearing nodes
-    out[0] = qd[ip[_IN_SPIN]] + om
-    out[1] = qd[ip[_OUT_SPIN]] + om
-    out[2] = mass[ip[_IN_SPIN]] * w * sd - f[ip[_IN_SPIN]]
+    out[0] = qd[ip[kl.IN_SPIN]] + om
+    out[1] = qd[ip[kl.OUT_SPIN]] + om
+    out[2] = mass[ip[kl.IN_SPIN]] * w * sd - f[ip[kl.IN_SPIN]]
     cth, sth = math.cos(th_c), math.sin(th_c)
     for k in range(2):
-        b = ip[_IN_BODY + k]
+        b = ip[kl.IN_BODY + k]
         ax = acc[3 * b] + 2.0 * om * (-qd[3 * b + 1]) - omd * q[3 * b + 1] - om * om * q[3 * b]
         ay = acc[3 * b + 1] + 2.0 * om * qd[3 * b] + omd * q[3 * b] - om * om * q[3 * b + 1]
         out[3 + 2 * k] = cth * ax - sth * ay
@@ -408,7 +404,7 @@ def static_mesh_forces(spec: GearboxSpec) -> tuple[np.ndarray, np.ndarray]:
     K = s.stiffness()
     free = model.free
     load = np.zeros(s.n)
-    load[model.ip[_OUT_SPIN]] = model.fp[_LOAD_SIGN] * model.fp[_T_LOAD]
+    load[model.ip[kl.OUT_SPIN]] = model.fp[kl.LOAD_SIGN] * model.fp[kl.T_LOAD]
     q = np.zeros(s.n)
     q[free] = np.linalg.solve(K[np.ix_(free, free)], load[free])
     forces = s.mesh_stiffness * (s.mesh_G @ q)

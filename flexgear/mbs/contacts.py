@@ -29,11 +29,10 @@ import numpy as np
 
 from flexgear.geometry.contact_lines import MeshContactGeometry, PeriodicSeries, mesh_contact_geometry
 from flexgear.geometry.involute import GearMesh
-from flexgear.geometry.pair import _EZ
 from flexgear.laws.contact import ContactLaw, friction_forces, half_laws, normal_force
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body, normal_lever, resting_node
-from flexgear.mbs.elements import _keep_alive
+from flexgear.mbs.elements import keep_alive
 from flexgear.mbs.mesh_constraint import MeshConstraint, contact_pairs
 from flexgear.spec import Contact, ContactAssumed
 
@@ -48,6 +47,7 @@ __all__ = [
     "mesh_pair_contacts",
 ]
 
+_EZ = np.array([0.0, 0.0, 1.0])  # the gear axis (unit z)
 
 # --------------------------------------------------------------------------- gear contact
 @dataclass(frozen=True)
@@ -152,7 +152,7 @@ def add_gear_contacts(mbs, bodies: list[Body], contacts: list[GearContact], ramp
         mbs.SetObjectParameter(spring, "springForceUserFunction", laws[-1])
         springs.append(spring)
     factors = [v for v, _ in shared.values()]
-    _keep_alive(mbs, laws + factors)
+    keep_alive(mbs, laws + factors)
     schedule = (StiffnessSchedule([c for _, c in shared.values()], ramp_time, drive_speed, factors)
                 if varying else None)
     return springs, aux, constraint, gradient, schedule

@@ -154,7 +154,7 @@ def add_speed_drive(mbs, body: Body, ramp_time: float, speed: float, marker: int
 
     fn = CreateSymbolicUserFunction(mbs, offset, "offsetUserFunction", drive)
     mbs.SetObjectParameter(drive, "offsetUserFunction", fn)
-    _keep_alive(mbs, [fn])
+    keep_alive(mbs, [fn])
     return drive
 
 
@@ -174,7 +174,7 @@ def add_load_torque(mbs, body: Body, torque: float, ramp_time: float, marker: in
 
     fn = CreateSymbolicUserFunction(mbs, ramped, "loadUserFunction", load)
     mbs.SetLoadParameter(load, "loadUserFunction", fn)
-    _keep_alive(mbs, [fn])
+    keep_alive(mbs, [fn])
     return load
 
 
@@ -236,7 +236,7 @@ def add_interface_joint(mbs, body: Body, other: Body, joint: FixedJointElement, 
                                             constrainedAxes=[1] * 6, visualization=VObjectJointGeneric(show=False)))
 
 
-def _keep_alive(mbs, functions: list) -> None:
+def keep_alive(mbs, functions: list) -> None:
     """Symbolic user functions must outlive the simulation: keep them with the system."""
     store = mbs.variables.setdefault("flexgear_symbolic_functions", [])
     store.extend(functions)

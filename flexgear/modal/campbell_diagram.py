@@ -64,7 +64,7 @@ from flexgear.schema import Variant
 from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["Campbell", "campbell", "excited_kinds", "mesh_frequency_hz", "track", "MESH_ORDERS", "MAX_DAMPING_RATIO",
-           "MAC_MIN"]
+           "MAC_MIN", "order_crossings"]
 
 MESH_ORDERS = tuple(range(1, 11))
 """Mesh orders k of the diagram: the harmonics k f_m of the mesh excitation, 1x to 10x."""
@@ -201,8 +201,8 @@ class Campbell:
         return ax
 
 
-def _crossings(table: pd.DataFrame, per_rpm: float, orders: Sequence[int], sun_teeth: int | None = None,
-               planet_count: int | None = None) -> pd.DataFrame:
+def order_crossings(table: pd.DataFrame, per_rpm: float, orders: Sequence[int], sun_teeth: int | None = None,
+                    planet_count: int | None = None) -> pd.DataFrame:
     """Crossings of each line of ``table`` with the mesh orders (module docstring); ``excited``: whether the order
     excites the mode's kind (:func:`excited_kinds`; every crossing without ``sun_teeth`` and ``planet_count``)."""
     rows = []
@@ -271,6 +271,6 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
                          "damping_ratio": m.damping_ratios[jj], "kind": m.kinds[jj]})
     table = pd.DataFrame(rows, columns=["speed_rpm", "mode", "frequency_hz", "damping_ratio", "kind"])
     table = table.sort_values(["speed_rpm", "frequency_hz"], ignore_index=True)
-    crossings = _crossings(table, per_rpm, orders, spec.gears.sun_teeth, spec.gears.planet_count)
+    crossings = order_crossings(table, per_rpm, orders, spec.gears.sun_teeth, spec.gears.planet_count)
     return Campbell(variant.name, table, crossings, per_rpm, band, tuple(orders),
                     float(macs.min()) if macs.size else 1.0)

@@ -82,7 +82,7 @@ def linear_system(variant: Variant, speed_rpm: float = 0.0, *, keep_all_modes: b
     if keep_all_modes:
         spec = variant.gearbox.with_fields("reduction_assumed", dynamic_cutoff_mesh_orders=0.0)
         variant = dataclasses.replace(variant, gearbox=spec)
-    built, _ = linear._with_speed(variant, speed_rpm)
+    built, _ = linear.with_speed(variant, speed_rpm)
     t_star = built.gearbox.load_case.ramp_time_s
     sc = exu.SystemContainer()
     try:
@@ -90,10 +90,10 @@ def linear_system(variant: Variant, speed_rpm: float = 0.0, *, keep_all_modes: b
         with threadpool_limits(limits=1, user_api="blas"):
             model = build_star_gearbox(mbs, built)
         mbs.Assemble()
-        linear._operating_point(mbs, model, built, t_star)
+        linear.operating_point(mbs, model, built, t_star)
         m, k, _, c = (np.asarray(a, float) for a in exu.solver.ComputeLinearizedSystem(
-            mbs, linear._settings(t_star), returnConstraintJacobian=True, autoAssemble=False))
-        labels = tuple(linear._labels(mbs, model, m.shape[0]))
+            mbs, linear.static_solver_settings(t_star), returnConstraintJacobian=True, autoAssemble=False))
+        labels = tuple(linear.coordinate_labels(mbs, model, m.shape[0]))
     finally:
         sc.Reset()
     spec = built.gearbox
@@ -151,13 +151,13 @@ def _interface_weights(nodes: np.ndarray, itf) -> sp.csr_matrix:
 def attachments(system: LinearSystem) -> list[Attachments]:
     """Every flexible body's :class:`Attachments`: all its interfaces' RBE3 motions and the Fourier coefficients
     of each distinct contact band (bands and local normals that coincide, the planets' turned copies, once)."""
-    from flexgear.modal.linear import _component_name
+    from flexgear.modal.linear import component_name
 
     out = []
     for name, body in system.bodies.items():
         if not body.flexible:
             continue
-        comp = _component_name(name)
+        comp = component_name(name)
         red = body.reduced
         index = np.array([i for i, c in enumerate(system.labels) if c.kind == "elastic" and c.component == comp])
         blocks = [_interface_weights(red.nodes, itf) for itf in red.interfaces]
@@ -416,10 +416,10 @@ def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.
     frequencies (each above the full model's of the same order), to size the eigen solve."""
     from threadpoolctl import threadpool_limits
 
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
 
     with threadpool_limits(limits=1, user_api="blas"):
-        solver = _FreeBodySolver(fe)
+        solver = FreeBodySolver(fe)
         m = fe.mass_operator()
         cons = solver.constrained((m @ solver.R).T)
         k = int(np.count_nonzero((2 * np.pi * np.asarray(frequencies_hz)) ** 2 < cut * s_max)) + 4

@@ -223,6 +223,6 @@ def _owners(coupled, flex: list, names: list[str], x: np.ndarray) -> list[str]:
 
 
 def _component(body: str) -> str:
-    from flexgear.modal.linear import _component_name
+    from flexgear.modal.linear import component_name
 
-    return _component_name(body)
+    return component_name(body)

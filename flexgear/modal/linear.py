@@ -41,7 +41,8 @@ import numpy as np
 
 from flexgear.spec import Variant
 
-__all__ = ["Coordinate", "LinearModel", "linearize", "ZERO_SPEED_RPM"]
+__all__ = ["Coordinate", "LinearModel", "linearize", "ZERO_SPEED_RPM", "component_name", "with_speed",
+           "coordinate_labels", "operating_point", "static_solver_settings"]
 
 ZERO_SPEED_RPM = 1e-9
 """Speed [rpm] that stands for zero: the builder needs a drive sense and divides by the input speed. The spin
@@ -133,12 +134,13 @@ class LinearModel:
         return dataclasses.replace(self, damping=np.zeros_like(self.damping))
 
 
-def _component_name(body: str) -> str:
+def component_name(body: str) -> str:
+    """The component name of a body of the built gearbox: ``planet1`` -> ``planet_1``, any other name unchanged."""
     return f"planet_{body[len('planet'):]}" if body.startswith("planet") else body
 
 
-def _with_speed(variant: Variant, speed_rpm: float | None,
-                cutoff_rpm: float | None = None) -> tuple[Variant, float]:
+def with_speed(variant: Variant, speed_rpm: float | None,
+               cutoff_rpm: float | None = None) -> tuple[Variant, float]:
     """The variant with mean mesh stiffness and, if given, the input speed ``speed_rpm``; the gears' dynamic cut-off
     (``[reduction_assumed] dynamic_cutoff_mesh_orders`` x f_mesh, flexgear.mbs.gearbox) held at the mesh frequency
     of ``cutoff_rpm`` [rpm] (default: the load case's speed), so that the modes a gear keeps do not change with the
@@ -158,7 +160,7 @@ def _with_speed(variant: Variant, speed_rpm: float | None,
     return dataclasses.replace(variant, gearbox=spec), speed
 
 
-def _labels(mbs, model, n: int) -> list[Coordinate]:
+def coordinate_labels(mbs, model, n: int) -> list[Coordinate]:
     """The label of every ODE2 coordinate of the built ``model`` (flexgear.mbs.gearbox.GearboxModel)."""
     out: list[Coordinate | None] = [None] * n
 
@@ -169,7 +171,7 @@ def _labels(mbs, model, n: int) -> list[Coordinate]:
             out[start + k] = make(k)
 
     for name, body in model.bodies.items():
-        comp = _component_name(name)
+        comp = component_name(name)
         put(body.node, lambda k, comp=comp: Coordinate(comp, "frame", FRAME_NAMES[k]))
         if body.flexible:
             offset = 0
@@ -178,7 +180,7 @@ def _labels(mbs, model, n: int) -> list[Coordinate]:
                 offset += len(mbs.GetNode(node)["referenceCoordinates"])
     for node in model.aux_nodes:
         pair = mbs.GetNode(node)["name"].removeprefix("mesh_deflections_")
-        comp = "_".join(_component_name(p) for p in pair.split("_"))
+        comp = "_".join(component_name(p) for p in pair.split("_"))
         put(node, lambda k, comp=comp: Coordinate(comp, "deflection", f"delta_{k + 1}"))
     for i in range(n):  # residual compliances and anything else: by node name
         if out[i] is None:
@@ -265,12 +267,12 @@ def _elastic_parts(variant: Variant, model, mbs) -> dict[str, tuple[np.ndarray, 
                                 for nd in nodes])
         t = np.eye(body.reduced.n_modes) if body.basis is None else body.basis  # q = T q~
         parts = tied_part_matrices(variant.gearbox, variant.mesh_level)
-        out[_component_name(name)] = (index, [(part, t.T @ m_p @ t, t.T @ k_p @ t)
-                                              for part, (m_p, k_p) in parts.items()])
+        out[component_name(name)] = (index, [(part, t.T @ m_p @ t, t.T @ k_p @ t)
+                                             for part, (m_p, k_p) in parts.items()])
     return out
 
 
-def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3) -> None:
+def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3) -> None:
     """Static equilibrium at time ``t_star`` (module docstring), left in the system's initial configuration."""
     import exudyn as exu
 
@@ -293,7 +295,7 @@ def _operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 
     pre = pre.get("function") if isinstance(pre, dict) else pre
     pre = pre if callable(pre) else None
     mbs.SetPreStepUserFunction(0)
-    ss = _settings(t_star)
+    ss = static_solver_settings(t_star)
     was = exu.config.printToConsole
     exu.config.printToConsole = False
     try:
@@ -319,8 +321,8 @@ error of a few 1e-12 at some gear angles): a residual still 1e-10 of the load, f
 
 
 def _solve_static(mbs, ss) -> bool:
-    """Exudyn's static solve with :func:`_settings`; once more at :data:`RETRY_RELATIVE_TOLERANCE` if Newton stalls
-    at round-off. The Newton state is reset to the same start for the second attempt."""
+    """Exudyn's static solve with :func:`static_solver_settings`; once more at :data:`RETRY_RELATIVE_TOLERANCE` if
+    Newton stalls at round-off. The Newton state is reset to the same start for the second attempt."""
     import exudyn as exu
 
     start = np.array(mbs.systemData.GetODE2Coordinates())
@@ -334,7 +336,7 @@ def _solve_static(mbs, ss) -> bool:
     return bool(mbs.SolveStatic(ss, showHints=False))
 
 
-def _settings(t_star: float):
+def static_solver_settings(t_star: float):
     """Static-solver settings: full Newton at the quasi-time ``t_star``, load steps with a vanishing mass
     stabiliser (a contact law whose tangent vanishes at zero deflection, the impact law's, starts regular)."""
     import exudyn as exu
@@ -371,7 +373,7 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
 
     from flexgear.mbs.gearbox import build_star_gearbox
 
-    built, speed = _with_speed(variant, speed_rpm, cutoff_rpm)
+    built, speed = with_speed(variant, speed_rpm, cutoff_rpm)
     spec = built.gearbox
     t_star = spec.load_case.ramp_time_s if t_star is None else float(t_star)
     sc = exu.SystemContainer()
@@ -380,12 +382,12 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
         with threadpool_limits(limits=1, user_api="blas"):
             model = build_star_gearbox(mbs, built, mass_source, reduced_source)
         mbs.Assemble()
-        _operating_point(mbs, model, built, t_star)
-        ss = _settings(t_star)
+        operating_point(mbs, model, built, t_star)
+        ss = static_solver_settings(t_star)
         m, k, dx, c = (np.asarray(a, float) for a in exu.solver.ComputeLinearizedSystem(
             mbs, ss, returnConstraintJacobian=True, autoAssemble=False))
         n = m.shape[0]
-        labels = _labels(mbs, model, n)
+        labels = coordinate_labels(mbs, model, n)
         q = np.array(mbs.systemData.GetODE2Coordinates())
         rows = [mbs.GetNodeODE2Index(node) + k for node in model.aux_nodes
                 for k in range(len(mbs.GetNode(node)["referenceCoordinates"]))]  # contacts in order
@@ -406,7 +408,7 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     basis = t1 @ t2
     coords = [labels[i] for i in ind[keep]]  # z_j is the system coordinate ind[keep[j]]
     mr, kr, dr = (basis.T @ a @ basis for a in (m, k, dx))
-    flexible = tuple(_component_name(nm) for nm, b in model.bodies.items() if b.flexible)
+    flexible = tuple(component_name(nm) for nm, b in model.bodies.items() if b.flexible)
     flexible += tuple(part for _, split in elastic_parts.values() for part, _, _ in split if part not in flexible)
     components = _components(spec.gears.planet_count)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),

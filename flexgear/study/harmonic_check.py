@@ -40,7 +40,7 @@ import pandas as pd
 
 from flexgear.settling import SettleRule, Settling, settled_start
 from flexgear.study.compare import harmonic_amplitudes
-from flexgear.study.indicators import _kv
+from flexgear.study.indicators import dynamic_factor
 
 __all__ = ["CheckSpeeds", "LumpedCheck", "check_speeds", "settled_lumped_run", "window_amplitudes",
            "compare_lumped", "line_amplitude", "sideband_rss", "periodic_peak_factor",
@@ -142,7 +142,7 @@ def window_amplitudes(signals: pd.DataFrame, mesh_frequency_hz: float, window_s:
     forces = [np.stack([signals[c].to_numpy()[sel] for c in signals.columns
                         if c.startswith(f"{kind}_mesh_force_") and c.endswith("_n")], axis=1)
               for kind in ("outer", "inner")]
-    return amps, _kv(*forces), (float(t[sel.start]), float(t[sel.stop - 1]))
+    return amps, dynamic_factor(*forces), (float(t[sel.start]), float(t[sel.stop - 1]))
 
 
 @dataclass(frozen=True)

@@ -38,7 +38,7 @@ from flexgear.settling import mesh_forces, radial_rms, ripple_pct, segment_slice
 from flexgear.study.compare import harmonic_amplitudes
 
 __all__ = ["STUDY_INDICATORS", "DYNAMIC_INDICATORS", "ALL_INDICATORS", "LEVEL_FLOOR_M_PER_S2", "segment_slices",
-           "indicator_segments", "on_scale"]
+           "indicator_segments", "on_scale", "dynamic_factor"]
 
 STUDY_INDICATORS: dict[str, str] = {
     "input_speed": "input speed",
@@ -71,7 +71,7 @@ def _sharing(fo: np.ndarray, fi: np.ndarray) -> float:
     return float(max((f.mean(axis=0).max() / f.mean()) for f in (fo, fi)))
 
 
-def _kv(fo: np.ndarray, fi: np.ndarray) -> float:
+def dynamic_factor(fo: np.ndarray, fi: np.ndarray) -> float:
     """K_v: a planet's peak mesh force over its own mean, the largest over planets and both meshes."""
     return float(max((f.max(axis=0) / f.mean(axis=0)).max() for f in (fo, fi)))
 
@@ -107,7 +107,7 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
         "outer_mesh_ripple": lambda s: ripple_pct(fo[s]),
         "inner_mesh_ripple": lambda s: ripple_pct(fi[s]),
         "load_sharing": lambda s: _sharing(fo[s], fi[s]),
-        "dynamic_factor": lambda s: _kv(fo[s], fi[s]),
+        "dynamic_factor": lambda s: dynamic_factor(fo[s], fi[s]),
         "input_bearing_rms": lambda s: radial_rms(acc["input"][0][s], acc["input"][1][s]),
         "output_bearing_rms": lambda s: radial_rms(acc["output"][0][s], acc["output"][1][s]),
         "input_bearing_mesh1x": one_x("input"),

@@ -182,7 +182,7 @@ class LinearRunUp:
 def _systems(variant: Any, harmonics: int, speeds: np.ndarray, torques: np.ndarray) -> tuple[list[LinearSystem],
                                                                                                list[Any]]:
     """The linear systems at ``speeds`` [rpm] under load torques ``torques`` [N m] on the first one's coordinates,
-    and their flexgear.harmonic.base._Operating (static forces F_0, excitation, output rows)."""
+    and their flexgear.harmonic.base.Operating (static forces F_0, excitation, output rows)."""
     from flexgear.harmonic.base import ACCEL_INDICATORS, excitation
     from flexgear.harmonic.response import frozen_operating
     from flexgear.modal.linear import linearize
