@@ -11,12 +11,14 @@ contacts for external and internal meshes (``pair_contacts``, assembled by ``add
 on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
 (``Recorder``, ``solve``). The GTF star gearbox of the reference study is built from the same parts
 (``build_star_gearbox``, ``run_variant``). Modules that pull in Exudyn, NGSolve or pandas are imported on
-first use, so ``import flexgear`` stays light.
+first use, so ``import flexgear`` stays light. Names that moved stay deprecated aliases until their removal
+version (``_DEPRECATED``).
 """
 
 from importlib import import_module
 
 from flexgear import sizing as _sizing  # noqa: F401  (registers the sizes that follow the gear set)
+from flexgear.deprecation import moved
 from flexgear.geometry import feasibility as _feasibility  # noqa: F401  (registers the load-time feasibility checks)
 from flexgear.geometry.involute import Gear, GearMesh, GearSetGeometry, Mesh, gear_set_geometry, solve_profile_shifts
 from flexgear.laws.ramps import step, step_integral
@@ -80,12 +82,21 @@ __all__ = [
 ]
 
 
+_DEPRECATED = {
+    # old name: (new name in flexgear, the version that removes the old one); one line per moved name
+    "Bushing": ("BearingElement.axisymmetric", "0.3"),  # 0.1's Bushing(body, k_r, k_a, k_t, damping_per_stiffness)
+}
+
+
 def __getattr__(name: str):
-    """Import the public names of the heavier modules on first use (PEP 562)."""
+    """Import the public names of the heavier modules on first use (PEP 562); a moved name (``_DEPRECATED``) gives
+    its new object with a DeprecationWarning."""
     if name in _LAZY:
         value = getattr(import_module(f"flexgear.{_LAZY[name]}"), name)
         globals()[name] = value
         return value
+    if name in _DEPRECATED:
+        return moved(__name__, name, *_DEPRECATED[name])
     raise AttributeError(f"module 'flexgear' has no attribute {name!r}")
 
 

@@ -13,9 +13,20 @@ from __future__ import annotations
 
 import numpy as np
 
+from flexgear.deprecation import moved
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.ramps import drive_angle, ramp_fraction
 from flexgear.mbs.bodies import Body, matrix_container, resting_node, zero_user_jacobian
+
+_DEPRECATED = {"Bushing": ("BearingElement.axisymmetric", "0.3")}
+"""This module's moved names: old name -> (new name in flexgear, removal version), as ``flexgear._DEPRECATED``."""
+
+
+def __getattr__(name: str):
+    """A moved name (``_DEPRECATED``, PEP 562) gives its new object with a DeprecationWarning."""
+    if name in _DEPRECATED:
+        return moved(__name__, name, *_DEPRECATED[name])
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def add_linear_elements(mbs, bodies: list[Body], elements: list[BearingElement], extra_nodes: list[int] | None = None,
