@@ -24,7 +24,7 @@ SPEEDS_RPM ?= 3000:9000:100
 # pytest-xdist worker processes of `make test` (the machine's 2 cores; `make test TEST_WORKERS=auto` for all)
 TEST_WORKERS ?= 2
 
-.PHONY: quick install venv test test-heavy lint meshes matrix readings report lpm bench clean distclean
+.PHONY: quick install venv test test-heavy lint meshes matrix readings report lpm bench api-docs clean distclean
 
 quick: install
 	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
@@ -84,6 +84,10 @@ lpm: install
 
 bench: install
 	$(PY) benchmarks/bench_rigid.py --repeat 3
+
+# docs/api.md from the docstrings of flexgear's public names (tests/test_api.py checks it is current)
+api-docs: install
+	$(PY) docs/gen_api.py
 
 clean:
 	rm -rf $(RESULTS) reports/*.pdf

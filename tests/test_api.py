@@ -56,3 +56,17 @@ def test_deprecated_names_resolve_and_go_in_a_later_version():
 def test_unknown_names_still_raise():
     with pytest.raises(AttributeError, match="no attribute 'Bushings'"):
         flexgear.Bushings  # noqa: B018
+
+
+def test_api_reference_is_current():
+    """docs/api.md is what docs/gen_api.py writes from today's docstrings (regenerate: make api-docs)."""
+    import importlib.util
+    from pathlib import Path
+
+    root = Path(__file__).resolve().parents[1]
+    spec = importlib.util.spec_from_file_location("gen_api", root / "docs" / "gen_api.py")
+    gen_api = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen_api)
+    text = gen_api.render()
+    assert "0x" not in text and str(root) not in text
+    assert (root / "docs" / "api.md").read_text() == text, "docs/api.md is not current: run python docs/gen_api.py"
