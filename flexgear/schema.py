@@ -15,6 +15,7 @@ from pathlib import Path
 from typing import Any
 
 from flexgear.schema_fields import SpecError, choice_field, derived_field, num_field
+from flexgear.schema_geometry import ComponentGeometry
 from flexgear.schema_screening import (
     IndicatorTolerance,
     IndicatorWeights,
@@ -337,6 +338,8 @@ class GearboxSpec:
     joints_assumed: JointsAssumed
     # "table.field" of every value the file left out that followed the gear data (flexgear.sizing); not hashed
     derived: tuple[str, ...] = ()
+    # components whose solid or volume mesh comes from a file (flexgear.schema_geometry); the files' content hashed
+    components_geometry: dict[str, ComponentGeometry] = field(default_factory=dict)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""

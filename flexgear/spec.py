@@ -50,6 +50,7 @@ from flexgear.schema import (
     SpecError,
     Variant,
 )
+from flexgear.schema_geometry import components_geometry_table
 from flexgear.schema_screening import PURPOSE_NAMES
 
 __all__ = [
@@ -269,7 +270,7 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     built: dict[str, Any] = {}
     derived: list[str] = []
-    rest = sorted(tables - set(_FIRST) - {"title", "meshing_assumed"})
+    rest = sorted(tables - set(_FIRST) - {"title", "meshing_assumed", "components_geometry"})
     for name in (*_FIRST, *rest):
         data = _with_derived(path, name, hints[name], raw.get(name, {}), built, derived)
         built[name] = _build(hints[name], data, path, name)
@@ -279,6 +280,7 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
                                                      derived), path, f"meshing_assumed.{level}")
         for level, table in levels.items()
     }
+    built["components_geometry"] = components_geometry_table(path, raw.get("components_geometry", {}))
     spec = GearboxSpec(source=path, title=title, derived=tuple(derived), **built)
     _check_loaded(spec)
     return spec
@@ -441,10 +443,11 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
 
 
 def as_dict(obj: Any) -> Any:
-    """A spec (or any of its tables) as plain JSON-able data; file paths are left out."""
+    """A spec (or any of its tables) as plain JSON-able data; file paths are left out, and so is an empty
+    ``components_geometry`` (a gearbox without it hashes as before the table existed)."""
     if dataclasses.is_dataclass(obj):
         return {f.name: as_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)
-                if f.name not in ("source", "derived")}
+                if f.name not in ("source", "derived") and (f.name != "components_geometry" or obj.components_geometry)}
     if isinstance(obj, dict):
         return {k: as_dict(v) for k, v in sorted(obj.items())}
     if isinstance(obj, Path):

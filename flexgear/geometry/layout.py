@@ -151,7 +151,16 @@ def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
     construction = () if all(w.plain for w in sweeps) else (
         ("precise_sweeps", *((w.pieces, w.scale) for w in sweeps)),)
     return spec_hash(spec.gears, spec.gears_assumed, spec.components_assumed, spec.material_assumed,
-                     GEOMETRY_VERSION, *construction, *extra)
+                     GEOMETRY_VERSION, *construction, *extra, *_imported_files(spec, extra))
+
+
+def _imported_files(spec: GearboxSpec, extra: tuple) -> tuple:
+    """The ``[components_geometry]`` entries (hashed as their files' SHA-256 and unit) of the components that the
+    first two of ``extra`` name (a component, or a tuple of them as in the tied ring and output shaft's key): () for
+    the built-in components, whose keys are then unchanged."""
+    imported = getattr(spec, "components_geometry", None) or {}
+    named = {n for e in extra[:2] for n in (e if isinstance(e, tuple) else (e,)) if isinstance(n, str)}
+    return tuple(imported[c] for c in sorted(named & set(imported)))
 
 
 @dataclass(frozen=True)
