@@ -9,10 +9,10 @@ compliance through ``dropped_modes``) or ``toothed_mass_properties`` (rigid)), b
 ``add_planet_bearing``), fixed joints (``FixedJointElement``, ``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
 on a rotating ``Carrier``), drive and load (``add_speed_drive``, ``add_load_torque``) and signals
-(``Recorder``, ``solve``). The GTF star gearbox of the reference study is built from the same parts
-(``build_star_gearbox``, ``run_variant``). Modules that pull in Exudyn, NGSolve or pandas are imported on
-first use, so ``import flexgear`` stays light. Names that moved stay deprecated aliases until their removal
-version (``_DEPRECATED``).
+(``Recorder``, ``solve``). A gearbox file's gearbox is built from the same parts (``build_gearbox``: the star,
+or the planetary stage with rigid components; ``run_variant``). Modules that pull in Exudyn, NGSolve or pandas
+are imported on first use, so ``import flexgear`` stays light. Names that moved stay deprecated aliases until
+their removal version (``_DEPRECATED``).
 """
 
 from importlib import import_module
@@ -54,7 +54,8 @@ _LAZY = {
     # signals and solving
     "Recorder": "mbs.recording", "solve": "mbs.recording", "solver_settings": "mbs.recording",
     # the study's gearbox
-    "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox", "run_variant": "mbs.run",
+    "build_gearbox": "mbs.gearbox", "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox",
+    "run_variant": "mbs.run",
     # modal analysis at the operating point
     "linearize": "modal.linear", "LinearModel": "modal.linear",
     "modes": "modal.eigenmodes", "Modes": "modal.eigenmodes",

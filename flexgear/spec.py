@@ -21,6 +21,7 @@ from collections.abc import Callable
 from pathlib import Path
 from typing import Any, get_type_hints
 
+from flexgear.derived import FIRST_TABLES, REQUIRED_TABLES, rederive, register_derived_defaults, with_derived
 from flexgear.schema import (
     COMPONENT_GEOMETRY,
     COMPONENTS,
@@ -93,24 +94,6 @@ __all__ = [
 
 # --------------------------------------------------------------------------- loading
 _FEASIBILITY: list[Callable[[GearboxSpec], None]] = []
-
-
-_DERIVED: list[Callable[[str, dict[str, Any], dict[str, Any]], dict[str, Any]]] = []
-
-REQUIRED_TABLES = ("gears", "bearings", "load_case")
-"""The tables every gearbox file gives; every other table and field has a documented default, fixed or derived
-from the gear data (:mod:`flexgear.sizing`)."""
-
-_FIRST = ("gears", "gears_assumed", "load_case", "material_assumed", "components_assumed")
-"""Tables built first, in this order: the derived defaults of the others follow from them."""
-
-
-def register_derived_defaults(provider: Callable[[str, dict[str, Any], dict[str, Any]], dict[str, Any]]) -> None:
-    """``provider(table, built, given)`` gives the derived defaults of ``table`` ("components_assumed",
-    "meshing_assumed.coarse", ...) from the tables already ``built`` (name -> dataclass) and the values the file
-    ``given`` in that table (raw, unchecked); see :mod:`flexgear.sizing`."""
-    if provider not in _DERIVED:
-        _DERIVED.append(provider)
 
 
 def register_feasibility_check(check: Callable[[GearboxSpec], None]) -> None:
@@ -202,22 +185,6 @@ def _over_default(f: dataclasses.Field, data: Any) -> Any:
     return {**dataclasses.asdict(f.default_factory()), **data}
 
 
-def _with_derived(path: Path, table: str, cls: type, data: Any, built: dict[str, Any], derived: list[str]) -> Any:
-    """``data`` with every derived field it leaves out filled by the registered providers (recorded in
-    ``derived``); fields no provider gives stay missing (then required)."""
-    if not isinstance(data, dict):
-        return data
-    missing = [f.name for f in dataclasses.fields(cls) if f.metadata.get("derived") and f.name not in data]
-    if not missing:
-        return data
-    given: dict[str, Any] = {}
-    for provider in _DERIVED:
-        given.update(provider(table, built, data))
-    filled = {name: given[name] for name in missing if name in given}
-    derived.extend(f"{table}.{name}" for name in filled)
-    return {**data, **filled}
-
-
 def _check_purposes(path: Path, name: str, value: Any) -> dict[str, tuple[str, ...]]:
     """``[screening.purposes]``: a table of purpose -> list of reference indicator names, each indicator in at most
     one purpose, every purpose of PURPOSE_NAMES present."""
@@ -270,13 +237,13 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     built: dict[str, Any] = {}
     derived: list[str] = []
-    rest = sorted(tables - set(_FIRST) - {"title", "meshing_assumed", "components_geometry"})
-    for name in (*_FIRST, *rest):
-        data = _with_derived(path, name, hints[name], raw.get(name, {}), built, derived)
+    rest = sorted(tables - set(FIRST_TABLES) - {"title", "meshing_assumed", "components_geometry"})
+    for name in (*FIRST_TABLES, *rest):
+        data = with_derived(path, name, hints[name], raw.get(name, {}), built, derived)
         built[name] = _build(hints[name], data, path, name)
     levels = {"coarse": {}, "default": {}, **meshing}
     built["meshing_assumed"] = {
-        level: _build(MeshingSettings, _with_derived(path, f"meshing_assumed.{level}", MeshingSettings, table, built,
+        level: _build(MeshingSettings, with_derived(path, f"meshing_assumed.{level}", MeshingSettings, table, built,
                                                      derived), path, f"meshing_assumed.{level}")
         for level, table in levels.items()
     }
@@ -297,34 +264,6 @@ def _check_loaded(spec: GearboxSpec) -> None:
             raise
         raise SpecError(spec.source, exc.field, f"{exc.allowed} (the default derived from the gear set, "
                         "flexgear.sizing; give the field in the file)") from None
-
-
-def _rederive(spec: GearboxSpec, kept: set[str]) -> GearboxSpec:
-    """``spec`` with its derived values derived again from its (overridden) tables, except those in ``kept``."""
-    redo = [d for d in spec.derived if d not in kept]
-    if not redo:
-        return spec
-    built = {name: getattr(spec, name) for name in _FIRST}
-    changes: dict[str, Any] = {}
-
-    def order(table: str) -> tuple[int, str]:
-        top = table.partition(".")[0]
-        return (_FIRST.index(top) if top in _FIRST else len(_FIRST), table)
-
-    for table in sorted({d.rsplit(".", 1)[0] for d in redo}, key=order):
-        top, _, level = table.partition(".")
-        current = spec.meshing_assumed[level] if level else changes.get(top, getattr(spec, top))
-        names = {d.rsplit(".", 1)[1] for d in redo if d.rsplit(".", 1)[0] == table}
-        given = {k: v for k, v in dataclasses.asdict(current).items() if k not in names}
-        values: dict[str, Any] = {}
-        for provider in _DERIVED:
-            values.update(provider(table, built, given))
-        new = dataclasses.replace(current, **{n: values[n] for n in names if n in values})
-        if level:
-            changes["meshing_assumed"] = {**changes.get("meshing_assumed", spec.meshing_assumed), level: new}
-        else:
-            changes[top] = built[top] = new
-    return dataclasses.replace(spec.with_changes(**changes), derived=tuple(d for d in spec.derived if d not in kept))
 
 
 def _check_consistency(spec: GearboxSpec) -> None:
@@ -376,7 +315,7 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
         merged.update(values)
         changes[table] = _build(type(current), merged, path, f"overrides.{table}")
     kept = {f"{table}.{name}" for table, values in overrides.items() for name in values}
-    return _rederive(gearbox.with_changes(**changes), kept)
+    return rederive(gearbox.with_changes(**changes), kept)
 
 
 def _variant_gearbox(path: Path, raw: dict[str, Any], gearbox_text: str | None) -> GearboxSpec:
@@ -432,6 +371,12 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
             raise SpecError(path, f"components.{name}", "missing; expected 'rigid' or 'flexible'")
         components[name] = _check_value(path, f"components.{name}", comps[name], str,
                                         {"choices": ("rigid", "flexible")})
+    if gearbox.gears.arrangement == "planetary":
+        flexible = [name for name in COMPONENTS if components[name] == "flexible"]
+        if flexible:
+            raise SpecError(path, f"components.{flexible[0]}", "expected 'rigid': the planetary arrangement "
+                            "(gears.arrangement) runs rigid components only (a rotating carrier with flexible "
+                            "bodies is not supported yet)", "flexible")
     level = raw.get("mesh_level", "default")
     if level not in gearbox.meshing_assumed:
         raise SpecError(path, "mesh_level", f"expected one of {sorted(gearbox.meshing_assumed)}", level)

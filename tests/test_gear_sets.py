@@ -2,7 +2,7 @@
 
 A small grid of valid sets (tooth counts 12-150, modules 1-20 mm, pressure angles 14.5-25 deg, planet shifts
 -0.5 to 0.8, spur and helical, single and double) written as gearbox files from the study's ``gearbox.toml``,
-the component sizes scaled with the module by hand (:func:`gear_set_gearbox`). Each gear of each set:
+every size left to follow the gear set (:func:`gear_set_gearbox`, flexgear.sizing). Each gear of each set:
 
 - its OCC solid (flexgear.geometry.solids) against the exact section integrals (flexgear.geometry.layout), 0.1 %;
 - its coarse second-order mesh: flank nodes on the involute helicoid within 1 um
@@ -24,7 +24,6 @@ import numpy as np
 import pytest
 from test_validation import to_toml
 
-from flexgear.geometry.involute import solve_profile_shifts
 from flexgear.spec import SpecError, load_gearbox, load_variant
 
 VARIANTS = Path(__file__).resolve().parents[1] / "model_variants"
@@ -54,44 +53,20 @@ CASES = {
 }
 
 
-def _root_diameters_mm(case: GearSetCase, shifts: tuple[float, float, float], dedendum: float) -> list[float]:
-    """Root diameters [mm] of sun, planet, ring: d_f = m_t z -/+ 2 m_n (h_f - x) (external/internal)."""
-    mt = case.module_mm / math.cos(math.radians(case.helix_deg))
-    return [mt * z + (1 if internal else -1) * 2 * case.module_mm * (dedendum - x)
-            for z, x, internal in zip(case.teeth, shifts, (False, False, True), strict=True)]
-
-
 def gear_set_gearbox(case: GearSetCase) -> dict:
-    """The study's gearbox file with the gear set of ``case``; component and mesh sizes scaled with the module m
-    (by hand: face width 4 m per helix, bores half the root diameter, rim 4 m, tooth and body mesh sizes 1.9 m
-    and 3.8 m, as the study's 4 and 8 mm at m = 2.12 mm)."""
-    m = case.module_mm
+    """The study's gearbox file with the gear set of ``case`` and every size left to follow the gear set
+    (flexgear.sizing): face width, gap and backlash, component and joint sizes, mesh levels."""
     data = copy.deepcopy(STUDY)
     zs, zp, zr = case.teeth
-    data["gears"].update(sun_teeth=zs, planet_teeth=zp, ring_teeth=zr, planet_count=case.planets, normal_module_mm=m,
-                         helix_angle_deg=case.helix_deg, normal_pressure_angle_deg=case.pressure_deg)
-    data["gears_assumed"].update(face_width_mm=4 * m, helix_layout=case.layout, half_gap_mm=3 * m,
-                                 operating_centre_distance_mm=0.0, planet_shift_coefficient=case.planet_shift,
-                                 normal_backlash_mm=0.05 * m)
-    mt = m / math.cos(math.radians(case.helix_deg))
-    centre = mt * (zs + zr) / 4  # 0 above: the mean standard centre distance
-    try:
-        xs, xp, xr, _, _ = solve_profile_shifts(zs, zp, zr, m * 1e-3, math.radians(case.helix_deg),
-                                                math.radians(case.pressure_deg), centre * 1e-3, case.planet_shift)
-    except ValueError:  # an unreachable centre distance: sized unshifted, refused on loading
-        xs, xp, xr = 0.0, case.planet_shift, 0.0
-    df_sun, df_planet, df_ring = _root_diameters_mm(case, (xs, xp, xr), data["gears_assumed"]["dedendum_coefficient"])
-    rim = 4 * m
-    flange = df_ring + 2 * rim + 8 * m
-    data["components_assumed"].update(
-        sun_bore_diameter_mm=0.5 * df_sun, planet_bore_diameter_mm=0.5 * df_planet, ring_rim_thickness_mm=rim,
-        ring_flange_outer_diameter_mm=flange, ring_flange_thickness_mm=4 * m, ring_bolt_hole_diameter_mm=2 * m,
-        input_shaft_outer_diameter_mm=0.5 * df_sun, input_shaft_inner_diameter_mm=0.25 * df_sun,
-        input_shaft_length_mm=40 * m, output_shaft_outer_diameter_mm=0.5 * flange,
-        output_shaft_inner_diameter_mm=0.4 * flange, output_shaft_length_mm=40 * m, relief_groove_depth_mm=0.5 * m,
-        bearing_seat_width_mm=8 * m)
-    data["joints_assumed"].update(bolt_clamp_diameter_mm=3 * m)
-    data["meshing_assumed"]["coarse"].update(tooth_size_mm=1.9 * m, body_size_mm=3.8 * m)
+    data["gears"].update(sun_teeth=zs, planet_teeth=zp, ring_teeth=zr, planet_count=case.planets,
+                         normal_module_mm=case.module_mm, helix_angle_deg=case.helix_deg,
+                         normal_pressure_angle_deg=case.pressure_deg)
+    for name in ("face_width_mm", "half_gap_mm", "normal_backlash_mm"):
+        del data["gears_assumed"][name]
+    data["gears_assumed"].update(helix_layout=case.layout, operating_centre_distance_mm=0.0,
+                                 planet_shift_coefficient=case.planet_shift)
+    for table in ("components_assumed", "joints_assumed", "meshing_assumed"):
+        del data[table]
     return data
 
 
@@ -160,13 +135,14 @@ def _sweeps(spec) -> list:
 
 
 def test_steep_helices_are_swept_precisely_and_the_study_as_before(tmp_path):
-    """The 13-tooth sun of m_n = 10 mm, beta = 30 deg turns 0.31 rad over its face: one sweep in metres would leave
-    its faces about 2 um off the involute helicoid (2.6e-3 r theta^4), so it is swept in millimetres; the study's
-    gears (at most 0.136 rad per helix half, every outline curve >= 1.2 mm) keep their sweep in metres."""
+    """The 13-tooth sun of m_n = 10 mm, beta = 30 deg turns 0.69 rad over its face (0.6 d_sun): one sweep in metres
+    would leave its faces about 45 um off the involute helicoid (2.6e-3 r theta^4), so it is swept in millimetres,
+    in pieces; the study's gears (at most 0.136 rad per helix half, every outline curve >= 1.2 mm) keep their sweep
+    in metres."""
     from flexgear.geometry.layout import HelixSweep
 
     steep = _load(tmp_path, "single_13_17_47_m10_b30_a20")
-    assert _sweeps(steep)[0] == HelixSweep(1, 1000.0)
+    assert _sweeps(steep)[0].scale == 1000.0
     assert _sweeps(load_gearbox(VARIANTS / "gearbox.toml")) == [HelixSweep(1, 1.0)] * 3
 
 
@@ -194,15 +170,17 @@ def test_a_short_radial_flank_is_swept_precisely(tmp_path, cache):
 
 
 def _with(case: GearSetCase, **fields) -> dict:
-    """The gearbox file of ``case`` with single fields changed (looked up in gears_assumed, components_assumed;
-    ``coarse_<field>`` in meshing_assumed.coarse)."""
+    """The gearbox file of ``case`` with single fields given (a field of [gears_assumed] or [components_assumed];
+    ``coarse_<field>`` of [meshing_assumed.coarse])."""
+    from flexgear.schema import ComponentsAssumed
+
     data = gear_set_gearbox(case)
+    components = {f.name for f in dataclasses.fields(ComponentsAssumed)}
     for key, value in fields.items():
         if key.startswith("coarse_"):
-            data["meshing_assumed"]["coarse"][key.removeprefix("coarse_")] = value
+            data.setdefault("meshing_assumed", {}).setdefault("coarse", {})[key.removeprefix("coarse_")] = value
             continue
-        table = next(t for t in ("gears_assumed", "components_assumed") if key in data[t])
-        data[table][key] = value
+        data.setdefault("components_assumed" if key in components else "gears_assumed", {})[key] = value
     return data
 
 
@@ -218,7 +196,7 @@ REFUSED = {
                                          "gears_assumed.operating_centre_distance_mm", ("51.000 mm", "56.382 mm")),
     "groove_depth_zero": (_with(SPUR, relief_groove_depth_mm=0.0), "components_assumed.relief_groove_depth_mm",
                           ("touches the tooth roots",)),
-    "tooth_elements_coarser_than_two_modules": (_with(SPUR, coarse_tooth_size_mm=7.0),
+    "tooth_elements_coarser_than_two_modules": (_with(SPUR, coarse_tooth_size_mm=7.0, coarse_body_size_mm=14.0),
                                                 "meshing_assumed.coarse.tooth_size_mm", ("<= 6.000 mm",)),
     "planet_tip_inside_its_base_circle": (_with(GearSetCase((30, 12, 56), 2, 2.0, 0.0, 20.0, -1.0, "single"),
                                                 addendum_coefficient=0.5),

@@ -17,7 +17,7 @@ from typing import Any, get_type_hints
 
 import pytest
 
-from flexgear.spec import GearboxSpec, MeshingSettings, SpecError, load_gearbox, load_variant
+from flexgear.spec import REQUIRED_TABLES, GearboxSpec, MeshingSettings, SpecError, load_gearbox, load_variant
 
 VARIANTS = Path(__file__).resolve().parents[1] / "model_variants"
 GEARBOX = tomllib.loads((VARIANTS / "gearbox.toml").read_text())
@@ -100,8 +100,34 @@ def _set(data: dict, dotted: str, value: Any) -> dict:
 
 _DELETE = object()
 FIELD_CASES = [pytest.param(path, *_broken_value(f, hint), id=path) for path, f, hint in schema_fields()]
-REQUIRED = [path for path, f, _ in schema_fields()
-            if f is None or (f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING)]
+
+
+def _has_default(f: dataclasses.Field) -> bool:
+    """Whether a file may leave ``f`` out: a fixed default, or one that follows the gear set (flexgear.sizing)."""
+    return (f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING
+            or bool(f.metadata.get("derived")))
+
+
+def _optional_ancestor(path: str) -> bool:
+    """Whether a table above the leaf ``path`` has a default (its own fields then come from that default)."""
+    *tables, _ = path.split(".")
+    if not tables:
+        return False
+    if tables[0] not in REQUIRED_TABLES:
+        return True
+    cls = get_type_hints(GearboxSpec)[tables[0]]
+    for name in tables[1:]:
+        f = next(x for x in dataclasses.fields(cls) if x.name == name)
+        if _has_default(f):
+            return True
+        cls = get_type_hints(cls)[name]
+    return False
+
+
+REQUIRED = [path for path, f, _ in schema_fields() if f is not None and not _has_default(f)
+            and not _optional_ancestor(path)]
+FIELDS = {path: f for path, f, _ in schema_fields()}
+OPTIONAL = [path for path, f, _ in schema_fields() if f is None or _has_default(f) or _optional_ancestor(path)]
 
 
 def _expect(tmp_path: Path, data: dict, field: str, words: tuple[str, ...], name: str = "gearbox.toml") -> str:
@@ -131,6 +157,26 @@ def test_every_field_refuses_a_wrong_value(tmp_path, field, value, word):
 @pytest.mark.parametrize("field", REQUIRED)
 def test_every_required_field_is_required(tmp_path, field):
     _expect(tmp_path, _set(GEARBOX, field, _DELETE), field, ("missing",))
+
+
+def test_the_required_fields_are_those_of_the_gears_bearings_and_load_case():
+    assert {p.split(".")[0] for p in REQUIRED} == set(REQUIRED_TABLES)
+    assert "load_case.input_speed_rpm" in REQUIRED and "load_case.step_size_s" not in REQUIRED
+
+
+@pytest.mark.parametrize("field", OPTIONAL)
+def test_every_other_field_may_be_left_out(tmp_path, field):
+    """A leaf left out takes its default (fixed, or derived from the gear set: then listed in ``derived``)."""
+    path = tmp_path / "gearbox.toml"
+    path.write_text(to_toml(_set(GEARBOX, field, _DELETE)))
+    spec = load_gearbox(path)
+    f = FIELDS[field]
+    if f is None:
+        assert spec.title == "gearbox"
+    elif f.metadata.get("derived"):
+        assert field in spec.derived
+    else:
+        assert spec.derived == ()
 
 
 @pytest.mark.parametrize("table", ["gears", "contact", "load_case", "bearings.planet", "screening.weights"])

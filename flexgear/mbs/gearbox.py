@@ -1,4 +1,5 @@
-"""Model: a single-stage star gearbox (carrier fixed) assembled from bodies and connectors.
+"""Model: a single-stage gearbox assembled from bodies and connectors; here the star (carrier fixed), the
+planetary stage in flexgear.mbs.planetary, both through :func:`build_gearbox`.
 
 The assembly follows section 2.1 of the study: input shaft fixed to the sun, ring fixed to the
 output shaft (for rigid parts the fixed joint merges the two into one body, which is exact),
@@ -41,7 +42,8 @@ from flexgear.mbs.train import add_gear_train
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory
 
-__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "dynamic_modes", "run_cost"]
+__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_gearbox", "build_star_gearbox", "mass_source_of",
+           "dynamic_modes", "run_cost"]
 
 
 @dataclass
@@ -97,12 +99,16 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
     outer-inner phase on the planet-ring mesh. ``spec``: a spec or its design (flexgear.design).
     """
     d = as_design(spec)
-    geo, spec = d.gears, d.spec
+    geo, spec, th = d.gears, d.spec, d.theory
     g = spec.gears
-    zs, zp, zr, aw = g.sun_teeth, g.planet_teeth, g.ring_teeth, geo.centre_distance
+    zs, aw = g.sun_teeth, geo.centre_distance
     sigma = 1.0 if drive_sign >= 0 else -1.0
-    spin = {"sun": 1.0, "planet": -zs / zp, "ring": -zs / zr}  # nominal spin per drive angle (carrier fixed)
-    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, phase_per_drive_angle=zs / (2 * math.pi))
+    # nominal spins per drive angle: the star's carrier fixed, the planetary's ring fixed (flexgear.theory)
+    carrier = 0.0 if g.arrangement == "star" else th.ratio
+    spin = {"sun": 1.0, "planet": carrier - g.sun_teeth / g.planet_teeth * (1.0 - carrier),
+            "ring": th.ratio if carrier == 0.0 else 0.0}
+    common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, carrier_spin=carrier,
+                  phase_per_drive_angle=zs * (1.0 - carrier) / (2 * math.pi))
     outer, inner = d.meshes["outer"], d.meshes["inner"]
     laws = mesh_laws(d)  # whole face width, then each helix half's share
     outer_laws = half_laws(outer, spec.contact, laws["outer"])
@@ -128,6 +134,12 @@ def _default_reduced_source(spec: GearboxSpec, component: str, level: str):
     from flexgear.fe.ring_shaft import reduced_body
 
     return reduced_body(spec, component, level, progress=True)
+
+
+def mass_source_of(variant: Variant, d: Design) -> MassSource:
+    """The rigid components' mass properties of ``variant`` (its ``rigid_mass_properties``: the coarse reduced
+    bodies' "mesh" or the "exact" geometry's) for its design ``d``."""
+    return _mass_source(variant, d, _default_reduced_source, True)
 
 
 def _mass_source(variant: Variant, d: Design, reduced: ReducedSource, default_bodies: bool) -> MassSource:
@@ -262,6 +274,20 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if geometry not in cache:
         cache[geometry] = dropped_modes(spec, full, keep, geometry)
     return replace(body, dropped=cache[geometry])
+
+
+def build_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
+                  reduced_source: ReducedSource | None = None, superelements: bool = False,
+                  design: Design | None = None) -> GearboxModel:
+    """Assemble the gearbox of ``variant`` into ``mbs`` in its ``[gears] arrangement``: the star
+    (:func:`build_star_gearbox`) or the planetary stage (flexgear.mbs.planetary, rigid components). Call
+    ``mbs.Assemble()`` afterwards."""
+    d = as_design(variant.gearbox if design is None else design)
+    if d.spec.gears.arrangement == "planetary":
+        from flexgear.mbs.planetary import build_planetary_gearbox
+
+        return build_planetary_gearbox(mbs, variant, mass_source, design=d)
+    return build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements, design=d)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,

@@ -25,7 +25,7 @@ import pandas as pd
 
 from flexgear.design import design
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
-from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_star_gearbox
+from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_gearbox
 from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
@@ -335,8 +335,8 @@ def run_variant(variant: Variant, t_end_s: float | str | None = None, progress: 
             raise ValueError(f"t_end_s must be a positive number, got {t_end_s!r}")
         sc = exu.SystemContainer()
         mbs = sc.AddSystem()
-        model = build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements=record_states_every > 0,
-                                   design=d)
+        model = build_gearbox(mbs, variant, mass_source, reduced_source, superelements=record_states_every > 0,
+                              design=d)
         sensors = add_gearbox_sensors(mbs, model)
         states = add_state_sensors(mbs, model) if record_states_every > 0 else {}
         mbs.Assemble()
