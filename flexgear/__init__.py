@@ -56,6 +56,8 @@ _LAZY = {
     # the study's gearbox
     "build_gearbox": "mbs.gearbox", "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox",
     "run_variant": "mbs.run",
+    # the facade: a gearbox and its flexible components in; runs, linear models, modes, reports out
+    "Simulation": "simulation",
     # modal analysis at the operating point
     "linearize": "modal.linear", "LinearModel": "modal.linear",
     "modes": "modal.eigenmodes", "Modes": "modal.eigenmodes",

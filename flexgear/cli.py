@@ -1,5 +1,5 @@
-"""Command line: flexgear run | matrix | sweep | lpm | compare | report | animate | meshes | modes | campbell |
-modal-screening | sweep-speed.
+"""Command line: flexgear run | matrix | sweep | lpm | compare | report | animate | meshes | export-geometry | modes |
+campbell | modal-screening | sweep-speed.
 
 Each subcommand is a pair of functions, ``_args_<name>(parser)`` (its arguments, each with help text) and
 ``cmd_<name>(args) -> exit code`` (a thin wrapper over one library function), listed in ``SUBCOMMANDS``;
@@ -335,6 +335,26 @@ def cmd_meshes(a: argparse.Namespace) -> int:
     return 0
 
 
+# --------------------------------------------------------------------------- export-geometry
+def _args_export_geometry(p: argparse.ArgumentParser) -> None:
+    p.add_argument("gearbox", help="gearbox file, or a variant file (its gearbox with its overrides)")
+    p.add_argument("--component", action="append", default=None, metavar="NAME",
+                   help="sun, planet, ring, input_shaft or output_shaft; repeat for several (default: all five)")
+    p.add_argument("--level", default="coarse", help="mesh level of [meshing_assumed] (default: %(default)s)")
+    p.add_argument("--out", default="geometry", metavar="DIR", help="output folder (default: %(default)s)")
+
+
+def cmd_export_geometry(a: argparse.Namespace) -> int:
+    from flexgear.fe.geometry_export import export_geometry
+    from flexgear.spec import GEOMETRY_COMPONENTS
+
+    spec = _gearbox_or_variant(a.gearbox)
+    for path in export_geometry(spec, tuple(a.component or GEOMETRY_COMPONENTS), a.level, a.out, progress=True):
+        unit = "mm, solid" if path.suffix == ".step" else "m, volume mesh with its regions as point data"
+        print(f"{path} ({unit})")
+    return 0
+
+
 # --------------------------------------------------------------------------- parser
 SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Callable[[argparse.Namespace], int]]] = [
     ("run", "run one variant file with the Exudyn backend", _args_run, cmd_run),
@@ -346,6 +366,8 @@ SUBCOMMANDS: list[tuple[str, str, Callable[[argparse.ArgumentParser], None], Cal
     ("report", "PDF screening report from saved results", _args_report, cmd_report),
     ("animate", "VTK time series (.pvd + .vtu) of the deformed bodies of a run", _args_animate, cmd_animate),
     ("meshes", "build (or load from the cache) the component meshes and reduced bodies", _args_meshes, cmd_meshes),
+    ("export-geometry", "write the components' solids as STEP (mm) and meshes as VTU (m)", _args_export_geometry,
+     cmd_export_geometry),
     MODES,
     CAMPBELL,
     SCREENING,

@@ -13,8 +13,12 @@ writes them (``flexgear export-geometry``, flexgear.fe.geometry_export), on the 
 import shutil
 from pathlib import Path
 
+import meshio
+import numpy as np
 import pytest
 
+from flexgear.cli import main
+from flexgear.fe.mesh import component_mesh
 from flexgear.spec import SpecError, load_gearbox, spec_hash
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -30,6 +34,45 @@ def _gearbox_with(folder: Path, table: str) -> Path:
 
 def _ring_entry(folder: Path, file: str, unit: str) -> Path:
     return _gearbox_with(folder, f'[components_geometry]\nring = {{ file = "{file}", length_unit = "{unit}" }}')
+
+
+@pytest.fixture(scope="module")
+def exported(tmp_path_factory) -> Path:
+    """The folder where ``flexgear export-geometry`` wrote the study ring's ``ring.step`` and ``ring.vtu`` (coarse)."""
+    folder = tmp_path_factory.mktemp("export")
+    assert main(["export-geometry", str(GEARBOX), "--component", "ring", "--level", "coarse", "--out",
+                 str(folder)]) == 0
+    return folder
+
+
+# --------------------------------------------------------------------------- export
+def test_export_writes_step_in_mm_and_vtu_in_vtk_order_with_regions(gearbox, exported):
+    mesh = component_mesh(gearbox, "ring", "coarse")
+    step = (exported / "ring.step").read_text(errors="replace")
+    assert "SI_UNIT(.MILLI.,.METRE.)" in step
+    vtu = meshio.read(exported / "ring.vtu")
+    (cells,) = vtu.cells
+    assert cells.type == "tetra10" and len(cells.data) == len(mesh.elements)
+    np.testing.assert_array_equal(vtu.points, mesh.nodes)  # metres
+    x, el = vtu.points, cells.data
+    v = x[el[:, :4]]
+    assert (np.einsum("ij,ij->i", v[:, 1] - v[:, 0], np.cross(v[:, 2] - v[:, 0], v[:, 3] - v[:, 0])) > 0).all()
+    for k, (a, b) in enumerate(((0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3))):  # VTK's edge order
+        length = np.linalg.norm(x[el[:, a]] - x[el[:, b]], axis=1)
+        off = np.linalg.norm(x[el[:, 4 + k]] - (x[el[:, a]] + x[el[:, b]]) / 2, axis=1)
+        assert np.median(off / length) < 1e-3 and (off < 0.25 * length).all()
+    for name, nodes in mesh.regions.items():
+        assert np.array_equal(np.flatnonzero(vtu.point_data[name]), nodes)
+    assert vtu.point_data["interface_bolt_patches"].sum() > 0
+    assert vtu.point_data["contact_band_0"].sum() > 0
+
+
+def test_export_errors_are_one_line(capsys, tmp_path):
+    assert main(["export-geometry", str(GEARBOX), "--component", "carrier", "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "unknown component 'carrier'" in err
+    assert main(["export-geometry", str(GEARBOX), "--level", "fine", "--out", str(tmp_path)]) == 2
+    assert "unknown mesh level 'fine'" in capsys.readouterr().err
 
 
 # --------------------------------------------------------------------------- the table

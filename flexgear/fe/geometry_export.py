@@ -1,0 +1,80 @@
+"""The components' solids as STEP and their volume meshes as VTU (``flexgear export-geometry``).
+
+- ``<component>.step``: the component's OCC solid (flexgear.fe.mesh.component_brep) in **millimetres**, the CAD
+  convention (the file declares its unit, mm), in the component's frame: z the axis, the origin where the
+  multibody model places the component's frame (the sun's and planets' centres on their axial mid-plane, the
+  ring and the shafts in the gearbox frame). Read back with ``length_unit = "mm"`` in ``[components_geometry]``.
+- ``<component>.vtu``: its volume mesh at the mesh level (flexgear.fe.mesh.component_mesh, the level's element
+  order: VTK ``tetra10`` in VTK's node order, flexgear.fe.mesh_io) in **metres**, the FE model's unit, with one
+  point-data array per mesh region (``flanks``, ``bore``, ``bolt_hole_<k>``, ``bearing_seat`` ...), per interface
+  of the component's reduction (``interface_<name>``: ``bore``, ``bolt_patches`` the clamped discs, ``sun_seat``,
+  ``bearing_seat``) and per contact band of a gear (``contact_band_<k>``: the nodes the contact kernel reads),
+  1 on the set's nodes, else 0. Read back with ``length_unit = "m"``.
+
+A component whose geometry is a volume mesh file (``[components_geometry]``) has no solid: only its VTU is written.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import numpy as np
+
+from flexgear.design import as_design
+from flexgear.fe.mesh import component_brep, component_mesh
+from flexgear.fe.mesh_io import write_vtu
+from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
+
+__all__ = ["export_geometry", "write_step", "STEP_UNIT_MM"]
+
+STEP_UNIT_MM = 1e3
+"""Millimetres per metre: the STEP files are written in mm."""
+
+
+def write_step(brep: Path, path: Path) -> Path:
+    """The solid of ``brep`` (metres) as a STEP file in millimetres at ``path``."""
+    from netgen.occ import OCCGeometry, Pnt
+
+    shape = OCCGeometry(str(brep)).shape.Scale(Pnt(0, 0, 0), STEP_UNIT_MM)
+    tmp = path.with_name(f".{path.name}.tmp.step")
+    shape.WriteStep(str(tmp))
+    tmp.replace(path)
+    return path
+
+
+def _point_sets(spec: GearboxSpec, component: str, nodes: np.ndarray, regions: dict) -> dict[str, np.ndarray]:
+    """The mesh's regions, its reduction's interfaces and a gear's contact bands as node sets (module docstring)."""
+    from flexgear.fe.attachment import circle_band
+    from flexgear.fe.reduced import component_interfaces, component_load_circles
+
+    d = as_design(spec)
+    sets = dict(regions)
+    shell = SimpleNamespace(nodes=nodes, regions={}, region_weights={})  # node positions are all they read
+    for itf in component_interfaces(shell, d, component):
+        sets[f"interface_{itf.name}"] = itf.nodes
+    for k, circle in enumerate(component_load_circles(d, component, spec.reduction_assumed.contact_fourier_order)):
+        sets[f"contact_band_{k}"] = circle_band(nodes, circle)
+    return sets
+
+
+def export_geometry(spec: GearboxSpec, components: tuple[str, ...] = GEOMETRY_COMPONENTS, level: str = "coarse",
+                    out: str | Path = "geometry", progress: bool = False) -> list[Path]:
+    """Write ``<component>.step`` and ``<component>.vtu`` of each of ``components`` at mesh ``level`` into ``out``
+    (module docstring); the paths written."""
+    if level not in spec.meshing_assumed:
+        raise ValueError(f"unknown mesh level {level!r}; the gearbox has {', '.join(sorted(spec.meshing_assumed))}")
+    for c in components:
+        if c not in GEOMETRY_COMPONENTS:
+            raise ValueError(f"unknown component {c!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
+    folder = Path(out)
+    folder.mkdir(parents=True, exist_ok=True)
+    written = []
+    for c in components:
+        entry = spec.components_geometry.get(c)
+        if entry is None or entry.kind != "mesh":
+            written.append(write_step(component_brep(spec, c, progress), folder / f"{c}.step"))
+        mesh = component_mesh(spec, c, level, progress=progress)
+        sets = _point_sets(spec, c, mesh.nodes, mesh.regions)
+        written.append(write_vtu(folder / f"{c}.vtu", mesh.nodes, mesh.elements, sets))
+    return written
