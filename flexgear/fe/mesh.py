@@ -168,6 +168,10 @@ def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = 
     """Path of the cached OCC solid (``.brep``) of ``component`` (``spec``: a spec or its design, flexgear.design),
     checked against its digest; built on a cache miss or when the file does not match its digest."""
     d = as_design(spec)
+    if component in d.spec.components_geometry:  # the user's solid ([components_geometry])
+        from flexgear.fe.imported import imported_brep
+
+        return imported_brep(d, component, progress)
     return layout_brep(d.layouts[component], geometry_hash(d.spec, component), progress)
 
 
@@ -315,7 +319,8 @@ def layout_regions(layout: ComponentLayout, nodes: np.ndarray, boundary: np.ndar
 
 def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coarse", order: int | None = None,
                    progress: bool = False) -> ComponentMesh:
-    """The (cached) tetrahedral mesh of ``component`` at mesh ``level``; ``order`` overrides the level's."""
+    """The (cached) tetrahedral mesh of ``component`` at mesh ``level``; ``order`` overrides the level's. A component
+    of ``[components_geometry]`` is meshed from its file (flexgear.fe.imported)."""
     spec = (d := as_design(spec)).spec
     if component not in GEOMETRY_COMPONENTS:
         raise ValueError(f"unknown component {component!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
@@ -323,6 +328,10 @@ def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coa
         raise ValueError(f"unknown mesh level {level!r}; gearbox.toml [meshing_assumed] has "
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
+    if component in spec.components_geometry:  # the user's solid or volume mesh ([components_geometry])
+        from flexgear.fe.imported import imported_mesh
+
+        return imported_mesh(d, component, level, order, progress)
     return source_mesh(_study_source(d, component, level), order, progress)
 
 
