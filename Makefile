@@ -1,4 +1,4 @@
-# flexgear: make (quick matrix + report), make test, make meshes, make matrix (full 0.6 s, both mesh laws), make report
+# flexgear: make (both laws' quick matrices in one pool + report), make test, make meshes, make matrix (full 0.6 s, both mesh laws), make report
 #
 # Environment: inside an active virtual environment ($VIRTUAL_ENV) make uses it; otherwise it creates
 # .venv with the first Python 3.11-3.13 it finds (PYTHON=/path/to/python3.x chooses one) and installs
@@ -28,8 +28,7 @@ TEST_WORKERS ?= 2
 
 quick: install
 	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
-	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) --out $(RESULTS)/quick --reference model7 --speeds-rpm $(SPEEDS_RPM)
-	$(PY) -m flexgear.cli matrix $(QUICK_ISO_VARIANTS) --out $(RESULTS)/quick_iso6336 --reference model7 \
+	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) $(QUICK_ISO_VARIANTS) --out '$(RESULTS)/{folder}' --reference model7 \
 		--speeds-rpm $(SPEEDS_RPM)
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick
 	$(PY) -m flexgear.cli sweep examples/sweeps/face_width.toml --out $(RESULTS)/quick/sweep_face_width

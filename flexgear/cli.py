@@ -78,7 +78,9 @@ def cmd_run(a: argparse.Namespace) -> int:
 def _args_matrix(p: argparse.ArgumentParser) -> None:
     p.add_argument("variants", nargs="+", metavar="VARIANT", help="variant files, one run each")
     p.add_argument("--t-end", type=_t_end, default=None, metavar="S", help=T_END_HELP)
-    p.add_argument("--out", default="results", metavar="DIR", help=OUT_HELP + "; finished runs are kept (resume)")
+    p.add_argument("--out", default="results", metavar="DIR",
+                   help=OUT_HELP + "; finished runs are kept (resume); a DIR with {folder} (e.g. 'results/{folder}') "
+                        "puts each variant file in the folder named after its own, all run in one pool")
     p.add_argument("--workers", type=int, default=2, metavar="N",
                    help="local worker processes (default: %(default)s; ignored with --scheduler)")
     p.add_argument("--scheduler", default=None, metavar="ADDR",
@@ -98,20 +100,24 @@ def _args_matrix(p: argparse.ArgumentParser) -> None:
 def cmd_matrix(a: argparse.Namespace) -> int:
     from flexgear.study.matrix import run_matrix
 
-    table = run_matrix([Path(p) for p in a.variants], out_dir=Path(a.out), t_end_s=a.t_end, workers=a.workers,
-                       scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget, reference=a.reference)
-    table = _with_screening_reason(table, Path(a.out))
+    table = run_matrix([Path(p) for p in a.variants], out_dir=a.out, t_end_s=a.t_end, workers=a.workers,
+                       scheduler=a.scheduler, progress=True, time_budget_s=a.time_budget, reference=a.reference,
+                       speeds_rpm=a.speeds_rpm)
+    folders = list(dict.fromkeys(table["results"])) if "results" in table.columns else [a.out]
     wanted = ["variant", "status", "wall_time_s", "bias_pct", "cv_pct", "distance_pct", "zone", "selected", "reason"]
-    print(table[[c for c in wanted if c in table.columns]].to_string(index=False))
-    _print_verdict(Path(a.out))
-    if a.speeds_rpm:
-        from flexgear.study.speed_screening import screen_speed_range
-
-        text = screen_speed_range(a.variants, a.out, a.speeds_rpm, a.reference)
-        selection = Path(a.out) / "selection.txt"
-        if selection.is_file():
-            print(f"Westgard: {selection.read_text().splitlines()[0]}")
-        print(f"Over the speed range (-> {Path(a.out) / 'speed_screening.txt'}):\n{text}", end="")
+    for folder in map(Path, folders):
+        rows = table[table["results"] == str(folder)] if "results" in table.columns else table
+        rows = _with_screening_reason(rows, folder)
+        if len(folders) > 1:
+            print(f"{folder}:")
+        print(rows[[c for c in wanted if c in rows.columns]].to_string(index=False))
+        _print_verdict(folder)
+        speed = folder / "speed_screening.txt"
+        if a.speeds_rpm and speed.is_file():
+            selection = folder / "selection.txt"
+            if selection.is_file():
+                print(f"Westgard: {selection.read_text().splitlines()[0]}")
+            print(f"Over the speed range (-> {speed}):\n{speed.read_text()}", end="")
     return 0
 
 

@@ -180,3 +180,22 @@ def test_quick_matrix_end_to_end_with_the_exudyn_backend(tmp_path):
     prescribed = step(t[inside], 0.0, 0.0, result.meta["ramp_time_s"], 36000.0).mean()
     assert s.indicators["input_speed"].mean == pytest.approx(prescribed, rel=1e-3)
     assert s.indicators["input_speed"].bias == pytest.approx(100 * (1 - prescribed / 36000.0), rel=1e-3)
+
+
+def test_one_pool_serves_several_results_folders(tmp_path):
+    """``--out results/{folder}``: the variant files of two folders, with the same names in both, run in one pool;
+    each folder gets its runs, tables and screening, as a matrix of its own would."""
+    paths = []
+    for folder in ("impact", "iso"):
+        (tmp_path / folder).mkdir()
+        _gearbox_after_ramps(tmp_path / folder)
+        paths += [_variant(tmp_path / folder, "rigid"), _variant(tmp_path / folder, "flex", ("sun",))]
+    table = run_matrix(paths, tmp_path / "results" / "{folder}", t_end_s=0.6, workers=2, progress=False,
+                       runner=fake_runner)
+    assert sorted(set(table["results"])) == [str(tmp_path / "results" / f) for f in ("impact", "iso")]
+    for folder in ("impact", "iso"):
+        out = tmp_path / "results" / folder
+        assert (out / "matrix_results.csv").is_file() and (out / "selection.txt").is_file()
+        rows = table[table["results"] == str(out)].set_index("variant")
+        assert set(rows.index) == {"rigid", "flex"} and (rows["status"] == "ok").all()
+        assert load_result(out / "rigid").meta["variant_file"] == str(tmp_path / folder / "rigid.toml")

@@ -6,8 +6,11 @@ gearbox file, not their paths: a worker needs no access to the caller's files. T
 variant from that content, builds (or finds in its own cache, ``FLEXGEAR_CACHE_DIR``, keyed by hash) the
 meshes and reduced bodies, runs it and sends the :class:`~flexgear.results.RunResult` back; the caller
 writes it with :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with
-copies of its input files (``inputs/``), as each run finishes. The runs with the most flexible bodies
-start first (the longest first, so that the last ones overlap). Then it writes
+copies of its input files (``inputs/``), as each run finishes (flexgear.study.pool). The runs with the most
+flexible bodies start first (the longest first, so that the last ones overlap); the screenings that need no run
+(the modal screening of an all-flexible reference, the speed screening) take a worker the runs leave free. One
+pool may serve several results folders (``out_dir`` with ``{folder}``: each variant file's folder name), the
+longest runs of all of them first. Then it writes, per folder,
 
 - ``matrix_results.csv`` / ``.parquet``: one row per variant: status and reason, components,
   simulated time, the runner's wall and CPU time of the run (model build + simulation), the
@@ -34,115 +37,34 @@ is recorded as failed with its reason while the others go on. CPU time is the wo
 from __future__ import annotations
 
 import dataclasses
-import datetime as _dt
 import json
-import socket
-import sys
-import time
 from collections.abc import Callable, Sequence
-from concurrent.futures import ProcessPoolExecutor
-from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
 import pandas as pd
 
 from flexgear.cache import atomic_write_bytes, remove_stale_temporaries
-from flexgear.progress import Progress, say
-from flexgear.results import RunResult, load_result, save_result
-from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant, spec_hash
+from flexgear.results import load_result, save_result
+from flexgear.spec import COMPONENTS, ScreeningSettings, SpecError, Variant, load_gearbox, load_variant
+from flexgear.study.pool import (
+    Runner,
+    RunTask,
+    execute,
+    failed_result,
+    make_task,
+    run_input_hash,
+    run_task,
+    save_task_result,
+    say_progress,
+)
 from flexgear.study.purposes import ALL_PURPOSES, verdict_table
 from flexgear.study.screening import ReferenceNotUsable, Selection, screen
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
 
-Runner = Callable[..., RunResult]
-
-_HEARTBEAT_S = 60.0
-_POLL_S = 0.2
-
-
-def run_input_hash(variant: Variant, t_end_s: float | str, error_window_s: float = 0.0) -> str:
-    """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``, except the settling
-    test's fields for a run continued until it settles), t_end (s, or "settled"), the error windows' length."""
-    gearbox = dataclasses.replace(variant.gearbox, screening=None)
-    if t_end_s != "settled":
-        extra: tuple = (float(t_end_s),)
-    else:
-        sc = variant.gearbox.screening
-        extra = ("settled", sc.settle_block_mesh_cycles, sc.settle_final_blocks, sc.settle_mean_tolerance_pct,
-                 sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s)
-    if error_window_s > 0:
-        extra = (*extra, "error_window", float(error_window_s))
-    return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn")
-
-
-def _default_runner() -> Runner:
-    from flexgear.mbs.run import run_variant
-
-    return run_variant
-
-
-def _failed(name: str, reason: str, **meta: Any) -> RunResult:
-    return RunResult({"variant": name, "backend": "exudyn", "status": "failed", "reason": reason,
-                      "created": _dt.datetime.now(_dt.UTC).isoformat(timespec="seconds"), **meta})
-
-
-@dataclasses.dataclass(frozen=True)
-class RunTask:
-    """One run as shipped to a worker: the input files' names and contents (no paths to open)."""
-
-    name: str
-    variant_file: str  # the caller's path: names the file in messages only
-    variant_text: str
-    gearbox_file: str
-    gearbox_text: str
-    t_end_s: float | str | None
-    input_hash: str
-    time_budget_s: float | None = None
-    error_window_s: float = 0.0   # > 0: the run also solves its numerical error windows (the screening reference)
-
-    def inputs(self) -> dict[str, bytes]:
-        """The input files for ``inputs/`` of the run folder."""
-        return {Path(self.variant_file).name: self.variant_text.encode(),
-                Path(self.gearbox_file).name: self.gearbox_text.encode()}
-
-
-def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None,
-              error_window_s: float = 0.0) -> RunTask:
-    """The task of a loaded variant: reads its two files once, on the caller's side; ``t_end_s`` in s, "settled"
-    or None (the load case's end: ``end_time_s``, or "settled" with ``[load_case] end = "settled"``)."""
-    lc = variant.gearbox.load_case
-    t_end = t_end_s if t_end_s is not None else ("settled" if lc.end == "settled" else lc.end_time_s)
-    return RunTask(variant.name, str(variant.source), Path(variant.source).read_text(),
-                   str(variant.gearbox.source), Path(variant.gearbox.source).read_text(), t_end_s,
-                   run_input_hash(variant, t_end, error_window_s), time_budget_s, error_window_s)
-
-
-def run_task(task: RunTask, runner: Runner | None = None) -> RunResult:
-    """Worker side: load the variant from the shipped content, run it, return the result (writes nothing
-    but cache entries). Never raises for a model failure."""
-    wall0, cpu0 = time.perf_counter(), time.process_time()
-    try:
-        variant = load_variant(task.variant_file, task.variant_text, task.gearbox_text)
-        extra: dict[str, Any] = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
-        if task.error_window_s > 0:
-            extra["error_window_s"] = task.error_window_s
-        result = (runner or _default_runner())(variant, t_end_s=task.t_end_s, progress=False, **extra)
-    except Exception as exc:  # recorded, not raised: the other variants go on
-        result = _failed(task.name, f"{type(exc).__name__}: {exc}")
-    result.meta.update(input_hash=task.input_hash, variant_file=task.variant_file, worker_host=socket.gethostname(),
-                       total_wall_time_s=time.perf_counter() - wall0, total_cpu_time_s=time.process_time() - cpu0)
-    return result
-
-
-def save_task_result(task: RunTask, result: RunResult, run_dir: Path) -> dict[str, Any]:
-    """Caller side: write the result and copies of its input files; return its metadata."""
-    save_result(result, run_dir, inputs=task.inputs())
-    return dict(result.meta)
-
-
+# --------------------------------------------------------------------------- tables
 def write_table(table: pd.DataFrame, stem: Path) -> None:
     """Write ``stem.csv`` and ``stem.parquet`` atomically."""
     atomic_write_bytes(stem.with_suffix(".csv"), table.to_csv(index=False).encode())
@@ -150,80 +72,6 @@ def write_table(table: pd.DataFrame, stem: Path) -> None:
 
 
 # --------------------------------------------------------------------------- execution
-def _say(progress: bool, text: str) -> None:
-    if progress:
-        say(f"[matrix {time.strftime('%H:%M:%S')}] {text}")
-
-
-def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, out_dir: Path,
-              progress: bool, bar: Progress) -> tuple[dict[str, dict], list[RunTask]]:
-    """Submit tasks, save each result as it arrives; return the metas and the tasks whose worker died."""
-    futures = {submit(run_task, t, runner): t for t in tasks}
-    started = last_beat = time.perf_counter()
-    metas: dict[str, dict] = {}
-    died: list[RunTask] = []
-    while futures:
-        finished = [f for f in futures if f.done()]
-        for fut in finished:
-            task = futures.pop(fut)
-            try:
-                result = fut.result()
-            except Exception as exc:  # the worker process died (segfault, out of memory) or was killed
-                died.append(task)
-                _say(progress, f"{task.name}: worker lost ({type(exc).__name__}: {exc})")
-                continue
-            meta = metas[task.name] = save_task_result(task, result, out_dir / task.name)
-            bar.update_to(bar.value + 1, postfix=f"{task.name} {meta['status']}")
-            _say(progress, f"{task.name}: {meta['status']}, {meta.get('wall_time_s', float('nan')):.1f} s wall, "
-                           f"{meta.get('cpu_time_s', float('nan')):.1f} s CPU"
-                           + (f" ({meta.get('reason')})" if meta["status"] != "ok" else ""))
-        now = time.perf_counter()
-        if futures and now - last_beat >= _HEARTBEAT_S:
-            last_beat = now
-            _say(progress, f"running or queued {len(futures)}: {', '.join(t.name for t in futures.values())} "
-                           f"({now - started:.0f} s elapsed)")
-        if futures and not finished:
-            time.sleep(_POLL_S)
-    return metas, died
-
-
-def _execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: Runner | None,
-             out_dir: Path, progress: bool) -> dict[str, dict]:
-    if not tasks:
-        return {}
-    # on a terminal a bar; in a log the per-run lines of _say are the progress
-    bar = Progress(len(tasks), "matrix", "runs", enabled=progress and sys.stderr.isatty(), fmt="{:.0f}")
-    if scheduler is not None:
-        from distributed import Client
-
-        with Client(scheduler) as client:
-            _say(progress, f"{len(tasks)} runs on Dask cluster {scheduler}")
-
-            def submit(fn: Callable, task: RunTask, run: Runner | None) -> Any:
-                return client.submit(fn, task, run, pure=False, key=f"flexgear-run-{task.name}-{task.input_hash}")
-
-            metas, died = _run_pool(tasks, submit, runner, out_dir, progress, bar)
-    else:
-        _say(progress, f"{len(tasks)} runs on {workers} local worker process(es)")
-        ctx = get_context("spawn")
-        with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
-            metas, died = _run_pool(tasks, pool.submit, runner, out_dir, progress, bar)
-        # A dead worker breaks the whole pool: rerun each affected task alone to find the culprit.
-        retry, died = died, []
-        for task in retry:
-            with ProcessPoolExecutor(max_workers=1, mp_context=ctx) as solo:
-                again, lost = _run_pool([task], solo.submit, runner, out_dir, progress, bar)
-            metas.update(again)
-            died += lost
-    for task in died:  # died again alone (or on the cluster): record it
-        result = _failed(task.name, "worker process died (crash or out of memory in the solver)",
-                         input_hash=task.input_hash, variant_file=task.variant_file)
-        metas[task.name] = save_task_result(task, result, out_dir / task.name)
-        bar.update_to(bar.value + 1, postfix=f"{task.name} failed")
-    bar.close()
-    return metas
-
-
 # --------------------------------------------------------------------------- matrix
 def _row(name: str, meta: dict, resumed: bool) -> dict[str, Any]:
     comps = meta.get("components") or {}
@@ -243,7 +91,7 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     ``reference``: a variant name to screen against (default ``settings.reference``). A reference that has not
     settled is refused: ``selection.txt`` then says so in one line and nothing is selected."""
     results = [load_result(out_dir / n) if (out_dir / n / "run.json").exists()
-               else _failed(n, "no saved run") for n in names]
+               else failed_result(n, "no saved run") for n in names]
     ref = settings.reference if reference is None else reference
     purposes = tuple(settings.purposes) if ref else ()
     try:
@@ -269,37 +117,51 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     text = (f"selected: {selection.variant}\nrule: {selection.rule}\nreference: {ref or 'theory'}\n"
             f"{selection.reasoning}\n")
     atomic_write_bytes(out_dir / "selection.txt", text.encode())
-    _say(progress, f"selected {selection.variant}: {selection.reasoning}")
+    say_progress(progress, f"selected {selection.variant}: {selection.reasoning}")
     return table
 
 
-def modal_verdict(out_dir: Path, reference: Any, progress: bool = False) -> str:
-    """The modal screening of the all-flexible reference (flexgear.modal.screening: which components deform in the
-    modes that the mesh harmonics can excite) beside the Westgard verdict of ``out_dir/selection.txt``; writes
-    ``modal_screening.csv``, ``modal_screening_modes.csv`` (ModalScreening.mode_table) and ``modal_screening.txt``
-    (one paragraph) and returns the paragraph. ``reference``: a Variant or its flexgear.modal.LinearModel. A
-    failure is recorded in the text, not raised: the Westgard verdict stands on its own."""
+def modal_job(variant_file: str, variant_text: str, gearbox_text: str) -> tuple[pd.DataFrame, pd.DataFrame, str, float]:
+    """Worker side: the modal screening of the all-flexible reference (flexgear.modal.screening) from its files'
+    content: (component table, mode table, recommended variant, band [Hz])."""
     from flexgear.modal.screening import modal_screening
 
-    name = reference.variant.name if hasattr(reference, "variant") else reference.name
+    m = modal_screening(load_variant(variant_file, variant_text, gearbox_text),
+                        variants_dir=Path(variant_file).parent)
+    return m.table, m.mode_table(), m.recommended, m.f_band_hz
 
-    try:
-        m = modal_screening(reference)
-    except Exception as exc:  # recorded: the time-domain screening does not depend on it
-        text = f"Modal screening of {name} not done: {type(exc).__name__}: {exc}"
+
+def write_modal_verdict(out_dir: Path, name: str, screened: Any, progress: bool = False) -> str:
+    """Write the modal screening ``screened`` (:func:`modal_job`'s result, or the exception it raised) of reference
+    ``name`` beside the Westgard verdict of ``out_dir/selection.txt``: ``modal_screening.csv``,
+    ``modal_screening_modes.csv`` (ModalScreening.mode_table) and ``modal_screening.txt`` (one paragraph); returns
+    the paragraph. A failure is recorded in the text, not raised: the Westgard verdict stands on its own."""
+    if isinstance(screened, BaseException):
+        text = f"Modal screening of {name} not done: {type(screened).__name__}: {screened}"
     else:
-        write_table(m.table, out_dir / "modal_screening")
-        write_table(m.mode_table(), out_dir / "modal_screening_modes")
+        table, modes, recommended, f_band = screened
+        write_table(table, out_dir / "modal_screening")
+        write_table(modes, out_dir / "modal_screening_modes")
         selection = (out_dir / "selection.txt").read_text().splitlines()[0].removeprefix("selected: ")
-        must = ", ".join(m.table.component[m.table.must_be_flexible]) or "none"
-        text = (f"Modal screening of {name}'s modes up to {m.f_band_hz:.4g} Hz (10x the mesh frequency): "
-                f"must be flexible: {must}; recommends {m.recommended}. Westgard verdict: {selection}"
-                + (" (the same)." if selection == m.recommended else
+        must = ", ".join(table.component[table.must_be_flexible]) or "none"
+        text = (f"Modal screening of {name}'s modes up to {f_band:.4g} Hz (10x the mesh frequency): "
+                f"must be flexible: {must}; recommends {recommended}. Westgard verdict: {selection}"
+                + (" (the same)." if selection == recommended else
                    "; they differ: the modal screening asks which components deform in the modes the mesh harmonics "
                    "can excite, the Westgard verdict whether the indicators change beyond their TEa."))
     atomic_write_bytes(out_dir / "modal_screening.txt", (text + "\n").encode())
-    _say(progress, text)
+    say_progress(progress, text)
     return text
+
+
+def modal_verdict(out_dir: Path, reference: Variant, progress: bool = False) -> str:
+    """:func:`write_modal_verdict` of the all-flexible ``reference`` variant, screened here (:func:`modal_job`)."""
+    try:
+        screened: Any = modal_job(str(reference.source), Path(reference.source).read_text(),
+                                  Path(reference.gearbox.source).read_text())
+    except Exception as exc:  # recorded: the time-domain screening does not depend on it
+        screened = exc
+    return write_modal_verdict(out_dir, reference.name, screened, progress)
 
 
 def _check_reference(reference: str, names: Sequence[str]) -> None:
@@ -316,10 +178,10 @@ def _flexible_bodies(variant: Variant) -> int:
     return sum((planets if c == "planets" else 1) for c, form in variant.components.items() if form == "flexible")
 
 
-def _run_order(variants: dict[str, Variant]) -> list[str]:
-    """Names longest run first (the last runs then overlap): by flexgear.mbs.gearbox.run_cost (the flexible
-    bodies' dynamic modes, squared and summed) when every variant's bodies are cached, else by the count of
-    flexible bodies. Stable for ties."""
+def _run_order(variants: dict[Any, Variant]) -> list[Any]:
+    """Keys (names, or folder and name) longest run first (the last runs then overlap): by
+    flexgear.mbs.gearbox.run_cost (the flexible bodies' dynamic modes, squared and summed) when every variant's
+    bodies are cached, else by the count of flexible bodies. Stable for ties."""
     from flexgear.mbs.gearbox import run_cost
 
     costs = {name: run_cost(v) for name, v in variants.items()}
@@ -328,10 +190,115 @@ def _run_order(variants: dict[str, Variant]) -> list[str]:
     return sorted(variants, key=lambda name: -costs[name])
 
 
+@dataclasses.dataclass
+class _Folder:
+    """One results folder of a matrix: its variants, the runs to do and the ones kept."""
+
+    out_dir: Path
+    names: list[str] = dataclasses.field(default_factory=list)
+    files: dict[str, Path] = dataclasses.field(default_factory=dict)
+    metas: dict[str, dict] = dataclasses.field(default_factory=dict)
+    resumed: set[str] = dataclasses.field(default_factory=set)
+    tasks: list[RunTask] = dataclasses.field(default_factory=list)
+    pending: dict[str, Variant] = dataclasses.field(default_factory=dict)
+    settings: ScreeningSettings | None = None
+    reference: str = ""
+
+
+def _folders(variant_paths: Sequence[str | Path], out_dir: str | Path) -> dict[Path, list[Path]]:
+    """The results folder of each variant file: ``out_dir``, or, when it holds ``{folder}``, that with the name of
+    the variant file's folder (``results/{folder}``: model_variants/quick/model7.toml -> results/quick)."""
+    out: dict[Path, list[Path]] = {}
+    for path in map(Path, variant_paths):
+        folder = Path(str(out_dir).replace("{folder}", path.resolve().parent.name))
+        out.setdefault(folder, []).append(path)
+    return out
+
+
+def _prepare(out_dir: Path, paths: list[Path], t_end_s: float | str | None, time_budget_s: float | None,
+             reference: str | None, progress: bool) -> _Folder:
+    """Load a folder's variant files, record the bad ones, keep the finished runs (resume), make the tasks."""
+    f = _Folder(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    for stale in remove_stale_temporaries(out_dir):
+        say_progress(progress, f"removed {stale.relative_to(out_dir)} (an interrupted write)")
+    for path in paths:
+        try:
+            variant = load_variant(path)
+        except SpecError as exc:
+            name = path.stem
+            result = failed_result(name, f"SpecError: {exc}", variant_file=str(path))
+            if name not in f.names:
+                f.names.append(name)
+                save_result(result, out_dir / name)
+                f.metas[name] = dict(result.meta)
+            say_progress(progress, f"{name}: bad variant file: {exc}")
+            continue
+        name = variant.name
+        if name in f.names:
+            raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
+        f.names.append(name)
+        f.files[name] = path
+        f.settings = f.settings or variant.gearbox.screening
+        f.reference = reference if reference is not None else f.settings.reference
+        task = make_task(variant, t_end_s, time_budget_s,
+                         f.settings.error_window_s if f.reference and name == f.reference else 0.0, out_dir)
+        run_dir = out_dir / name
+        if (run_dir / "run.json").exists():
+            old = load_result(run_dir).meta
+            if old.get("status") == "ok" and old.get("input_hash") == task.input_hash:
+                f.metas[name] = old
+                f.resumed.add(name)
+                say_progress(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
+                continue
+        f.tasks.append(task)
+        f.pending[name] = variant
+    _check_reference(reference if reference is not None else (f.settings.reference if f.settings else ""), f.names)
+    return f
+
+
+def _jobs(f: _Folder, speeds_rpm: Sequence[float] | None, modal: bool) -> list[tuple[Any, Callable, tuple]]:
+    """The folder's screenings that need no run, for the pool: the modal screening of an all-flexible reference,
+    the speed screening of its variants."""
+    jobs: list[tuple[Any, Callable, tuple]] = []
+    ref_file = f.files.get(f.reference)
+    if modal and ref_file is not None:
+        ref = load_variant(ref_file)
+        if all(form == "flexible" for form in ref.components.values()):
+            jobs.append((("modal", str(f.out_dir)), modal_job,
+                         (str(ref_file), ref_file.read_text(), Path(ref.gearbox.source).read_text())))
+    if speeds_rpm and f.files:
+        from flexgear.study.speed_screening import job_files, speed_job
+
+        files = job_files([f.files[n] for n in f.names if n in f.files])
+        jobs.append((("speed", str(f.out_dir)), speed_job, (files, list(speeds_rpm), f.reference)))
+    return jobs
+
+
+def _finish(f: _Folder, metas: dict, done: dict, progress: bool, reference: str | None) -> pd.DataFrame:
+    """Write the folder's tables and screenings (the runs', then the jobs' results)."""
+    f.metas.update({name: meta for (folder, name), meta in metas.items() if folder == str(f.out_dir)})
+    table = pd.DataFrame([_row(n, f.metas[n], n in f.resumed) for n in f.names])
+    write_table(table, f.out_dir / "matrix_results")
+    settings = f.settings or load_gearbox(Path(__file__).resolve().parents[2] / "model_variants"
+                                          / "gearbox.toml").screening
+    screening = screen_directory(f.out_dir, f.names, settings, progress, reference)
+    if ("modal", str(f.out_dir)) in done:
+        write_modal_verdict(f.out_dir, f.reference, done["modal", str(f.out_dir)], progress)
+    if ("speed", str(f.out_dir)) in done:
+        from flexgear.study.speed_screening import operating_speed_rpm, write_speed_screening
+
+        write_speed_screening(f.out_dir, done["speed", str(f.out_dir)], operating_speed_rpm(list(f.files.values())))
+    screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
+                                           "selected"])
+    return table.merge(screening, on="variant", how="left")
+
+
 def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s: float | str | None = None,
                workers: int = 2, scheduler: str | None = None, progress: bool = True,
                runner: Runner | None = None, time_budget_s: float | None = None,
-               reference: str | None = None, modal: bool = True) -> pd.DataFrame:
+               reference: str | None = None, modal: bool = True,
+               speeds_rpm: Sequence[float] | None = None) -> pd.DataFrame:
     """Run the variant files, save each run, screen them; return the results + screening table.
 
     ``runner(variant, t_end_s=..., progress=...) -> RunResult`` defaults to
@@ -340,65 +307,21 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     processes. ``time_budget_s`` overrides each variant's ``[solver_assumed] wall_time_budget_s``.
     ``reference``: screen against this variant (:func:`flexgear.study.screening.screen`; default the
     gearbox's ``[screening] reference``). ``modal``: with an all-flexible reference and the default runner, also
-    :func:`modal_verdict`. See the module docstring for the files written and the resume rule.
+    the modal screening (:func:`write_modal_verdict`); ``speeds_rpm``: also the speed screening over these input
+    speeds (flexgear.study.speed_screening). ``out_dir`` holding ``{folder}`` serves several results folders from
+    one pool (:func:`_folders`: each variant file's folder name), the longest runs of all first and the
+    screenings that need no run beside them; the table then has a column ``results``. See the module docstring
+    for the files written and the resume rule.
     """
-    out_dir = Path(out_dir)
-    out_dir.mkdir(parents=True, exist_ok=True)
-    for stale in remove_stale_temporaries(out_dir):
-        _say(progress, f"removed {stale.relative_to(out_dir)} (an interrupted write)")
-    names: list[str] = []
-    variant_files: dict[str, Path] = {}
-    metas: dict[str, dict] = {}
-    resumed: set[str] = set()
-    tasks: list[RunTask] = []
-    pending: dict[str, Variant] = {}
-    settings: ScreeningSettings | None = None
-    for path in map(Path, variant_paths):
-        try:
-            variant = load_variant(path)
-        except SpecError as exc:
-            name = path.stem
-            result = _failed(name, f"SpecError: {exc}", variant_file=str(path))
-            if name not in names:
-                names.append(name)
-                save_result(result, out_dir / name)
-                metas[name] = dict(result.meta)
-            _say(progress, f"{name}: bad variant file: {exc}")
-            continue
-        name = variant.name
-        if name in names:
-            raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
-        names.append(name)
-        variant_files[name] = path
-        settings = settings or variant.gearbox.screening
-        ref = reference if reference is not None else settings.reference
-        task = make_task(variant, t_end_s, time_budget_s,
-                         settings.error_window_s if ref and name == ref else 0.0)
-        run_dir = out_dir / name
-        if (run_dir / "run.json").exists():
-            old = load_result(run_dir).meta
-            if old.get("status") == "ok" and old.get("input_hash") == task.input_hash:
-                metas[name] = old
-                resumed.add(name)
-                _say(progress, f"{name}: unchanged (hash {task.input_hash}), skipped")
-                continue
-        tasks.append(task)
-        pending[name] = variant
-    order = {name: k for k, name in enumerate(_run_order(pending))}
-    tasks.sort(key=lambda t: order[t.name])
-    _check_reference(reference if reference is not None else (settings.reference if settings else ""), names)
-    metas.update(_execute(tasks, workers, scheduler, runner, out_dir, progress))
-    table = pd.DataFrame([_row(n, metas[n], n in resumed) for n in names])
-    write_table(table, out_dir / "matrix_results")
-    if settings is None:
-        settings = load_gearbox(Path(__file__).resolve().parents[2] / "model_variants" / "gearbox.toml").screening
-    screening = screen_directory(out_dir, names, settings, progress, reference)
-    ref_name = reference if reference is not None else settings.reference
-    ref_file = variant_files.get(ref_name)
-    if ref_file is not None and modal and runner is None:
-        ref_variant = load_variant(ref_file)
-        if all(form == "flexible" for form in ref_variant.components.values()):
-            modal_verdict(out_dir, ref_variant, progress)
-    screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
-                                           "selected"])
-    return table.merge(screening, on="variant", how="left")
+    folders = [_prepare(Path(d), paths, t_end_s, time_budget_s, reference, progress)
+               for d, paths in _folders(variant_paths, out_dir).items()]
+    pending = {(str(f.out_dir), name): v for f in folders for name, v in f.pending.items()}
+    order = {key: k for k, key in enumerate(_run_order(pending))}
+    tasks = sorted((t for f in folders for t in f.tasks), key=lambda t: order[t.key])
+    jobs = [j for f in folders for j in _jobs(f, speeds_rpm, modal and runner is None)] if runner is None else []
+    metas, done = execute(tasks, workers, scheduler, runner, progress, jobs)
+    tables = [_finish(f, metas, done, progress, reference) for f in folders]
+    if len(tables) == 1:
+        return tables[0]
+    return pd.concat([t.assign(results=str(f.out_dir)) for t, f in zip(tables, folders, strict=True)],
+                     ignore_index=True)

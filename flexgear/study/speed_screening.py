@@ -180,35 +180,77 @@ def speed_screening(variants: Sequence[Any], speeds_rpm: Sequence[float], refere
     return compare_curves(curves, reference, _tea(ref.gearbox.screening))
 
 
+def speed_job(variant_files: Sequence[tuple[str, str, str]], speeds_rpm: Sequence[float],
+              reference: str = "") -> SpeedScreening:
+    """Worker side: :func:`speed_screening` of the variants given as (variant file, its text, its gearbox's text);
+    ``reference`` "" = the gearbox's ``[screening] reference`` (then, if empty, the most flexible variant)."""
+    from flexgear.spec import load_variant
+
+    variants = [load_variant(path, text, gearbox) for path, text, gearbox in variant_files]
+    if not variants:
+        raise ValueError("no variants to screen over the speed range")
+    return speed_screening(variants, speeds_rpm, reference or variants[0].gearbox.screening.reference or "")
+
+
+def write_speed_screening(out_dir: str | Path, result: SpeedScreening | BaseException,
+                          operating_rpm: float | None) -> str:
+    """Write :func:`speed_job`'s ``result`` into the results folder ``out_dir``: speed_screening.csv (the table),
+    speed_screening_summary.csv and speed_screening.txt (one line per variant); when the folder holds a verdict
+    against a reference variant (verdict.csv), also speed_bands.csv (:func:`speed_bands` about ``operating_rpm``,
+    the variants' load-case input speed) and one line per band in the text; returns the text. A failed screening
+    (the exception as ``result``) is one line in the text."""
+    from flexgear.cache import atomic_write_bytes
+    from flexgear.study.matrix import write_table
+
+    out = Path(out_dir)
+    out.mkdir(parents=True, exist_ok=True)
+    if isinstance(result, BaseException):
+        lines = [f"speed screening not done: {type(result).__name__}: {result}"]
+    else:
+        write_table(result.table, out / "speed_screening")
+        write_table(result.summary, out / "speed_screening_summary")
+        lines = result.lines()
+        bands = speed_bands(out, operating_rpm)
+        if bands is not None:
+            lines += [f"acceptable speed band, {r.purpose}: {r.text}" for r in bands.itertuples()]
+    text = "\n".join(lines) + "\n"
+    atomic_write_bytes(out / "speed_screening.txt", text.encode())
+    return text
+
+
+def job_files(variant_paths: Sequence[str | Path]) -> list[tuple[str, str, str]]:
+    """(variant file, its text, its gearbox file's text) of each variant file, for :func:`speed_job`."""
+    from flexgear.spec import load_variant
+
+    out = []
+    for path in map(Path, variant_paths):
+        variant = load_variant(path)
+        out.append((str(path), path.read_text(), Path(variant.gearbox.source).read_text()))
+    return out
+
+
+def operating_speed_rpm(variant_paths: Sequence[str | Path]) -> float | None:
+    """The variants' common load-case input speed [rpm], None when they differ."""
+    from flexgear.spec import load_variant
+
+    speeds = {float(load_variant(p).gearbox.load_case.input_speed_rpm) for p in variant_paths}
+    return speeds.pop() if len(speeds) == 1 else None
+
+
 def screen_speed_range(variant_paths: Sequence[str | Path], out_dir: str | Path, speeds_rpm: Sequence[float],
                        reference: str | None = None, harmonics: int | None = None) -> str:
-    """:func:`speed_screening` of the variant files into the results folder ``out_dir``: writes
-    speed_screening.csv (the table), speed_screening_summary.csv and speed_screening.txt (one line per variant);
-    when the folder holds a verdict against a reference variant (verdict.csv), also speed_bands.csv
-    (:func:`speed_bands`, the operating speed being the variants' load case input speed) and one line per band in
-    the text; returns the text. ``reference``: None = the gearbox's ``[screening] reference`` (then, if empty, the most
-    flexible variant)."""
-    from flexgear.cache import atomic_write_bytes
+    """:func:`speed_screening` of the variant files into the results folder ``out_dir``
+    (:func:`write_speed_screening`); returns the text. ``reference``: None = the gearbox's ``[screening]
+    reference`` (then, if empty, the most flexible variant); ``harmonics``: mesh harmonics (default
+    flexgear.harmonic's)."""
     from flexgear.spec import load_variant
-    from flexgear.study.matrix import write_table
 
     variants = [load_variant(p) for p in variant_paths]
     if not variants:
         raise ValueError("no variants to screen over the speed range")
     ref = reference if reference is not None else variants[0].gearbox.screening.reference
     result = speed_screening(variants, speeds_rpm, ref or "", harmonics)
-    out = Path(out_dir)
-    out.mkdir(parents=True, exist_ok=True)
-    write_table(result.table, out / "speed_screening")
-    write_table(result.summary, out / "speed_screening_summary")
-    lines = result.lines()
-    operating = {float(v.gearbox.load_case.input_speed_rpm) for v in variants}
-    bands = speed_bands(out, operating.pop() if len(operating) == 1 else None)
-    if bands is not None:
-        lines += [f"acceptable speed band, {r.purpose}: {r.text}" for r in bands.itertuples()]
-    text = "\n".join(lines) + "\n"
-    atomic_write_bytes(out / "speed_screening.txt", text.encode())
-    return text
+    return write_speed_screening(out_dir, result, operating_speed_rpm(variant_paths))
 
 
 # --------------------------------------------------------------------------- acceptable speed band
