@@ -142,6 +142,18 @@ def test_vtu_round_trip_gives_the_built_in_fe_model(gearbox, exported, coarse_fe
     assert all(np.array_equal(mesh.regions[k], reference.regions[k]) for k in mesh.regions)
 
 
+@pytest.mark.parametrize("suffix, file_format", [(".msh", "gmsh"), (".inp", "abaqus")])
+def test_gmsh_and_abaqus_meshes_in_mm_give_the_built_in_mesh(gearbox, exported, tmp_path, suffix, file_format):
+    """meshio converts Gmsh's and Abaqus' node orders to VTK's; the file in mm is scaled to metres."""
+    vtu = meshio.read(exported / "ring.vtu")
+    meshio.write(tmp_path / f"ring{suffix}", meshio.Mesh(vtu.points * 1e3, vtu.cells), file_format=file_format)
+    mesh = component_mesh(load_gearbox(_ring_entry(tmp_path, f"ring{suffix}", "mm")), "ring", "coarse")
+    reference = component_mesh(gearbox, "ring", "coarse")
+    assert np.abs(mesh.nodes - reference.nodes).max() < 1e-12
+    np.testing.assert_array_equal(mesh.elements, reference.elements)
+    assert all(np.array_equal(mesh.regions[k], reference.regions[k]) for k in reference.regions)
+
+
 def _held_frequencies(body, name: str) -> np.ndarray:
     """Frequencies [Hz] of the reduced body with interface ``name``'s six motions held (flexgear.fe.joined)."""
     import scipy.linalg as la

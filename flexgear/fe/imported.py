@@ -204,7 +204,8 @@ def imported_mesh(spec: GearboxSpec | Design, component: str, level: str, order:
                             lambda o: geometry_hash(spec, component, settings, o, GRADING, MESH_VERSION,
                                                     IMPORT_VERSION), regions)
         try:
-            mesh, checked = source_mesh(source, order, progress), source_mesh(source, settings.element_order, progress)
+            mesh = source_mesh(source, order, progress)
+            checked = mesh if order == settings.element_order else source_mesh(source, settings.element_order, progress)
         except GeometryFileError:
             raise
         except Exception as exc:  # Netgen fails on a solid it cannot mesh
