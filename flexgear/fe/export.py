@@ -9,6 +9,7 @@ import numpy as np
 import trimesh
 
 from flexgear.fe.mesh import component_mesh
+from flexgear.fe.mesh_io import NETGEN_TO_VTK
 from flexgear.fe.surface import surface_mesh
 from flexgear.geometry.check import MM_PER_M, nominal_placements, transverse_section
 from flexgear.geometry.involute import gear_set_geometry
@@ -30,8 +31,10 @@ def assembly_trimesh(spec: GearboxSpec, level: str = "coarse") -> dict[str, trim
 
 
 def write_vtk(path: str | Path, nodes: np.ndarray, elements: np.ndarray) -> None:
-    """Legacy ASCII VTK unstructured grid of tetrahedra (VTK types 10 / 24 for 4 / 10 nodes)."""
+    """Legacy ASCII VTK unstructured grid of tetrahedra (VTK types 10 / 24 for 4 / 10 nodes), ``elements`` in
+    Netgen's node order, written in VTK's (:data:`flexgear.fe.mesh_io.NETGEN_TO_VTK`)."""
     vtk_type = {4: 10, 10: 24}[elements.shape[1]]
+    elements = np.asarray(elements)[:, NETGEN_TO_VTK[elements.shape[1]]]
     lines = ["# vtk DataFile Version 3.0", "flexgear mesh", "ASCII", "DATASET UNSTRUCTURED_GRID",
              f"POINTS {len(nodes)} double"]
     lines += [" ".join(f"{v:.9g}" for v in p) for p in nodes]
