@@ -62,3 +62,27 @@ def test_flexible_components_in_the_planetary_arrangement_are_refused_at_load_ti
     with pytest.raises(SpecError) as err:
         load_variant(path)
     assert err.value.field == "components.sun" and "planetary" in str(err.value) and "\n" not in str(err.value)
+
+
+def test_spur_planetary_example_against_hand_theory_and_the_lumped_model(tmp_path):
+    """examples/spur_planetary (24/30/84, 3 planets, only gears, bearings and load case given): the multibody
+    run's ratio and mean mesh forces against hand theory (1e-3, 1 %) and against the lumped model (eq. 1-13) run
+    alike (its mean mesh forces within 1 %)."""
+    from flexgear.cli import main
+    from flexgear.results import load_result
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
+    assert main(["matrix", str(example / "rigid.toml"), "--out", str(tmp_path)]) == 0
+    assert main(["lpm", str(example / "rigid.toml"), "--out", str(tmp_path)]) == 0
+    spec = load_variant(example / "rigid.toml").gearbox
+    t_sun = spec.load_case.load_torque_nm * 24 / 108
+    r_b = 3e-3 * 24 * math.cos(math.radians(20.0)) / 2
+    force = t_sun / (3 * r_b)
+    means = {}
+    for name in ("rigid", "lumped"):
+        s = load_result(tmp_path / name).signals
+        late = s[s.time_s >= 0.05]
+        assert late.transmission_ratio.mean() == pytest.approx(24 / 108, rel=1e-3), name
+        means[name] = late[[f"{m}_mesh_force_{i}_n" for m in ("outer", "inner") for i in (1, 2, 3)]].mean()
+        np.testing.assert_allclose(means[name], force, rtol=0.01, err_msg=name)
+    np.testing.assert_allclose(means["rigid"].to_numpy(), means["lumped"].to_numpy(), rtol=0.01)
