@@ -7,6 +7,8 @@ field that causes the problem and what is allowed:
   (the equal-spacing assembly condition is checked in :mod:`flexgear.spec`);
 - centre distance: reachable by profile shifts, cos(alpha_wt) = a_0 cos(alpha_t) / a_w < 1 for both meshes
   (ISO 21771 centre-distance equation), also the mean standard centre distance that 0 selects;
+- no undercut of sun and planet by the generating basic rack (:func:`undercut_limit`; the field named sets the
+  gear's profile shift: the planet's own, the sun's through the centre distance);
 - tooth thickness at the tip > 0 for sun, planet and ring (no pointed tooth), psi(r_a) of
   :meth:`flexgear.geometry.involute.Gear.tooth_half_angle`; the field named is the one that makes it pointed
   (backlash, addendum or the profile shift, which the centre distance sets for sun and ring);
@@ -43,7 +45,7 @@ from flexgear.geometry.involute import Gear, gear_set_geometry, transverse_press
 from flexgear.geometry.profile import ToothProfile, tooth_profile
 from flexgear.spec import GearboxSpec, SpecError, register_feasibility_check
 
-__all__ = ["check_feasibility"]
+__all__ = ["check_feasibility", "undercut_limit"]
 
 _MM = 1e-3
 _ELEMENTS_PER_CURVE = 500.0
@@ -107,20 +109,39 @@ def _pointed_field(spec: GearboxSpec, name: str, gear: Gear) -> str:
     return max(losses, key=losses.__getitem__)
 
 
+def undercut_limit(gear: Gear, fillet_coefficient: float) -> float:
+    """Smallest profile shift of an external gear that the generating basic rack does not undercut:
+    x_min = h_s - z sin^2(alpha_t) / (2 cos beta), h_s = h_f - rho_f (1 - sin alpha_n) the rack's straight flank
+    beyond its reference line per m_n (the rack's addendum, the gear's dedendum h_f, ends in the root fillet rho_f):
+    its flank must not reach past the interference point, r sin^2(alpha_t) from the reference line."""
+    h = gear.dedendum_coefficient - fillet_coefficient * (1.0 - math.sin(gear.normal_pressure_angle))
+    return h - gear.teeth * math.sin(gear.transverse_pressure_angle) ** 2 / (2.0 * math.cos(gear.helix_angle))
+
+
+def _shift_field(name: str) -> str:
+    """The field that sets an external gear's profile shift: the planet's own, the sun's through the centre
+    distance."""
+    return ("gears_assumed.planet_shift_coefficient" if name == "planet"
+            else "gears_assumed.operating_centre_distance_mm")
+
+
 def _teeth(spec: GearboxSpec) -> None:
     gs = gear_set_geometry(spec)
     g = spec.gears
     for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
         if gear.internal and gear.tip_radius <= gear.base_radius:
-            raise SpecError(spec.source, "gears_assumed.addendum_coefficient",
-                            f"the ring's tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
-                            f"(d = {2e3 * gear.base_radius:.2f} mm): no involute at the tip; expected a smaller value",
-                            spec.gears_assumed.addendum_coefficient)
+            # the ring's shift follows the planet's: a negative planet shift pulls the ring's tips inwards
+            field = ("gears_assumed.planet_shift_coefficient" if gear.shift > 0
+                     and spec.gears_assumed.planet_shift_coefficient < 0 else "gears_assumed.addendum_coefficient")
+            raise SpecError(spec.source, field,
+                            f"the ring's tip circle (d = {2e3 * gear.tip_radius:.2f} mm, profile shift x = "
+                            f"{gear.shift:.3f}) lies inside its base circle (d = {2e3 * gear.base_radius:.2f} mm): "
+                            "no involute at the tip; expected a value that puts the tip circle outside it",
+                            _value(spec, field))
         if not gear.internal and gear.tip_radius <= gear.base_radius:  # r_a = r + m_n (h_a + x) <= r_b
             field = "gears_assumed.addendum_coefficient"
             if gear.shift < 0:  # the planet's own shift, or the sun's that the centre distance sets
-                field = ("gears_assumed.planet_shift_coefficient" if name == "planet"
-                         else "gears_assumed.operating_centre_distance_mm")
+                field = _shift_field(name)
             raise SpecError(spec.source, field,
                             f"the {name}'s tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
                             f"(d = {2e3 * gear.base_radius:.2f} mm, profile shift x = {gear.shift:.3f}): no involute "
@@ -131,6 +152,15 @@ def _teeth(spec: GearboxSpec) -> None:
             raise SpecError(spec.source, field,
                             f"makes the {name} tooth pointed (no tooth thickness left at the tip circle, profile "
                             f"shift x = {gear.shift:.3f}); expected a value that leaves a tip thickness > 0",
+                            _value(spec, field))
+    for name, gear in (("sun", gs.sun), ("planet", gs.planet)):  # after the tips: a pointed tooth is named first
+        limit = undercut_limit(gear, spec.gears_assumed.root_fillet_coefficient)
+        if gear.shift < limit - 1e-9:
+            field = _shift_field(name)
+            raise SpecError(spec.source, field,
+                            f"the {name} ({gear.teeth} teeth) is undercut by the generating rack: profile shift "
+                            f"x = {gear.shift:.3f} < {limit:.3f} (x_min = h_s - z sin^2(alpha_t) / (2 cos beta)); "
+                            "expected a value that gives it a larger profile shift, or more teeth",
                             _value(spec, field))
     tip_d = 2 * gs.planet.tip_radius
     spacing = 2 * gs.centre_distance * math.sin(math.pi / g.planet_count) if g.planet_count > 1 else math.inf
