@@ -46,7 +46,7 @@ class GearSetCase:
 
 
 CASES = {
-    "spur_double_12_18_48_m20_a25": GearSetCase((12, 18, 48), 3, 20.0, 0.0, 25.0, -0.5, "double"),
+    "spur_double_12_18_48_m20_a25": GearSetCase((12, 18, 48), 3, 20.0, 0.0, 25.0, -0.3, "double"),
     "single_13_17_47_m10_b30_a20": GearSetCase((13, 17, 47), 3, 10.0, 30.0, 20.0, 0.0, "single"),
     "double_16_16_48_m5_b20_a20": GearSetCase((16, 16, 48), 4, 5.0, 20.0, 20.0, 0.0, "double"),
     "spur_30_58_150_m1_a14.5": GearSetCase((30, 58, 150), 3, 1.0, 0.0, 14.5, 0.8, "single"),
@@ -192,6 +192,9 @@ REFUSED = {
                                             root_fillet_coefficient=0.38),
                                       "gears_assumed.root_fillet_coefficient", ("ring's root fillets", "< 0.303")),
     # the 12-tooth sun at 25 deg needs x >= 0.005; a planet shift of +0.3 leaves it -0.3
+    # x_p -0.5 gives the ring +0.5 (its tips inwards): they reach into the planet's base circle
+    "ring_tips_interfere": (_with(GearSetCase((12, 18, 48), 3, 20.0, 0.0, 25.0, -0.5, "single")),
+                            "gears_assumed.addendum_coefficient", ("ring's tips interfere", "planet-ring")),
     "sun_undercut": (_with(GearSetCase((12, 18, 48), 3, 20.0, 0.0, 25.0, 0.3, "single")),
                      "gears_assumed.operating_centre_distance_mm", ("sun (12 teeth) is undercut", "< 0.005")),
     "ring_spaces_close_above_the_root": (_with(dataclasses.replace(SPUR, pressure_deg=25.0), dedendum_coefficient=2.0),

@@ -7,6 +7,7 @@ field that causes the problem and what is allowed:
   (the equal-spacing assembly condition is checked in :mod:`flexgear.spec`);
 - centre distance: reachable by profile shifts, cos(alpha_wt) = a_0 cos(alpha_t) / a_w < 1 for both meshes
   (ISO 21771 centre-distance equation), also the mean standard centre distance that 0 selects;
+- no involute interference: along each mesh's line of action no tip passes the mate's base-circle tangent point;
 - no undercut of sun and planet by the generating basic rack (:func:`undercut_limit`; the field named sets the
   gear's profile shift: the planet's own, the sun's through the centre distance);
 - tooth thickness at the tip > 0 for sun, planet and ring (no pointed tooth), psi(r_a) of
@@ -170,6 +171,25 @@ def _teeth(spec: GearboxSpec) -> None:
         raise SpecError(spec.source, "gears.planet_count",
                         f"neighbouring planets' tip circles overlap (centre spacing {spacing / _MM:.2f} mm <= "
                         f"tip diameter {tip_d / _MM:.2f} mm); expected at most {fit} planets", g.planet_count)
+
+
+def _interference(spec: GearboxSpec) -> None:
+    """No involute interference: along each mesh's line of action a tip must not pass the mate's base-circle
+    tangent point T (beyond it the mate has no involute): external pair sqrt(r_a^2 - r_b^2) <= a_w sin(alpha_wt)
+    for each gear; internal pair the ring's tip sqrt(r_a2^2 - r_b2^2) >= a_w sin(alpha_wt)."""
+    gs = gear_set_geometry(spec)
+    for names, mesh in ((("sun", "planet"), gs.sun_planet), (("planet", "ring"), gs.planet_ring)):
+        gw = mesh.centre_distance * math.sin(mesh.operating_pressure_angle)
+        label = "-".join(names)
+        for (name, other), gear in ((names, mesh.gear1), (names[::-1], mesh.gear2)):
+            reach = math.sqrt(max(gear.tip_radius ** 2 - gear.base_radius ** 2, 0.0))
+            bad = reach < gw - 1e-12 if gear.internal else (not mesh.internal and reach > gw + 1e-12)
+            if bad:
+                raise SpecError(spec.source, "gears_assumed.addendum_coefficient",
+                                f"the {name}'s tips interfere with the {other} in the {label} mesh: they reach "
+                                f"{reach / _MM:.3f} mm along the line of action against {gw / _MM:.3f} mm to the "
+                                f"{other}'s base-circle tangent point, below which it has no involute; expected a "
+                                "smaller addendum (or other profile shifts)", spec.gears_assumed.addendum_coefficient)
 
 
 def _profile_fits(gear: Gear, fillet_radius: float) -> bool:
@@ -336,6 +356,7 @@ def check_feasibility(spec: GearboxSpec) -> None:
     _backlash(spec)
     _reachable_centre_distance(spec)
     _teeth(spec)
+    _interference(spec)
     _profiles(spec)
     _components(spec)
     _mesh_sizes(spec)
