@@ -54,7 +54,7 @@ _LAZY = {
     # signals and solving
     "Recorder": "mbs.recording", "solve": "mbs.recording", "solver_settings": "mbs.recording",
     # the study's gearbox
-    "build_gearbox": "mbs.gearbox", "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox",
+    "build_gearbox": "mbs.assemble", "build_star_gearbox": "mbs.gearbox", "mesh_contacts": "mbs.gearbox",
     "run_variant": "mbs.run",
     # the facade: a gearbox and its flexible components in; runs, linear models, modes, reports out
     "Simulation": "simulation",

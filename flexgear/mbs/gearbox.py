@@ -1,5 +1,5 @@
 """Model: a single-stage gearbox assembled from bodies and connectors; here the star (carrier fixed), the
-planetary stage in flexgear.mbs.planetary, both through :func:`build_gearbox`.
+planetary stage in flexgear.mbs.planetary, either through flexgear.mbs.assemble.build_gearbox.
 
 The assembly follows section 2.1 of the study: input shaft fixed to the sun, ring fixed to the
 output shaft (for rigid parts the fixed joint merges the two into one body, which is exact),
@@ -42,8 +42,8 @@ from flexgear.mbs.train import add_gear_train
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory
 
-__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_gearbox", "build_star_gearbox", "mass_source_of",
-           "dynamic_modes", "run_cost"]
+__all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
+           "run_cost"]
 
 
 @dataclass
@@ -274,20 +274,6 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     if geometry not in cache:
         cache[geometry] = dropped_modes(spec, full, keep, geometry)
     return replace(body, dropped=cache[geometry])
-
-
-def build_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
-                  reduced_source: ReducedSource | None = None, superelements: bool = False,
-                  design: Design | None = None) -> GearboxModel:
-    """Assemble the gearbox of ``variant`` into ``mbs`` in its ``[gears] arrangement``: the star
-    (:func:`build_star_gearbox`) or the planetary stage (flexgear.mbs.planetary, rigid components). Call
-    ``mbs.Assemble()`` afterwards."""
-    d = as_design(variant.gearbox if design is None else design)
-    if d.spec.gears.arrangement == "planetary":
-        from flexgear.mbs.planetary import build_planetary_gearbox
-
-        return build_planetary_gearbox(mbs, variant, mass_source, design=d)
-    return build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements, design=d)
 
 
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,

@@ -28,6 +28,7 @@ from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.carrier import Carrier, add_planet_bearing
 from flexgear.mbs.elements import add_fixed_joint, add_load_torque, add_speed_drive, add_support, interface_spin_marker
+from flexgear.mbs.gearbox import GearboxModel, helix_halves, mass_source_of, mesh_contacts
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import GearboxSpec, Variant
 
@@ -44,9 +45,7 @@ def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
 def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Design | None = None):
     """Assemble the planetary gearbox of ``variant`` (every component rigid) into ``mbs``; returns its
     flexgear.mbs.gearbox.GearboxModel (output body: the carrier). ``mass_source`` (spec, geometry) ->
-    MassProperties overrides the variant's rigid mass properties, as in flexgear.mbs.gearbox.build_gearbox."""
-    from flexgear.mbs.gearbox import GearboxModel, helix_halves, mass_source_of, mesh_contacts
-
+    MassProperties overrides the variant's rigid mass properties, as in flexgear.mbs.assemble.build_gearbox."""
     d = as_design(variant.gearbox if design is None else design)
     spec, th, geo = d.spec, d.theory, d.gears
     flexible = [c for c, f in variant.components.items() if f != "rigid"]

@@ -24,8 +24,9 @@ import numpy as np
 import pandas as pd
 
 from flexgear.design import design
+from flexgear.mbs.assemble import build_gearbox
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
-from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource, build_gearbox
+from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource
 from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table

@@ -57,6 +57,7 @@ from flexgear.study.pool import (
     run_task,
     save_task_result,
     say_progress,
+    write_table,
 )
 from flexgear.study.purposes import ALL_PURPOSES, verdict_table
 from flexgear.study.screening import ReferenceNotUsable, Selection, screen
@@ -65,13 +66,6 @@ __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "
            "screen_directory"]
 
 # --------------------------------------------------------------------------- tables
-def write_table(table: pd.DataFrame, stem: Path) -> None:
-    """Write ``stem.csv`` and ``stem.parquet`` atomically."""
-    atomic_write_bytes(stem.with_suffix(".csv"), table.to_csv(index=False).encode())
-    atomic_write_bytes(stem.with_suffix(".parquet"), table.to_parquet(index=False))
-
-
-# --------------------------------------------------------------------------- execution
 # --------------------------------------------------------------------------- matrix
 def _row(name: str, meta: dict, resumed: bool) -> dict[str, Any]:
     comps = meta.get("components") or {}

@@ -20,12 +20,15 @@ from multiprocessing import get_context
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
+
+from flexgear.cache import atomic_write_bytes
 from flexgear.progress import Progress, say
 from flexgear.results import RunResult, save_result
 from flexgear.spec import Variant, load_variant, spec_hash
 
 __all__ = ["Runner", "RunTask", "make_task", "run_input_hash", "run_task", "save_task_result", "failed_result",
-           "execute", "say_progress"]
+           "execute", "say_progress", "write_table"]
 
 Runner = Callable[..., RunResult]
 
@@ -117,6 +120,15 @@ def save_task_result(task: RunTask, result: RunResult, run_dir: Path) -> dict[st
     """Caller side: write the result and copies of its input files; return its metadata."""
     save_result(result, run_dir, inputs=task.inputs())
     return dict(result.meta)
+
+
+def write_table(table: pd.DataFrame, stem: Path) -> None:
+    """Write ``stem.csv`` and ``stem.parquet`` atomically."""
+    atomic_write_bytes(stem.with_suffix(".csv"), table.to_csv(index=False).encode())
+    atomic_write_bytes(stem.with_suffix(".parquet"), table.to_parquet(index=False))
+
+
+# --------------------------------------------------------------------------- execution
 
 
 def say_progress(progress: bool, text: str) -> None:

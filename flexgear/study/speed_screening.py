@@ -200,7 +200,7 @@ def write_speed_screening(out_dir: str | Path, result: SpeedScreening | BaseExce
     the variants' load-case input speed) and one line per band in the text; returns the text. A failed screening
     (the exception as ``result``) is one line in the text."""
     from flexgear.cache import atomic_write_bytes
-    from flexgear.study.matrix import write_table
+    from flexgear.study.pool import write_table
 
     out = Path(out_dir)
     out.mkdir(parents=True, exist_ok=True)
@@ -400,7 +400,7 @@ def speed_bands(out_dir: str | Path, operating_rpm: float | None = None) -> pd.D
     than the verdict's (the verdict's reference differs from itself in speed_screening.csv)."""
     import json
 
-    from flexgear.study.matrix import write_table
+    from flexgear.study.pool import write_table
 
     out = Path(out_dir)
     saved = out / "screening.json"
