@@ -48,7 +48,7 @@ class GearSetCase:
 CASES = {
     "spur_double_12_18_48_m20_a25": GearSetCase((12, 18, 48), 3, 20.0, 0.0, 25.0, -0.3, "double"),
     "single_13_17_47_m10_b30_a20": GearSetCase((13, 17, 47), 3, 10.0, 30.0, 20.0, 0.0, "single"),
-    "double_16_16_48_m5_b20_a20": GearSetCase((16, 16, 48), 4, 5.0, 20.0, 20.0, 0.0, "double"),
+    "double_14_22_58_m5_b20_a20": GearSetCase((14, 22, 58), 3, 5.0, 20.0, 20.0, -0.2, "double"),
     "spur_30_58_150_m1_a14.5": GearSetCase((30, 58, 150), 3, 1.0, 0.0, 14.5, 0.8, "single"),
 }
 

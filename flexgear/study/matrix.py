@@ -148,14 +148,18 @@ def write_modal_verdict(out_dir: Path, name: str, screened: Any, progress: bool 
     return text
 
 
-def modal_verdict(out_dir: Path, reference: Variant, progress: bool = False) -> str:
-    """:func:`write_modal_verdict` of the all-flexible ``reference`` variant, screened here (:func:`modal_job`)."""
+def modal_verdict(out_dir: Path, reference: Any, progress: bool = False) -> str:
+    """:func:`write_modal_verdict` of the all-flexible ``reference`` (a Variant, or its flexgear.modal.LinearModel
+    at the operating point), screened here."""
+    from flexgear.modal.screening import modal_screening
+
+    name = reference.variant.name if hasattr(reference, "variant") else getattr(reference, "name", str(reference))
     try:
-        screened: Any = modal_job(str(reference.source), Path(reference.source).read_text(),
-                                  Path(reference.gearbox.source).read_text())
+        m = modal_screening(reference)
+        screened: Any = (m.table, m.mode_table(), m.recommended, m.f_band_hz)
     except Exception as exc:  # recorded: the time-domain screening does not depend on it
         screened = exc
-    return write_modal_verdict(out_dir, reference.name, screened, progress)
+    return write_modal_verdict(out_dir, name, screened, progress)
 
 
 def _check_reference(reference: str, names: Sequence[str]) -> None:
