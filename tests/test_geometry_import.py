@@ -165,7 +165,7 @@ def _held_frequencies(body, name: str) -> np.ndarray:
     return np.sqrt(la.eigh(basis.T @ stiffness @ basis, basis.T @ mass @ basis, eigvals_only=True)) / (2 * np.pi)
 
 
-@pytest.mark.slow
+@pytest.mark.heavy  # about 100 s of CPU (STEP read, remeshing, reduction): make test-heavy
 def test_step_round_trip_gives_the_built_in_reduced_body(gearbox, exported, tmp_path, monkeypatch):
     """The solid is meshed anew from the STEP file: Netgen meshes the translated solid differently (69560 nodes
     against 69888), so the bodies agree to the coarse mesh's variation, not to round-off. Measured: mass 2.8e-7,

@@ -70,6 +70,7 @@ def test_the_example_is_the_study_gearbox_with_its_ring_from_a_file(example, gea
     assert "SI_UNIT(.MILLI.,.METRE.)" in (example / "parts" / "ring_lightened.step").read_text(errors="replace")
 
 
+@pytest.mark.heavy  # about 140 s of CPU (the full FE model's factorisation and clamped modes): make test-heavy
 def test_lightened_ring_against_its_full_fe_model(example, gearbox):
     from test_rigid_partner import Clamped, held_frequencies
 
