@@ -77,6 +77,7 @@ def test_rigid_and_all_flexible_variants_meet_hand_theory(tmp_path, example_cach
         np.testing.assert_allclose(forces, force, rtol=0.01, err_msg=name)
 
 
+@pytest.mark.heavy  # the ring's own reduction and its full FE factorisation and modes: make test-heavy
 def test_flexible_spur_ring_against_its_full_fe_model(example_cache, gearbox):
     from test_rigid_partner import Clamped, held_frequencies
 
