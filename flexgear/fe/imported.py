@@ -25,14 +25,13 @@ from __future__ import annotations
 import contextlib
 import math
 import os
-import time
 from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
 
-from flexgear.cache import cache_dir, check_digest, load_or_build, record_digest
+from flexgear.cache import cache_dir
 from flexgear.design import Design, as_design
 from flexgear.fe.mesh import (
     GRADING,
@@ -44,8 +43,8 @@ from flexgear.fe.mesh import (
     source_mesh,
 )
 from flexgear.fe.mesh_io import MeshFileError, boundary_faces, netgen_mesh, read_volume_mesh
+from flexgear.fe.parts import cached_brep, register_file_parts
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
-from flexgear.progress import say
 from flexgear.schema_geometry import ComponentGeometry
 from flexgear.spec import GearboxSpec
 
@@ -96,16 +95,9 @@ def imported_brep(spec: GearboxSpec | Design, component: str, progress: bool = F
         raise GeometryFileError(component, entry, "is a volume mesh; it has no solid (export its mesh instead)")
     path = cache_dir() / f"solid-{layout.name}-{geometry_hash(d.spec, component, IMPORT_VERSION)}.brep"
 
-    def load() -> Path | None:
-        if not path.exists():
-            return None
-        check_digest(path)
-        return path
-
-    def build() -> Path:
+    def read() -> object:
         from netgen.occ import OCCGeometry, Pnt
 
-        t0 = time.perf_counter()
         try:
             with _quiet():
                 shape = OCCGeometry(str(entry.source)).shape
@@ -123,15 +115,9 @@ def imported_brep(spec: GearboxSpec | Design, component: str, progress: bool = F
             solid = solid.Scale(Pnt(0, 0, 0), entry.scale)
         lo, hi = solid.bounding_box
         _check_extent(component, entry, layout, max(abs(lo[0]), abs(lo[1]), abs(hi[0]), abs(hi[1])))
-        tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp.brep")
-        solid.WriteBrep(str(tmp))
-        tmp.replace(path)
-        record_digest(path)
-        if progress:
-            say(f"  {component}: solid read from {entry.source.name} in {time.perf_counter() - t0:.1f} s")
-        return path
+        return solid
 
-    return load_or_build(path, load, build)
+    return cached_brep(path, read, f"{component}: solid read from {entry.source.name}", progress)
 
 
 def _check_extent(component: str, entry: ComponentGeometry, layout: ComponentLayout, radius: float) -> None:
@@ -300,3 +286,6 @@ def _check_flanks(component: str, entry: ComponentGeometry, layout: ComponentLay
     if len(np.unique(half)) != 2 * g.teeth:
         raise GeometryFileError(component, entry, f"flank nodes on {len(np.unique(half))} of the "
                                 f"{2 * g.teeth} flanks of the gear data's {g.teeth} teeth")
+
+
+register_file_parts(imported_brep, imported_mesh)

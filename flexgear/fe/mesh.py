@@ -28,9 +28,7 @@ from __future__ import annotations
 
 import io
 import json
-import os
 import time
-import uuid
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -40,13 +38,12 @@ import numpy as np
 from flexgear.cache import (
     atomic_write_bytes,
     cache_dir,
-    check_digest,
     check_gzip,
     load_or_build,
     read_entry,
-    record_digest,
 )
 from flexgear.design import Design, as_design
+from flexgear.fe.parts import cached_brep, file_parts, private_temporary
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
 from flexgear.progress import say
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, MeshingSettings
@@ -120,12 +117,6 @@ def _load_netgen_mesh(vol: Path, brep: Path):
     return ngmesh
 
 
-def _private_temporary(path: Path, suffix: str) -> Path:
-    """A temporary name next to ``path``, unique to this process and call (two workers building the same
-    cache entry must not write into one file), ending in ``suffix`` (the writers choose the format by it)."""
-    return path.with_name(f".{path.name}.{os.getpid()}-{uuid.uuid4().hex[:8]}.tmp{suffix}")
-
-
 @dataclass(frozen=True)
 class MeshSizes:
     """Netgen settings of a mesh: element size on the tooth (and bolt-hole) faces and elsewhere [m], Netgen's
@@ -169,9 +160,7 @@ def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = 
     checked against its digest; built on a cache miss or when the file does not match its digest."""
     d = as_design(spec)
     if component in d.spec.components_geometry:  # the user's solid ([components_geometry])
-        from flexgear.fe.imported import imported_brep
-
-        return imported_brep(d, component, progress)
+        return file_parts()[0](d, component, progress)
     return layout_brep(d.layouts[component], geometry_hash(d.spec, component), progress)
 
 
@@ -179,28 +168,10 @@ def layout_brep(layout: ComponentLayout, key: str, progress: bool = False) -> Pa
     """Path of the cached OCC solid (``solid-<layout name>-<key>.brep``) of ``layout``
     (flexgear.geometry.solids.component_solid), checked against its digest; built on a cache miss or when the
     file does not match its digest. ``key``: a hash of everything the layout is made from."""
-    component = layout.name
-    path = cache_dir() / f"solid-{component}-{key}.brep"
+    from flexgear.geometry.solids import component_solid
 
-    def load() -> Path | None:
-        if not path.exists():
-            return None
-        check_digest(path)
-        return path
-
-    def build() -> Path:
-        from flexgear.geometry.solids import component_solid
-
-        t0 = time.perf_counter()
-        shape = component_solid(layout)
-        tmp = _private_temporary(path, ".brep")
-        shape.WriteBrep(str(tmp))
-        tmp.replace(path)
-        record_digest(path)
-        _say(progress, f"  {component}: solid built in {time.perf_counter() - t0:.1f} s")
-        return path
-
-    return load_or_build(path, load, build)
+    return cached_brep(cache_dir() / f"solid-{layout.name}-{key}.brep", lambda: component_solid(layout),
+                       f"{layout.name}: solid built", progress)
 
 
 def _say(progress: bool, text: str) -> None:
@@ -329,9 +300,7 @@ def component_mesh(spec: GearboxSpec | Design, component: str, level: str = "coa
                          f"{', '.join(sorted(spec.meshing_assumed))}")
     order = spec.meshing_assumed[level].element_order if order is None else order
     if component in spec.components_geometry:  # the user's solid or volume mesh ([components_geometry])
-        from flexgear.fe.imported import imported_mesh
-
-        return imported_mesh(d, component, level, order, progress)
+        return file_parts()[1](d, component, level, order, progress)
     return source_mesh(_study_source(d, component, level), order, progress)
 
 
@@ -409,7 +378,7 @@ def _build_mesh(source: MeshSource, order: int, paths: dict[str, Path], brep: Pa
     surface = _orient_outward(nodes, surface)
     regions = source.regions(nodes, np.unique(surface))
     mesh = ComponentMesh(component, level, order, nodes, elements, surface, regions, build, paths["vol"], brep)
-    tmp_vol = _private_temporary(paths["vol"], ".vol.gz")
+    tmp_vol = private_temporary(paths["vol"], ".vol.gz")
     ngmesh.Save(str(tmp_vol))
     tmp_vol.replace(paths["vol"])
     buf = io.BytesIO()
