@@ -126,27 +126,27 @@ def _shift_field(name: str) -> str:
             else "gears_assumed.operating_centre_distance_mm")
 
 
+def _tip_inside_field(spec: GearboxSpec, name: str, gear: Gear) -> str:
+    """The field that puts a gear's tip circle inside its base circle: its profile shift where that is negative
+    (an external gear's own, the sun's through the centre distance; the ring's follows a negative planet shift
+    with the opposite sign), else the addendum."""
+    if not gear.internal and gear.shift < 0:
+        return _shift_field(name)
+    if gear.internal and gear.shift > 0 and spec.gears_assumed.planet_shift_coefficient < 0:
+        return "gears_assumed.planet_shift_coefficient"
+    return "gears_assumed.addendum_coefficient"
+
+
 def _teeth(spec: GearboxSpec) -> None:
     gs = gear_set_geometry(spec)
     g = spec.gears
     for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
-        if gear.internal and gear.tip_radius <= gear.base_radius:
-            # the ring's shift follows the planet's: a negative planet shift pulls the ring's tips inwards
-            field = ("gears_assumed.planet_shift_coefficient" if gear.shift > 0
-                     and spec.gears_assumed.planet_shift_coefficient < 0 else "gears_assumed.addendum_coefficient")
+        if gear.tip_radius <= gear.base_radius:  # external r_a = r + m_n (h_a + x) <= r_b; the ring's tips inwards
+            field = _tip_inside_field(spec, name, gear)
             raise SpecError(spec.source, field,
-                            f"the ring's tip circle (d = {2e3 * gear.tip_radius:.2f} mm, profile shift x = "
+                            f"the {name}'s tip circle (d = {2e3 * gear.tip_radius:.2f} mm, profile shift x = "
                             f"{gear.shift:.3f}) lies inside its base circle (d = {2e3 * gear.base_radius:.2f} mm): "
                             "no involute at the tip; expected a value that puts the tip circle outside it",
-                            _value(spec, field))
-        if not gear.internal and gear.tip_radius <= gear.base_radius:  # r_a = r + m_n (h_a + x) <= r_b
-            field = "gears_assumed.addendum_coefficient"
-            if gear.shift < 0:  # the planet's own shift, or the sun's that the centre distance sets
-                field = _shift_field(name)
-            raise SpecError(spec.source, field,
-                            f"the {name}'s tip circle (d = {2e3 * gear.tip_radius:.2f} mm) lies inside its base circle "
-                            f"(d = {2e3 * gear.base_radius:.2f} mm, profile shift x = {gear.shift:.3f}): no involute "
-                            "flank; expected a value that puts the tip circle outside the base circle",
                             _value(spec, field))
         if _tip_thickness(gear) <= 0:
             field = _pointed_field(spec, name, gear)
