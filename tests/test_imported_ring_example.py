@@ -72,29 +72,10 @@ def test_the_example_is_the_study_gearbox_with_its_ring_from_a_file(example, gea
 
 @pytest.mark.heavy  # about 140 s of CPU (the full FE model's factorisation and clamped modes): make test-heavy
 def test_lightened_ring_against_its_full_fe_model(example, gearbox):
-    from test_rigid_partner import Clamped, held_frequencies
+    from test_rigid_partner import ring_against_full_fe
 
-    from flexgear.fe.compliance import _kernel_loads
-    from flexgear.fe.reduced import component_contacts, component_load_circles, component_reduced_body
-    from flexgear.fe.ring_shaft import part_fe_model
-    from flexgear.theory import theory
-
-    fe = part_fe_model(gearbox, "ring", "coarse")
-    body = component_reduced_body(gearbox, "ring", "coarse")
-    assert np.array_equal(body.nodes, fe.nodes)
-    clamped = Clamped(fe, body.interface("bolt_patches").nodes)
-    band = 3.0 * theory(gearbox).mesh_frequency
-    full = clamped.frequencies(K_MODES)
-    n = int(np.sum(full < band))
+    n = ring_against_full_fe(gearbox, K_MODES)
     assert 60 <= n < K_MODES, n  # every clamped mode in the band is compared (measured: 74, 4.04-12.90 kHz)
-    np.testing.assert_allclose(held_frequencies(body, "bolt_patches", n), full[:n], rtol=0.01)
-
-    points, normals = component_contacts(gearbox, "ring")
-    kernel = component_load_circles(gearbox, "ring", gearbox.reduction_assumed.contact_fourier_order)
-    full_c = clamped.compliance(_kernel_loads(fe.nodes, kernel, points, normals))
-    reduced = fg.static_compliance(body, points, normals, "bolt_patches", kernel=kernel)
-    assert np.max(np.abs(reduced - full_c)) < 0.02 * np.max(np.abs(full_c))
-    assert reduced.sum(axis=1) == pytest.approx(full_c.sum(axis=1), rel=0.02)
 
 
 K_MODES = 90
