@@ -61,6 +61,7 @@ from flexgear.study.pool import (
 )
 from flexgear.study.purposes import ALL_PURPOSES, verdict_table
 from flexgear.study.screening import ReferenceNotUsable, Selection, screen
+from flexgear.study.speed_screening import job_files, operating_speed_rpm, speed_job, write_speed_screening
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
@@ -199,6 +200,7 @@ class _Folder:
     resumed: set[str] = dataclasses.field(default_factory=set)
     tasks: list[RunTask] = dataclasses.field(default_factory=list)
     pending: dict[str, Variant] = dataclasses.field(default_factory=dict)
+    variants: dict[str, Variant] = dataclasses.field(default_factory=dict)  # every loaded variant file
     settings: ScreeningSettings | None = None
     reference: str = ""
 
@@ -237,6 +239,7 @@ def _prepare(out_dir: Path, paths: list[Path], t_end_s: float | str | None, time
             raise SpecError(path, "name", f"variant names in a matrix must be unique; {name!r} is used twice")
         f.names.append(name)
         f.files[name] = path
+        f.variants[name] = variant
         f.settings = f.settings or variant.gearbox.screening
         f.reference = reference if reference is not None else f.settings.reference
         task = make_task(variant, t_end_s, time_budget_s,
@@ -259,17 +262,12 @@ def _jobs(f: _Folder, speeds_rpm: Sequence[float] | None, modal: bool) -> list[t
     """The folder's screenings that need no run, for the pool: the modal screening of an all-flexible reference,
     the speed screening of its variants."""
     jobs: list[tuple[Any, Callable, tuple]] = []
-    ref_file = f.files.get(f.reference)
-    if modal and ref_file is not None:
-        ref = load_variant(ref_file)
-        if all(form == "flexible" for form in ref.components.values()):
-            jobs.append((("modal", str(f.out_dir)), modal_job,
-                         (str(ref_file), ref_file.read_text(), Path(ref.gearbox.source).read_text())))
-    if speeds_rpm and f.files:
-        from flexgear.study.speed_screening import job_files, speed_job
-
-        files = job_files([f.files[n] for n in f.names if n in f.files])
-        jobs.append((("speed", str(f.out_dir)), speed_job, (files, list(speeds_rpm), f.reference)))
+    ref = f.variants.get(f.reference)
+    if modal and ref is not None and all(form == "flexible" for form in ref.components.values()):
+        jobs.append((("modal", str(f.out_dir)), modal_job, *job_files([ref])))
+    if speeds_rpm and f.variants:
+        jobs.append((("speed", str(f.out_dir)), speed_job,
+                     (job_files(f.variants.values()), list(speeds_rpm), f.reference)))
     return jobs
 
 
@@ -284,9 +282,7 @@ def _finish(f: _Folder, metas: dict, done: dict, progress: bool, reference: str 
     if ("modal", str(f.out_dir)) in done:
         write_modal_verdict(f.out_dir, f.reference, done["modal", str(f.out_dir)], progress)
     if ("speed", str(f.out_dir)) in done:
-        from flexgear.study.speed_screening import operating_speed_rpm, write_speed_screening
-
-        write_speed_screening(f.out_dir, done["speed", str(f.out_dir)], operating_speed_rpm(list(f.files.values())))
+        write_speed_screening(f.out_dir, done["speed", str(f.out_dir)], operating_speed_rpm(f.variants.values()))
     screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
                                            "selected"])
     return table.merge(screening, on="variant", how="left")

@@ -218,22 +218,15 @@ def write_speed_screening(out_dir: str | Path, result: SpeedScreening | BaseExce
     return text
 
 
-def job_files(variant_paths: Sequence[str | Path]) -> list[tuple[str, str, str]]:
-    """(variant file, its text, its gearbox file's text) of each variant file, for :func:`speed_job`."""
-    from flexgear.spec import load_variant
-
-    out = []
-    for path in map(Path, variant_paths):
-        variant = load_variant(path)
-        out.append((str(path), path.read_text(), Path(variant.gearbox.source).read_text()))
-    return out
+def job_files(variants: Sequence[Any]) -> list[tuple[str, str, str]]:
+    """(variant file, its text, its gearbox file's text) of each loaded variant (flexgear.spec.Variant), for
+    :func:`speed_job`."""
+    return [(str(v.source), Path(v.source).read_text(), Path(v.gearbox.source).read_text()) for v in variants]
 
 
-def operating_speed_rpm(variant_paths: Sequence[str | Path]) -> float | None:
+def operating_speed_rpm(variants: Sequence[Any]) -> float | None:
     """The variants' common load-case input speed [rpm], None when they differ."""
-    from flexgear.spec import load_variant
-
-    speeds = {float(load_variant(p).gearbox.load_case.input_speed_rpm) for p in variant_paths}
+    speeds = {float(v.gearbox.load_case.input_speed_rpm) for v in variants}
     return speeds.pop() if len(speeds) == 1 else None
 
 
@@ -250,7 +243,7 @@ def screen_speed_range(variant_paths: Sequence[str | Path], out_dir: str | Path,
         raise ValueError("no variants to screen over the speed range")
     ref = reference if reference is not None else variants[0].gearbox.screening.reference
     result = speed_screening(variants, speeds_rpm, ref or "", harmonics)
-    return write_speed_screening(out_dir, result, operating_speed_rpm(variant_paths))
+    return write_speed_screening(out_dir, result, operating_speed_rpm(variants))
 
 
 # --------------------------------------------------------------------------- acceptable speed band
