@@ -17,7 +17,7 @@ over the bolts' clamped discs, flexgear.fe.ring_shaft.tied_pair: the body of the
 - Spectrum. Both levels as the production reduction builds the FE model (flexgear.fe.ring_shaft.part_fe_model: the
   level's element order raised on the first-order mesh), every free-free mode below 1.05 x the band (``--band-orders``
   x the mesh frequency of the load case, flexgear.theory.mesh_frequency_hz: 3 x 4400 Hz), by the project's
-  shift-invert block Lanczos on the Cholesky factor of the free body (flexgear.fe.cms._FreeBodySolver). The six
+  shift-invert block Lanczos on the Cholesky factor of the free body (flexgear.fe.cms.FreeBodySolver). The six
   rigid-body modes are removed exactly: the eigenproblem is solved on the constraint (M R)^T phi = 0 (R the rigid
   modes), as flexgear.fe.cms.full_free_modes does, so every mode found is elastic.
 - Pairing. By order: the k-th elastic mode of the base with the k-th of the reference, for every k up to the larger
@@ -98,10 +98,10 @@ def fe_of(spec, body: str, level: str):
 
 def free_modes(fe, f_max_hz: float) -> tuple[np.ndarray, np.ndarray]:
     """Every elastic free-free mode below ``f_max_hz``: frequencies [Hz], M-orthonormal shapes (3n, k)."""
-    from flexgear.fe.cms import _FreeBodySolver
+    from flexgear.fe.cms import FreeBodySolver
     from flexgear.fe.spectrum import lowest_eigenpairs
 
-    solver = _FreeBodySolver(fe)
+    solver = FreeBodySolver(fe)
     m = fe.mass_operator()
     free = solver.constrained((m @ solver.R).T)  # rigid-body modes removed: (M R)^T phi = 0
     lam, vec = lowest_eigenpairs(lambda k, found: free.eigen(fe, k, m, found), max_hz=f_max_hz)

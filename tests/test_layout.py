@@ -115,3 +115,26 @@ def test_private_name_scan_sees_every_form(tmp_path):
     lines = [line for line, target in sorted(_private_uses(pkg / "b.py", modules, tmp_path))
              if target == "flexgear.sub.a._x"]
     assert lines == [1, 5, 9, 9, 9]
+
+
+def test_benchmarks_and_examples_import_names_that_exist():
+    """Every ``from flexgear... import name`` of a script under benchmarks/ or examples/ (at any depth of the
+    script, imports inside functions too) names something the module has: a renamed name breaks no script
+    silently (those scripts run outside the test suite)."""
+    import ast
+    import importlib
+
+    missing = []
+    for path in sorted([*(ROOT / "benchmarks").rglob("*.py"), *(ROOT / "examples").rglob("*.py")]):
+        for node in ast.walk(ast.parse(path.read_text())):
+            if not (isinstance(node, ast.ImportFrom) and node.level == 0 and node.module
+                    and node.module.split(".")[0] == "flexgear"):
+                continue
+            module = importlib.import_module(node.module)
+            for alias in node.names:
+                if not hasattr(module, alias.name):
+                    try:
+                        importlib.import_module(f"{node.module}.{alias.name}")
+                    except ImportError:
+                        missing.append(f"{path.relative_to(ROOT)}:{node.lineno}: {node.module}.{alias.name}")
+    assert not missing, "\n".join(missing)
