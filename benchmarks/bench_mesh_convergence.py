@@ -60,22 +60,30 @@ CLUSTER = 0.005
 """Modes within this relative spacing on either level form one group for the shape check (degenerate pairs)."""
 
 
-def levels(spec, level: str, base_tooth: float | None, base_body: float | None, half: bool, tooth: float | None,
-           body: float | None):
-    """The spec with the base and reference levels added; (spec, base name, reference name)."""
+def _sized(settings, tooth: float, body: float):
+    """``settings`` with every component's tooth and body sizes (the ring's too) set to ``tooth`` / ``body`` mm."""
+    return dataclasses.replace(settings, tooth_size_mm=tooth, body_size_mm=body, ring_tooth_size_mm=tooth,
+                               ring_body_size_mm=body)
+
+
+def levels(spec, body_name: str, level: str, base_tooth: float | None, base_body: float | None, half: bool,
+           tooth: float | None, body: float | None):
+    """The spec with the base and reference levels added; (spec, base name, reference name). The sizes are those
+    ``body_name`` takes at the level (the ring has its own, MeshingSettings.sizes_mm); both levels give them to
+    every component."""
     from flexgear.schema import MeshingSettings
 
     base: MeshingSettings = spec.meshing_assumed[level]
+    t0, b0 = base.sizes_mm("ring" if body_name in ("ring", "tied") else body_name)
     base_name = level
     if base_tooth is not None or base_body is not None:
-        base = dataclasses.replace(base, tooth_size_mm=base_tooth or base.tooth_size_mm,
-                                   body_size_mm=base_body or base.body_size_mm)
-        base_name = f"{level}_t{base.tooth_size_mm:g}_b{base.body_size_mm:g}"
+        t0, b0 = base_tooth or t0, base_body or b0
+        base_name = f"{level}_t{t0:g}_b{b0:g}"
+    base = _sized(base, t0, b0)
     if half or (tooth is None and body is None):
-        ref = dataclasses.replace(base, tooth_size_mm=base.tooth_size_mm / 2, body_size_mm=base.body_size_mm / 2)
+        ref = _sized(base, t0 / 2, b0 / 2)
     else:
-        ref = dataclasses.replace(base, tooth_size_mm=tooth or base.tooth_size_mm,
-                                  body_size_mm=body or base.body_size_mm)
+        ref = _sized(base, tooth or t0, body or b0)
     ref_name = f"ref_t{ref.tooth_size_mm:g}_b{ref.body_size_mm:g}"
     spec = spec.with_changes(meshing_assumed={**spec.meshing_assumed, base_name: base, ref_name: ref})
     return spec, base_name, ref_name
@@ -148,12 +156,13 @@ def reduction_cost(spec, body: str, level: str) -> dict:
     return {"reduced_modes": int(red.n_modes), "reduction_wall_s": time.perf_counter() - t0}
 
 
-def _spectrum_key(spec, level: str, f_max_hz: float) -> str:
-    """Hash of what a stored spectrum depends on: the gearbox (geometry, material, level settings), the limit."""
-    import hashlib
+def _spectrum_key(spec, body: str, level: str, f_max_hz: float) -> str:
+    """Hash of what a stored spectrum depends on: the gearbox (geometry, material), the settings the body is
+    meshed with at the level (MeshingSettings.for_component), the limit."""
+    from flexgear.spec import spec_hash
 
-    text = repr((spec.with_changes(meshing_assumed={}), spec.meshing_assumed[level], round(f_max_hz, 3)))
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    settings = spec.meshing_assumed[level].for_component("ring" if body == "tied" else body)
+    return spec_hash(spec.with_changes(meshing_assumed={}), body, settings, round(f_max_hz, 3))
 
 
 def run_body(spec, body: str, base: str, ref: str, band_orders: float, criterion_pct: float,
@@ -163,11 +172,11 @@ def run_body(spec, body: str, base: str, ref: str, band_orders: float, criterion
 
     f_band = band_orders * mesh_frequency_hz(spec, spec.load_case.input_speed_rpm)
     row: dict = {"body": body, "base": base, "reference": ref, "band_hz": f_band,
-                 **{f"{tag}_sizes_mm": [spec.meshing_assumed[lv].tooth_size_mm, spec.meshing_assumed[lv].body_size_mm]
+                 **{f"{tag}_sizes_mm": list(spec.meshing_assumed[lv].sizes_mm(body))
                     for tag, lv in (("base", base), ("reference", ref))}}
     res = {}
     for tag, lv in (("base", base), ("reference", ref)):
-        stored = spectra / f"{body}-{_spectrum_key(spec, lv, EDGE * f_band)}.npz" if spectra else None
+        stored = spectra / f"{body}-{_spectrum_key(spec, body, lv, EDGE * f_band)}.npz" if spectra else None
         if stored is not None and stored.exists():
             with np.load(stored) as data:
                 nodes, f, vec, n_dof = data["nodes"], data["f"], data["vec"], int(data["n_dof"])
@@ -263,9 +272,9 @@ def main() -> None:
 
     from flexgear.spec import load_gearbox
 
-    spec, base, ref = levels(load_gearbox(args.gearbox), args.level, args.base_tooth, args.base_body, args.half,
-                             args.tooth, args.body)
     if args.child:  # one body in this process: its row as the last line of stdout
+        spec, base, ref = levels(load_gearbox(args.gearbox), args.bodies[0], args.level, args.base_tooth,
+                                 args.base_body, args.half, args.tooth, args.body)
         row = run_body(spec, args.bodies[0], base, ref, args.band_orders, args.criterion_pct, args.reduction,
                        Path(args.spectra) if args.spectra else None)
         print(json.dumps(row))

@@ -243,11 +243,30 @@ class MeshingSettings:
 
     tooth_size_mm: float = derived_field(0.0, lo_open=True)
     body_size_mm: float = derived_field(0.0, lo_open=True)
+    # The ring's own sizes (tooth and bolt-hole faces / elsewhere): its thin rim and the teeth on it set its
+    # bending modes, which need finer elements than the solid gears' (flexgear.sizing, docs/configuration.md).
+    ring_tooth_size_mm: float = derived_field(0.0, lo_open=True)
+    ring_body_size_mm: float = derived_field(0.0, lo_open=True)
     element_order: int = num_field(1, 2, integer=True, default=2)
     # Netgen curvaturesafety: element size <= curvature radius / this on curved faces and edges.
     elements_per_curvature_radius: float = num_field(0.0, lo_open=True, default=0.3, derived=True)
     # Netgen optsteps2d and optsteps3d: smoothing/swapping passes after surface and volume meshing.
     optimisation_steps: int = num_field(0, 10, integer=True, default=3, derived=True)
+
+    def sizes_mm(self, component: str) -> tuple[float, float]:
+        """(tooth, body) element size [mm] of ``component``: the ring's own, the level's for every other."""
+        if component == "ring":
+            return self.ring_tooth_size_mm, self.ring_body_size_mm
+        return self.tooth_size_mm, self.body_size_mm
+
+    def for_component(self, component: str) -> dict[str, float | int]:
+        """The settings ``component`` is meshed with, its sizes under the level's names (``tooth_size_mm``,
+        ``body_size_mm``): what its mesh and reduced body depend on, so what their cache keys hash (another
+        component's sizes do not rebuild them)."""
+        tooth, body = self.sizes_mm(component)
+        return {"tooth_size_mm": tooth, "body_size_mm": body, "element_order": self.element_order,
+                "elements_per_curvature_radius": self.elements_per_curvature_radius,
+                "optimisation_steps": self.optimisation_steps}
 
 
 @dataclass(frozen=True, kw_only=True)

@@ -21,6 +21,8 @@ With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`f
   shaft's (94/73/146 vs 90/70/150); bearing seats 0.4 sun bores wide (19.5 vs 20);
 - mesh levels: ``coarse`` teeth 1.9 m, body 3.8 m but no coarser than the teeth allow 6 elements across the
   input shaft (4.03/8.06 vs 4/8); ``default`` teeth 0.95 m, body 2.8 m, 8 across the shaft (2.0/5.9 vs 2/6);
+  the ring's own: teeth 1.2 m (``coarse``) or 0.95 m (``default``), never coarser than the level's teeth, and
+  at least two elements through its rim (2.54/4.25 vs 2.5/4; 2.0/4.25 vs 2/4);
   Netgen's curvature refinement and optimisation passes as the study's levels;
 - reduction: fixed-interface cutoff 3.5 mesh orders at the load case's input speed (15.4 kHz, as the study's);
 - load case: step 1/24 of the mesh period (9.5 vs 10 us);
@@ -41,7 +43,8 @@ from flexgear.spec import register_derived_defaults
 from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["derived_defaults", "FACE_WIDTH_PER_SUN_DIAMETER", "CUTOFF_MESH_ORDERS", "STEPS_PER_MESH_PERIOD",
-           "MESH_SIZES_PER_MODULE", "MESH_REFINEMENT", "ELEMENTS_PER_SHAFT_DIAMETER"]
+           "MESH_SIZES_PER_MODULE", "MESH_REFINEMENT", "ELEMENTS_PER_SHAFT_DIAMETER", "RING_TOOTH_SIZE_PER_MODULE",
+           "ELEMENTS_THROUGH_RING_RIM"]
 
 FACE_WIDTH_PER_SUN_DIAMETER = 0.6
 """Face width (all helix halves) over the sun's reference diameter: b/d_1 of a planetary sun, 0.5-0.8 in practice."""
@@ -56,6 +59,13 @@ ELEMENTS_PER_SHAFT_DIAMETER = {"coarse": 6.0, "default": 8.0}
 """Least elements across the input shaft's diameter (body size <= d / this): a coarser shaft is meshed too
 unevenly for its axisymmetric frame (``frame_axisymmetry_tolerance``; 2.8 elements gave 3e-4 against 1e-4). The
 study's 50 mm shaft has 6.25 at its coarse level."""
+RING_TOOTH_SIZE_PER_MODULE = {"coarse": 1.2, "default": 0.95}
+"""Element size on the ring's teeth per normal module, at most the level's tooth size: the ring's in-band modes
+bend its thin rim, and its teeth (their mass and root compliance) need finer elements than the solid gears' to
+converge (benchmarks/RESULTS.md, mesh convergence)."""
+ELEMENTS_THROUGH_RING_RIM = 2.0
+"""Least second-order elements through the ring's rim below the tooth root (ring body size <= rim / this): one
+element through it makes the rim's bending about 1.4 % too stiff (benchmarks/RESULTS.md, mesh convergence)."""
 MESH_REFINEMENT = {"coarse": (0.1, 1), "default": (0.3, 3)}
 """(elements per curvature radius, optimisation passes) of the two levels, as the study's coarse and default."""
 
@@ -146,9 +156,14 @@ def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -
         tooth, body = MESH_SIZES_PER_MODULE[level]
         curvature, passes = MESH_REFINEMENT[level]
         shaft = built["components_assumed"].input_shaft_outer_diameter_mm
-        tooth_mm = tooth * g.normal_module_mm
-        body_mm = max(tooth_mm, min(body * g.normal_module_mm, shaft / ELEMENTS_PER_SHAFT_DIAMETER[level]))
-        return {"tooth_size_mm": tooth_mm, "body_size_mm": body_mm,
+        tooth_mm = _given(given, "tooth_size_mm", tooth * g.normal_module_mm)
+        body_mm = _given(given, "body_size_mm", max(
+            tooth_mm, min(body * g.normal_module_mm, shaft / ELEMENTS_PER_SHAFT_DIAMETER[level])))
+        ring_tooth_mm = min(tooth_mm, RING_TOOTH_SIZE_PER_MODULE[level] * g.normal_module_mm)
+        rim = built["components_assumed"].ring_rim_thickness_mm / ELEMENTS_THROUGH_RING_RIM
+        ring_tooth_mm = _given(given, "ring_tooth_size_mm", ring_tooth_mm)
+        return {"tooth_size_mm": tooth_mm, "body_size_mm": body_mm, "ring_tooth_size_mm": ring_tooth_mm,
+                "ring_body_size_mm": max(ring_tooth_mm, min(body_mm, rim)),
                 "elements_per_curvature_radius": curvature, "optimisation_steps": passes}
     if table == "lumped_assumed":
         return _carrier(g, a, built["material_assumed"])

@@ -293,9 +293,10 @@ def _check_consistency(spec: GearboxSpec) -> None:
     if lc.step_size_s >= min(lc.end_time_s, lc.ramp_time_s):
         raise SpecError(p, "load_case.step_size_s", "expected < ramp_time_s and < end_time_s", lc.step_size_s)
     for level, m in spec.meshing_assumed.items():
-        if m.body_size_mm < m.tooth_size_mm:
-            raise SpecError(p, f"meshing_assumed.{level}.body_size_mm", "expected >= tooth_size_mm",
-                            m.body_size_mm)
+        for prefix in ("", "ring_"):
+            if getattr(m, f"{prefix}body_size_mm") < getattr(m, f"{prefix}tooth_size_mm"):
+                raise SpecError(p, f"meshing_assumed.{level}.{prefix}body_size_mm",
+                                f"expected >= {prefix}tooth_size_mm", getattr(m, f"{prefix}body_size_mm"))
 
 
 def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> GearboxSpec:

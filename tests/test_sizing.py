@@ -134,3 +134,27 @@ def test_the_study_gives_every_size_and_keeps_them():
         got = getattr(derived.components_assumed, name)
         assert math.isclose(got, value, rel_tol=0.08), (name, got, value)
     assert dataclasses.asdict(derived.bearings) == dataclasses.asdict(spec.bearings)
+
+
+def test_the_ring_is_meshed_finer_than_the_solid_gears_and_a_given_ring_size_wins(tmp_path):
+    """The ring's own sizes: teeth at most 1.2 normal modules (and no coarser than the level's teeth), at least
+    two elements through its rim (and no finer than its teeth); a file's value wins and is checked: a ring body
+    finer than its teeth is refused in one line naming the ring's field."""
+    spec = _load(tmp_path, _minimal(3.0))
+    coarse, rim = spec.meshing_assumed["coarse"], spec.components_assumed.ring_rim_thickness_mm
+    assert coarse.ring_tooth_size_mm == pytest.approx(min(coarse.tooth_size_mm, 1.2 * 3.0), rel=1e-12)
+    assert coarse.ring_body_size_mm == pytest.approx(max(coarse.ring_tooth_size_mm, min(coarse.body_size_mm, rim / 2)),
+                                                     rel=1e-12)
+    assert coarse.ring_body_size_mm <= rim / 2 + 1e-12 and coarse.ring_tooth_size_mm < coarse.tooth_size_mm
+    assert coarse.sizes_mm("ring") == (coarse.ring_tooth_size_mm, coarse.ring_body_size_mm)
+    assert coarse.sizes_mm("sun") == (coarse.tooth_size_mm, coarse.body_size_mm)
+
+    data = _minimal(3.0)
+    data["meshing_assumed"] = {"coarse": {"ring_tooth_size_mm": 3.5}}
+    given = _load(tmp_path, data).meshing_assumed["coarse"]
+    assert given.ring_tooth_size_mm == 3.5 and given.ring_body_size_mm == pytest.approx(max(3.5, min(
+        given.body_size_mm, rim / 2)), rel=1e-12)
+    data["meshing_assumed"] = {"coarse": {"ring_tooth_size_mm": 4.0, "ring_body_size_mm": 3.0}}
+    with pytest.raises(SpecError) as err:
+        _load(tmp_path, data)
+    assert err.value.field == "meshing_assumed.coarse.ring_body_size_mm" and "\n" not in str(err.value)

@@ -186,9 +186,10 @@ def imported_mesh(spec: GearboxSpec | Design, component: str, level: str, order:
     else:
         solid_key = geometry_hash(spec, component, IMPORT_VERSION)
         imported_brep(d, component, progress)  # the cache entry source_mesh reads as the component's solid
-        source = MeshSource(d.layouts[component], level, MeshSizes.of(settings), settings.element_order, solid_key,
-                            lambda o: geometry_hash(spec, component, settings, o, GRADING, MESH_VERSION,
-                                                    IMPORT_VERSION), regions)
+        source = MeshSource(d.layouts[component], level, MeshSizes.of(settings, component), settings.element_order,
+                            solid_key,
+                            lambda o: geometry_hash(spec, component, settings.for_component(component), o, GRADING,
+                                                    MESH_VERSION, IMPORT_VERSION), regions)
         try:
             mesh = source_mesh(source, order, progress)
             checked = mesh if order == settings.element_order else source_mesh(source, settings.element_order, progress)

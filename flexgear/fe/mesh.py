@@ -11,7 +11,8 @@ interfaces:
 - output_shaft: ``bearing_seat`` (outer surface, far +z end), ``bolt_holes``, ``bolt_hole_<k>``
 
 Mesh sizes per level come from ``[meshing_assumed.<level>]`` of gearbox.toml: ``tooth_size_mm``
-on the tooth and bolt-hole faces, ``body_size_mm`` elsewhere, ``element_order`` 1 or 2. Second
+on the tooth and bolt-hole faces, ``body_size_mm`` elsewhere (the ring: ``ring_tooth_size_mm`` and
+``ring_body_size_mm``), ``element_order`` 1 or 2. Second
 order nodes are placed on the true (OCC) surfaces by Netgen. Any other layout (a single gear body,
 flexgear.fe.toothed) is meshed and cached the same way from a :class:`MeshSource` (:func:`source_mesh`).
 
@@ -128,10 +129,12 @@ class MeshSizes:
     optimisation_steps: int = 3
 
     @classmethod
-    def of(cls, settings: MeshingSettings) -> MeshSizes:
-        """The sizes of a mesh level of gearbox.toml (``[meshing_assumed.<level>]``, mm)."""
-        return cls(settings.tooth_size_mm * 1e-3, settings.body_size_mm * 1e-3,
-                   settings.elements_per_curvature_radius, settings.optimisation_steps)
+    def of(cls, settings: MeshingSettings, component: str = "") -> MeshSizes:
+        """The sizes of ``component`` at a mesh level of gearbox.toml (``[meshing_assumed.<level>]``, mm;
+        :meth:`MeshingSettings.sizes_mm`)."""
+        tooth_mm, body_mm = settings.sizes_mm(component)
+        return cls(tooth_mm * 1e-3, body_mm * 1e-3, settings.elements_per_curvature_radius,
+                   settings.optimisation_steps)
 
 
 @dataclass(frozen=True)
@@ -309,9 +312,10 @@ def _study_source(d: Design, component: str, level: str) -> MeshSource:
     the geometry, the mesh by the geometry, the level's settings, the order and the meshing procedure."""
     spec = d.spec
     settings = spec.meshing_assumed[level]
-    return MeshSource(d.layouts[component], level, MeshSizes.of(settings), settings.element_order,
+    return MeshSource(d.layouts[component], level, MeshSizes.of(settings, component), settings.element_order,
                       geometry_hash(spec, component),
-                      lambda order: geometry_hash(spec, component, settings, order, GRADING, MESH_VERSION),
+                      lambda order: geometry_hash(spec, component, settings.for_component(component), order, GRADING,
+                                                MESH_VERSION),
                       lambda nodes, boundary: region_nodes(d, component, nodes, boundary))
 
 

@@ -289,7 +289,7 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
         return reduce(fe, itfs, kind=_INTERFACE_KIND, n_compare=0, load_circles=circles,
                       rigid=tuple(i.name for i in itfs if i.name == BOLT_PATCHES), max_hz=max_hz)
 
-    key = geometry_hash(spec, name, mesh_settings, max_hz, _INTERFACE_KIND, _WHOLE_BASIS,
+    key = geometry_hash(spec, name, mesh_settings.for_component(name), max_hz, _INTERFACE_KIND, _WHOLE_BASIS,
                         [c.key() for c in circles], _REDUCTION_VERSION, *extra)
     return f"{name}-{level}-{key}", build
 

@@ -212,7 +212,7 @@ def _largest(fits: Callable[[float], bool], lo: float, hi: float) -> float:
 def _short_curves(spec: GearboxSpec, name: str, gear: Gear, profile: ToothProfile) -> None:
     """Every curve of the gear's outline (:meth:`ToothProfile.outline_curves`) at least the largest tooth mesh size
     / :data:`_ELEMENTS_PER_CURVE` and :data:`_MIN_CURVE` long."""
-    tooth = max(level.tooth_size_mm for level in spec.meshing_assumed.values()) * _MM
+    tooth = max(level.sizes_mm(name)[0] for level in spec.meshing_assumed.values()) * _MM
     limit = max(_MIN_CURVE, tooth / _ELEMENTS_PER_CURVE)
     curve, shortest = min(profile.outline_curves(), key=lambda c: c[1])
     if shortest >= limit:
@@ -345,10 +345,12 @@ def _mesh_sizes(spec: GearboxSpec) -> None:
     """Every mesh level's tooth size at most :data:`_TOOTH_SIZE_PER_MODULE` normal modules (Netgen fails above)."""
     limit = _TOOTH_SIZE_PER_MODULE * spec.gears.normal_module_mm
     for level, settings in spec.meshing_assumed.items():
-        if settings.tooth_size_mm > limit:
-            raise SpecError(spec.source, f"meshing_assumed.{level}.tooth_size_mm",
-                            f"expected <= {limit:.3f} mm ({_TOOTH_SIZE_PER_MODULE:g} normal modules): coarser tooth "
-                            "elements make Netgen's surface mesher fail in the tooth spaces", settings.tooth_size_mm)
+        for name in ("tooth_size_mm", "ring_tooth_size_mm"):
+            if getattr(settings, name) > limit:
+                raise SpecError(spec.source, f"meshing_assumed.{level}.{name}",
+                                f"expected <= {limit:.3f} mm ({_TOOTH_SIZE_PER_MODULE:g} normal modules): coarser "
+                                "tooth elements make Netgen's surface mesher fail in the tooth spaces",
+                                getattr(settings, name))
 
 
 def check_feasibility(spec: GearboxSpec) -> None:

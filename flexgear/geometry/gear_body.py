@@ -202,7 +202,7 @@ class GearBody:
         body = dict(
             root_fillet_coefficient=a.root_fillet_coefficient, hand=_HANDS[component], helix_layout=a.helix_layout,
             half_gap=a.half_gap_m, groove_depth=c.relief_groove_depth_mm * 1e-3, material=spec.material_assumed,
-            tooth_mesh_size=mesh.tooth_size_mm * 1e-3, body_mesh_size=mesh.body_size_mm * 1e-3,
+            tooth_mesh_size=mesh.sizes_mm(component)[0] * 1e-3, body_mesh_size=mesh.sizes_mm(component)[1] * 1e-3,
             element_order=mesh.element_order, elements_per_curvature_radius=mesh.elements_per_curvature_radius,
             optimisation_steps=mesh.optimisation_steps)
         if component == "ring":
