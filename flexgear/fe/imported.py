@@ -13,11 +13,14 @@ axis, the built-in component's origin), in ``length_unit``:
 
 Either way the regions the reduction needs are found by geometry on the mesh, by the built-in parts' rules from
 the gear data (flexgear.fe.mesh.region_nodes, flexgear.fe.reduced.component_interfaces), so that a part exported
-and imported again gets the same regions. A part is refused, in one line naming the component and the file
+and imported again gets the same regions; a region the entry's ``regions`` names is found by its selector instead
+(a cylinder, a point set, a physical group of the mesh file: flexgear.fe.selectors), under the same name. A part
+is refused, in one line naming the component and the file
 (:class:`GeometryFileError`), when its file cannot be read, holds no solid or several, is far larger or smaller
 than its gear data (a wrong ``length_unit``), when its teeth do not match the gear data (tip or root radius, or
 flanks off the involute flanks of the gear data's tooth count, module, helix and profile shift, at any rotation),
-or when a region finds no node.
+or when a region finds no node, or a selector finds no node or nodes on more than one surface (the message
+names the selector).
 """
 
 from __future__ import annotations
@@ -44,8 +47,9 @@ from flexgear.fe.mesh import (
 )
 from flexgear.fe.mesh_io import MeshFileError, boundary_faces, netgen_mesh, read_volume_mesh
 from flexgear.fe.parts import cached_brep, register_file_parts
+from flexgear.fe.selectors import SelectorError, group_points, selected_regions
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
-from flexgear.schema_geometry import ComponentGeometry
+from flexgear.schema_geometry import SELECTABLE_REGIONS, ComponentGeometry
 from flexgear.spec import GearboxSpec
 
 __all__ = ["GeometryFileError", "ImportedMesh", "imported_brep", "imported_mesh", "check_imported_mesh",
@@ -198,12 +202,26 @@ def imported_mesh(spec: GearboxSpec | Design, component: str, level: str, order:
         except Exception as exc:  # Netgen fails on a solid it cannot mesh
             raise GeometryFileError(component, entry, f"cannot be meshed at level {level!r} "
                                     f"({exc.__class__.__name__}: {' '.join(str(exc).split())[:120]})") from None
+    if entry.regions:  # the named regions, checked on the FE model's nodes (of the level's order)
+        _select(d, component, entry, checked, True)
+        if mesh is not checked:
+            _select(d, component, entry, mesh, False)
     check_imported_mesh(d, component, checked, entry)  # the regions the FE model's nodes (of the level's order) get
     return mesh
 
 
-_REGIONS = {"sun": ("bore", "flanks"), "planet": ("bore", "flanks"), "ring": ("flanks", "bolt_holes"),
-            "input_shaft": ("bearing_seat", "gear_seat"), "output_shaft": ("bearing_seat", "bolt_holes")}
+def _select(d: Design, component: str, entry: ComponentGeometry, mesh: ComponentMesh, strict: bool) -> None:
+    """``mesh``'s regions with those the entry's selectors name found by them (flexgear.fe.selectors); ``strict``:
+    a selection that finds no node or more than one surface is refused (:class:`GeometryFileError`)."""
+    holes = sum(q.section.holes for q in d.layouts[component].prisms)
+    try:
+        groups = group_points(entry.source, entry.scale) if any(s.group for s in entry.regions) else None
+        mesh.regions = selected_regions(entry.regions, mesh.regions, holes, mesh.nodes, mesh.surface, groups, strict)
+    except SelectorError as exc:
+        raise GeometryFileError(component, entry, f"selector {exc}") from None
+
+
+_REGIONS = {c: tuple(n for n in names if "<" not in n) for c, names in SELECTABLE_REGIONS.items()}
 """The mesh regions of each component that its reduction's interfaces and contact bands stand on."""
 
 
