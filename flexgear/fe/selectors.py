@@ -11,16 +11,18 @@ built-in holes are: hole k nearest 2 pi k / n); ``bolt_hole_<k>`` named alone re
 
 - it finds no boundary node;
 - it holds no whole boundary face (a triangle whose three vertices it holds): nodes along an edge or a few
-  scattered nodes are no surface;
-- its faces form more connected patches (faces sharing a node are connected) than the region is made of: one for
-  ``bore``, ``bearing_seat``, ``gear_seat`` and each ``bolt_hole_<k>``, the layout's number of holes for
-  ``bolt_holes``, any number for ``flanks`` (two per tooth);
+  scattered nodes are no surface (``flanks`` excepted: between form and tip radius a coarse mesh's flank may
+  hold nodes but no whole face);
+- its faces form another number of connected patches (faces sharing a node are connected) than the region is
+  made of: one for ``bore``, ``bearing_seat``, ``gear_seat`` and each ``bolt_hole_<k>``, the layout's number of
+  holes for ``bolt_holes``, any number for ``flanks`` (two per tooth);
 - two of its faces sharing an edge turn by more than :data:`FEATURE_ANGLE_DEG` (the selection goes round an edge
-  of the part onto another surface, such as a bore and the end face it meets).
+  of the part onto another surface, such as a bore and the end face it meets at a right angle).
 
 Nodes of the selection outside its faces (on the edges where other surfaces meet the selected one) are kept, as
-the built-in rules keep them. The test is topological and the angle is far above the turn between neighbouring
-faces of a coarse mesh of a curved surface (a bore meshed with 12 faces round turns by 30 degrees).
+the built-in rules keep them. The test is topological; its angle lies between the facets of a coarse mesh of a
+curved surface (a bolt hole of the study's coarse output shaft has six faces round: 60 degrees) and a part's right
+angles, so a chamfer or a rounded edge (turning by less) is not found by it.
 """
 
 from __future__ import annotations
@@ -37,7 +39,7 @@ from flexgear.schema_geometry import RegionSelector
 __all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "check_surface",
            "selected_regions"]
 
-FEATURE_ANGLE_DEG = 50.0
+FEATURE_ANGLE_DEG = 75.0
 """Two faces of one selection that share an edge may turn by at most this angle [deg] (module docstring)."""
 _SINGLE = ("bore", "bearing_seat", "gear_seat")
 """Regions made of one connected surface (so is each ``bolt_hole_<k>``)."""
@@ -61,10 +63,11 @@ def group_points(source: str | Path, scale: float) -> dict[str, np.ndarray]:
     points = np.asarray(mesh.points, float)[:, :3] * scale
     ids: dict[str, list[np.ndarray]] = {}
     tags = mesh.cell_data.get("gmsh:physical")
-    for name, (tag, _dim) in ((n, v[:2]) for n, v in mesh.field_data.items() if len(v) >= 2):
-        if tags is not None:
+    for name, (tag, dim) in ((n, v[:2]) for n, v in mesh.field_data.items() if len(v) >= 2):
+        if tags is not None:  # a physical group: its tag among the cells of its dimension
             ids.setdefault(name, []).extend(
-                np.ravel(block.data[np.asarray(t) == tag]) for block, t in zip(mesh.cells, tags, strict=True))
+                np.ravel(block.data[np.asarray(t) == tag]) for block, t in zip(mesh.cells, tags, strict=True)
+                if getattr(block, "dim", dim) == dim)
     for name, blocks in mesh.cell_sets.items():
         ids.setdefault(name, []).extend(np.ravel(block.data[np.asarray(s, np.int64)])
                                         for block, s in zip(mesh.cells, blocks, strict=False) if len(s))
@@ -156,6 +159,8 @@ def check_surface(selector: RegionSelector, picked: np.ndarray, nodes: np.ndarra
     if not len(picked):
         raise SelectorError(f"{what}: finds no boundary node")
     faces = _faces(picked, nodes, surface)
+    if not len(faces) and selector.region == "flanks":
+        return np.full(len(picked), -1, np.int64)
     if not len(faces):
         raise SelectorError(f"{what}: finds {len(picked)} boundary nodes but no whole boundary face (nodes along "
                             "edges or scattered, not a surface)")
