@@ -305,9 +305,8 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     d = as_design(variant.gearbox if design is None else design)
     spec = d.spec
     if spec.gears.arrangement != "star":
-        raise ValueError(f"{spec.source}: field 'gears.arrangement': expected 'star' here: the modal analyses (modes, "
-                         "campbell, modal-screening, sweep-speed) linearise the star only; run, matrix, lpm and report "
-                         f"take {spec.gears.arrangement!r}")
+        raise ValueError(f"{spec.source}: field 'gears.arrangement': expected 'star' here: build_star_gearbox builds "
+                         "the star; flexgear.mbs.assemble.build_gearbox builds any arrangement")
     source = reduced_source or _default_reduced_source
     loaded: dict[tuple[str, str], object] = {}
 

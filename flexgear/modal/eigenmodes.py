@@ -49,8 +49,8 @@ from flexgear.modal.linear import LinearModel
 
 __all__ = ["Modes", "modes", "state_space_roots", "CENTRAL", "PLANET_SHARE", "MOTION_SHARE"]
 
-CENTRAL = ("input_shaft", "sun", "ring", "output_shaft")
-"""The central members of the star gearbox (carrier fixed)."""
+CENTRAL = ("input_shaft", "sun", "ring", "output_shaft", "carrier")
+"""The central members: the star's (its carrier fixed) and the planetary stage's turning carrier."""
 
 PLANET_SHARE = 1e-4
 """Share of a mode's kinetic energy in the central members' frames below which they count as at rest (a planet

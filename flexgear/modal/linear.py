@@ -1,14 +1,14 @@
-"""The star gearbox linearised at its operating point: mass, damping, gyroscopic and stiffness matrices.
+"""A gearbox linearised at its operating point: mass, damping, gyroscopic and stiffness matrices.
 
-:func:`linearize` builds a variant into an Exudyn system exactly as a run does (flexgear.mbs.gearbox.
-build_star_gearbox), brings it to its steady operating point and lets Exudyn differentiate the assembled equations
-there (``ComputeLinearizedSystem``). The operating point is the static equilibrium at the time t* = T (the end of
-the load case's STEP ramps of speed and load): the drive holds the input at its prescribed angle, the load torque
-acts in full, and the per-step updates (spin terms, turning joints and contact columns, friction) are those of t*
-at the nominal speeds. Mesh stiffness is its mean: the variant is built with ``[contact_assumed]
-stiffness_variation = "constant"`` (s(phi) = 1, the mean of eq. 11-12's series). Each contact law then enters with
-its tangent at its static deflection delta_0 (the study's impact law: dF/d delta = 1.5 k delta_0^0.5; the ISO 6336
-law: k).
+:func:`linearize` builds a variant into an Exudyn system exactly as a run does (flexgear.mbs.assemble.
+build_gearbox: the star at any speed, the planetary stage at rest), brings it to its steady operating point and lets
+Exudyn differentiate the assembled equations there (``ComputeLinearizedSystem``). The operating point is the static
+equilibrium at the time t* = T (the end of the load case's STEP ramps of speed and load): the drive holds the input
+at its prescribed angle, the load torque acts in full, and the per-step updates (spin terms, turning joints and
+contact columns, friction) are those of t* at the nominal speeds. Mesh stiffness is its mean: the variant is built
+with ``[contact_assumed] stiffness_variation = "constant"`` (s(phi) = 1, the mean of eq. 11-12's series). Each
+contact law then enters with its tangent at its static deflection delta_0 (the study's impact law: dF/d delta = 1.5
+k delta_0^0.5; the ISO 6336 law: k).
 
 The linearised equations over all ODE2 coordinates q (frames, modal and auxiliary coordinates) are
 
@@ -39,7 +39,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexgear.spec import Variant
+from flexgear.spec import SpecError, Variant
 
 __all__ = ["Coordinate", "LinearModel", "linearize", "ZERO_SPEED_RPM", "component_name", "with_speed",
            "coordinate_labels", "operating_point", "static_solver_settings"]
@@ -371,16 +371,20 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     import exudyn as exu
     from threadpoolctl import threadpool_limits
 
-    from flexgear.mbs.gearbox import build_star_gearbox
+    from flexgear.mbs.assemble import build_gearbox
 
     built, speed = with_speed(variant, speed_rpm, cutoff_rpm)
     spec = built.gearbox
+    if spec.gears.arrangement != "star" and speed != 0.0:
+        raise SpecError(spec.source, "gears.arrangement", "expected 'star' for modes at speed: the planetary stage "
+                        "is linearised at rest only (modes --speed-rpm 0), its planets' orbit needs the carrier's "
+                        "frame at speed", spec.gears.arrangement)
     t_star = spec.load_case.ramp_time_s if t_star is None else float(t_star)
     sc = exu.SystemContainer()
     try:
         mbs = sc.AddSystem()
         with threadpool_limits(limits=1, user_api="blas"):
-            model = build_star_gearbox(mbs, built, mass_source, reduced_source)
+            model = build_gearbox(mbs, built, mass_source, reduced_source)
         mbs.Assemble()
         operating_point(mbs, model, built, t_star)
         ss = static_solver_settings(t_star)
@@ -410,11 +414,14 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     mr, kr, dr = (basis.T @ a @ basis for a in (m, k, dx))
     flexible = tuple(component_name(nm) for nm, b in model.bodies.items() if b.flexible)
     flexible += tuple(part for _, split in elastic_parts.values() for part, _, _ in split if part not in flexible)
-    components = _components(spec.gears.planet_count)
+    components = _components(spec.gears.planet_count, "carrier" in model.bodies)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
                        basis, tuple(labels), m, k, components, flexible, parts, static, residuals,
                        static_residuals, elastic_parts)
 
 
-def _components(planets: int) -> tuple[str, ...]:
-    return ("input_shaft", "sun", *(f"planet_{i + 1}" for i in range(planets)), "ring", "output_shaft")
+def _components(planets: int, carrier: bool = False) -> tuple[str, ...]:
+    """The components whose energy shares the modes report: the gearbox file's, and the turning carrier of the
+    planetary stage."""
+    return ("input_shaft", "sun", *(f"planet_{i + 1}" for i in range(planets)), "ring", "output_shaft",
+            *(("carrier",) if carrier else ()))
