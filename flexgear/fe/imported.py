@@ -19,8 +19,8 @@ is refused, in one line naming the component and the file
 (:class:`GeometryFileError`), when its file cannot be read, holds no solid or several, is far larger or smaller
 than its gear data (a wrong ``length_unit``), when its teeth do not match the gear data (tip or root radius, or
 flanks off the involute flanks of the gear data's tooth count, module, helix and profile shift, at any rotation),
-or when a region finds no node, or a selector finds no node or nodes on more than one surface (the message
-names the selector).
+or when a region finds no node (or, but the flanks, nodes holding no whole boundary face), or a selector finds no
+node or nodes on more than one surface (the message names the selector).
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ from flexgear.fe.mesh import (
 )
 from flexgear.fe.mesh_io import MeshFileError, boundary_faces, netgen_mesh, read_volume_mesh
 from flexgear.fe.parts import cached_brep, register_file_parts
-from flexgear.fe.selectors import SelectorError, group_points, selected_regions
+from flexgear.fe.selectors import SelectorError, group_points, selected_regions, whole_faces
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
 from flexgear.schema_geometry import SELECTABLE_REGIONS, ComponentGeometry
 from flexgear.spec import GearboxSpec
@@ -226,13 +226,17 @@ _REGIONS = {c: tuple(n for n in names if "<" not in n) for c, names in SELECTABL
 
 
 def check_imported_mesh(d: Design, component: str, mesh: ComponentMesh, entry: ComponentGeometry) -> None:
-    """Refuse (:class:`GeometryFileError`) an imported mesh whose regions find no node, or whose teeth do not match
-    the gear data (:func:`_check_teeth`); the bolts' clamped discs must each hold nodes (flexgear.fe.bolted)."""
+    """Refuse (:class:`GeometryFileError`) an imported mesh whose regions find no node (or, but the flanks, nodes
+    that hold no whole boundary face: no surface), or whose teeth do not match the gear data
+    (:func:`_check_teeth`); the bolts' clamped discs must each hold nodes (flexgear.fe.bolted)."""
     for name in _REGIONS[component]:
-        if not len(mesh.regions.get(name, ())):
-            raise GeometryFileError(component, entry, f"region {name!r} finds no node on its mesh (by the gear "
-                                    "data's rule, flexgear.fe.mesh.region_nodes): is the part in the component's "
-                                    "frame and of the gear data's dimensions?")
+        nodes = mesh.regions.get(name, np.zeros(0, np.int64))
+        if not len(nodes) or (name != "flanks" and not len(whole_faces(nodes, mesh.nodes, mesh.surface))):
+            plural = "s" if len(nodes) > 1 else ""
+            found = f" on a surface ({len(nodes)} node{plural}, no whole boundary face)" if len(nodes) else ""
+            raise GeometryFileError(component, entry, f"region {name!r} finds no node{found} on its mesh (by the "
+                                    "gear data's rule, flexgear.fe.mesh.region_nodes): is the part in the "
+                                    "component's frame and of the gear data's dimensions?")
     if component in ("ring", "output_shaft"):
         from flexgear.fe.bolted import clamped_patches
 

@@ -36,7 +36,7 @@ import numpy as np
 
 from flexgear.schema_geometry import RegionSelector
 
-__all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "check_surface",
+__all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "whole_faces", "check_surface",
            "selected_regions"]
 
 FEATURE_ANGLE_DEG = 75.0
@@ -113,8 +113,8 @@ def picked_nodes(selector: RegionSelector, nodes: np.ndarray, surface: np.ndarra
     return np.union1d(boundary[inside[boundary]], np.unique(surface[whole]))
 
 
-def _faces(picked: np.ndarray, nodes: np.ndarray, surface: np.ndarray) -> np.ndarray:
-    """The boundary triangles (rows of ``surface``) whose three vertices are all in ``picked``."""
+def whole_faces(picked: np.ndarray, nodes: np.ndarray, surface: np.ndarray) -> np.ndarray:
+    """The boundary triangles (rows of ``surface``) whose three vertices are all in ``picked`` (node indices)."""
     held = np.zeros(len(nodes), bool)
     held[picked] = True
     return surface[held[surface[:, :3]].all(axis=1)]
@@ -158,7 +158,7 @@ def check_surface(selector: RegionSelector, picked: np.ndarray, nodes: np.ndarra
     what = selector.describe()
     if not len(picked):
         raise SelectorError(f"{what}: finds no boundary node")
-    faces = _faces(picked, nodes, surface)
+    faces = whole_faces(picked, nodes, surface)
     if not len(faces) and selector.region == "flanks":
         return np.full(len(picked), -1, np.int64)
     if not len(faces):
