@@ -102,6 +102,7 @@ def test_the_example_file_gives_gears_helix_layout_bearings_and_load_case(gearbo
     assert gearbox.contact.law == "iso6336" and "gears_assumed.face_width_mm" in gearbox.derived
 
 
+@pytest.mark.slow  # two reductions and two runs: about half a minute of CPU
 def test_rigid_and_flexible_gears_variants_meet_hand_theory(tmp_path, example_cache, gearbox):
     from flexgear.cli import main
     from flexgear.results import load_result
