@@ -39,7 +39,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from flexgear.spec import SpecError, Variant
+from flexgear.modal.carrier_frame import frame_pairs, orbit, to_carrier_frame
+from flexgear.spec import Variant
 
 __all__ = ["Coordinate", "LinearModel", "linearize", "ZERO_SPEED_RPM", "component_name", "with_speed",
            "coordinate_labels", "operating_point", "static_solver_settings"]
@@ -285,10 +286,15 @@ def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3
     v0 = np.zeros_like(q0)
     shafts = {"sun": th.input_speed, "input_shaft": th.input_speed, "ring": th.output_speed,
               "output_shaft": th.output_speed}
+    if "carrier" in model.bodies:  # planetary: the ring held, the carrier turning, the planets orbiting with it
+        shafts.update(ring=0.0, carrier=th.output_speed)
+        theta_c, omega_c = carrier_angle(model, spec, t_star)
     for name, body in model.bodies.items():  # the nominal kinematics at t*: spin angle and speed of every frame
         w = shafts.get(name, th.planet_speed)
-        i = mbs.GetNodeODE2Index(body.node) + 5
-        q0[i], v0[i] = theta * w / th.input_speed, w
+        i = mbs.GetNodeODE2Index(body.node)
+        q0[i + 5], v0[i + 5] = theta * w / th.input_speed, w
+        if name.startswith("planet") and "carrier" in model.bodies:
+            q0[i:i + 2], v0[i:i + 2] = orbit(body.position, theta_c, omega_c)
     mbs.systemData.SetODE2Coordinates(q0, exu.ConfigurationType.Initial)
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
     pre = mbs.GetPreStepUserFunction()
@@ -313,6 +319,16 @@ def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3
         exu.config.printToConsole = was
     mbs.systemData.SetODE2Coordinates(q0, exu.ConfigurationType.Initial)
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
+
+
+def carrier_angle(model, spec, t_star: float) -> tuple[float, float]:
+    """(angle [rad], rate [rad/s]) of the planetary stage's nominal carrier at ``t_star``: the drive's angle and
+    speed times the carrier's ratio z_s / (z_s + z_r)."""
+    from flexgear.laws.ramps import drive_angle
+
+    th, lc = model.theory, spec.load_case
+    ratio = th.output_speed / th.input_speed
+    return ratio * float(drive_angle(t_star, lc.ramp_time_s, lc.input_speed_rad_s)), th.output_speed
 
 
 RETRY_RELATIVE_TOLERANCE = 1e-10
@@ -375,10 +391,6 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
 
     built, speed = with_speed(variant, speed_rpm, cutoff_rpm)
     spec = built.gearbox
-    if spec.gears.arrangement != "star" and speed != 0.0:
-        raise SpecError(spec.source, "gears.arrangement", "expected 'star' for modes at speed: the planetary stage "
-                        "is linearised at rest only (modes --speed-rpm 0), its planets' orbit needs the carrier's "
-                        "frame at speed", spec.gears.arrangement)
     t_star = spec.load_case.ramp_time_s if t_star is None else float(t_star)
     sc = exu.SystemContainer()
     try:
@@ -391,6 +403,10 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
         m, k, dx, c = (np.asarray(a, float) for a in exu.solver.ComputeLinearizedSystem(
             mbs, ss, returnConstraintJacobian=True, autoAssemble=False))
         n = m.shape[0]
+        if "carrier" in model.bodies:  # the planetary stage: its equations in the carrier's axes
+            theta_c, omega_c = carrier_angle(model, spec, t_star)
+            m, dx, k, c = to_carrier_frame(m, dx, k, c.T if c.size else c, frame_pairs(mbs, model), theta_c, omega_c)
+            c = c.T if c.size else c
         labels = coordinate_labels(mbs, model, n)
         q = np.array(mbs.systemData.GetODE2Coordinates())
         rows = [mbs.GetNodeODE2Index(node) + k for node in model.aux_nodes

@@ -133,6 +133,9 @@ def table3_variants(folder: Path) -> dict[str, tuple[str, ...]]:
 def recommend(must: tuple[str, ...], candidates: dict[str, tuple[str, ...]]) -> tuple[str, str]:
     """(name, one-line reason): the candidate with the fewest flexible components that holds all of ``must``, the
     first of them on a tie; the one with the most flexible components if none holds them all."""
+    if not candidates:
+        return "", (f"{', '.join(must) or 'no component'} must be flexible; the folder holds no Table 3 variant "
+                    "(model<N>.toml) to recommend")
     fits = [name for name, flexible in candidates.items() if set(must) <= set(flexible)]
     if fits:
         name = min(fits, key=lambda n: len(candidates[n]))
