@@ -214,3 +214,28 @@ def test_selectors_enter_the_spec_hash_and_cache_keys(gearbox, tmp_path):
     assert len(set(keys)) == 3 and len({spec_hash(s) for s in (plain, bore, wider)}) == 3
     assert geometry_hash(again, "sun") == keys[1] and spec_hash(again) == spec_hash(bore)
     assert geometry_hash(bore, "ring") == geometry_hash(plain, "ring") == geometry_hash(gearbox, "ring")
+
+
+# --------------------------------------------------------------------------- what the reduction stands on
+def test_a_selected_bore_carries_the_reduction_of_a_part_the_gear_data_do_not_describe(tmp_path):
+    """A sun whose bore (40 mm) is not the gearbox file's (50 mm): imported without a selector it is refused (the
+    built-in bore finds no surface); with a cylinder selector at its bore, its reduced body is the one the gear data
+    of a 40 mm bore give: the same modes (the free-free frequencies of the reduced and of the full FE model within
+    1e-9) on the same bore interface (its nodes at 20 mm)."""
+    from flexgear.fe.reduced import component_reduced_body
+
+    study = load_gearbox(GEARBOX)
+    other = study.with_fields("components_assumed", sun_bore_diameter_mm=40.0)
+    mesh = component_mesh(other, "sun", "coarse")
+    write_vtu(tmp_path / "sun40.vtu", mesh.nodes, mesh.elements)
+    _refused(tmp_path, "sun", "sun40.vtu", "m", "", "bore")
+    _, z0, z1 = _bore(study)
+    selector = f"bore = {{ cylinder = {{ radius_m = 0.020, z_m = [{z0}, {z1}] }} }}"
+    imported = component_reduced_body(load_gearbox(_gearbox(tmp_path, "sun", "sun40.vtu", "m", selector)), "sun")
+    built_in = component_reduced_body(other, "sun")
+    bore = next(i for i in imported.interfaces if i.name == "bore")
+    reference = next(i for i in built_in.interfaces if i.name == "bore")
+    assert len(bore.nodes) == len(reference.nodes) > 0
+    np.testing.assert_allclose(np.hypot(*imported.nodes[bore.nodes][:, :2].T), 0.020, atol=1e-6)
+    np.testing.assert_allclose(imported.frequencies_hz, built_in.frequencies_hz, rtol=1e-9)
+    np.testing.assert_allclose(imported.full_frequencies_hz, built_in.full_frequencies_hz, rtol=1e-9)

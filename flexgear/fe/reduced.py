@@ -71,7 +71,7 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
     c = spec.components_assumed
     if component in ("sun", "planet"):
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
-        return [interface(fe, np.flatnonzero(np.abs(r - bore) < _TOL), "bore")]
+        return [_interface(fe, d, component, np.abs(r - bore) < _TOL, "bore")]
     if component == "ring":
         return [patch_union(fe, d, BOLT_PATCHES)]
     tube = [p for p in d.layouts[component].prisms if p.name == "tube"][0]
@@ -80,12 +80,33 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
     if component == "input_shaft":
         sun = d.layouts["sun"].prisms
         z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
-        joints = [interface(fe, np.flatnonzero(on_tube & (z > z0 - _TOL) & (z < z1 + _TOL)), "sun_seat")]
+        joints = [_interface(fe, d, component, on_tube & (z > z0 - _TOL) & (z < z1 + _TOL), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
         joints = [patch_union(fe, d, BOLT_PATCHES)]
         far = (z > tube.z1 - seat - _TOL)
-    return [*joints, interface(fe, np.flatnonzero(on_tube & far), "bearing_seat")]
+    return [*joints, _interface(fe, d, component, on_tube & far, "bearing_seat")]
+
+
+SELECTED_INTERFACES = {"bore": "bore", "bearing_seat": "bearing_seat", "sun_seat": "gear_seat"}
+"""Interface -> the region of ``[components_geometry] <component>.regions`` that places it on an imported part
+(flexgear.schema_geometry.RegionSelector). The bolt patches stay on the bolt circle of the gear data
+(flexgear.fe.bolted), the contact bands on the gear data's meshes."""
+
+
+def _interface(fe, d: Design, component: str, builtin: np.ndarray, name: str) -> Interface:
+    """Interface ``name`` of ``component``: on the nodes a selector of its imported part's file picks
+    (flexgear.fe.selectors.picked_nodes on the FE model's nodes and boundary, checked when the part was meshed),
+    else on the built-in rule's nodes ``builtin`` (a mask over the FE nodes)."""
+    entry = d.spec.components_geometry.get(component)
+    region = SELECTED_INTERFACES.get(name)
+    chosen = next((sel for sel in entry.regions if sel.region == region), None) if entry is not None else None
+    if chosen is None:
+        return interface(fe, np.flatnonzero(builtin), name)
+    from flexgear.fe.selectors import group_points, picked_nodes
+
+    groups = group_points(entry.source, entry.scale) if chosen.group else None
+    return interface(fe, picked_nodes(chosen, fe.nodes, fe.surface_triangles, groups), name)
 
 
 def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
