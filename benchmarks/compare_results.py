@@ -33,7 +33,9 @@ def main(argv: list[str] | None = None) -> int:
             print(f"{name:<12} (a run without signals)")
             continue
         end = min(ra.signals.time_s.iloc[-1], rb.signals.time_s.iloc[-1])
-        ag = signal_agreement(ra, rb, (end - a.window, end), ra.meta["theory"]["mesh_frequency_hz"])
+        half_step = 0.5 * float(ra.signals.time_s.diff().median())  # window edges between samples, not on them
+        ag = signal_agreement(ra, rb, (end - a.window + half_step, end + half_step),
+                              ra.meta["theory"]["mesh_frequency_hz"])
         print(f"{name:<12} {ag.worst_mean:>11.2e} {ag.worst_amplitude:>10.2e}")
     return 0
 
