@@ -13,6 +13,7 @@ read these from it; what they cache on disk stays keyed by the spec it carries.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass, replace
 
 from flexgear.geometry.contact_lines import MeshContactGeometry, mesh_contact_geometry
@@ -31,7 +32,7 @@ from flexgear.geometry.supports import seat_supports
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
 from flexgear.theory import Theory, gear_set_theory
 
-__all__ = ["Design", "design", "as_design"]
+__all__ = ["Design", "design", "as_design", "register_part_masses"]
 
 
 @dataclass(frozen=True, eq=False)
@@ -40,12 +41,12 @@ class Design:
 
     ``gears``: the gear set; ``theory``: its theoretical values; ``profiles``: tooth profiles of sun, planet and
     ring (flexgear.geometry.layout.tooth_profiles); ``layouts``: every geometry component's prisms in its frame
-    (flexgear.spec.GEOMETRY_COMPONENTS); ``masses``: each one's mass [kg], centre of mass [m] and inertia about
-    it [kg m^2] from the exact section integrals (flexgear.geometry.layout.component_mass_properties, cached on
-    disk under the same key); ``supports``: the Table 2 bearings at their seats
-    (flexgear.geometry.supports.gearbox_supports); ``meshes``: the contact geometry of the sun-planet ("outer",
-    sun = gear 1 of hand +1 in the +z half) and the planet-ring ("inner", planet = gear 1 of hand -1) mesh, with
-    ``[contact_assumed] stiffness_harmonics`` harmonics in the contact-line series.
+    (flexgear.spec.GEOMETRY_COMPONENTS); ``masses``: each one's mass [kg], centre of mass [m] and inertia about it
+    [kg m^2] from the exact section integrals (flexgear.geometry.layout.component_mass_properties, cached on disk
+    under the same key), or for a part from a file its own geometry's (flexgear.fe.imported_mass); ``supports``: the
+    Table 2 bearings at their seats (flexgear.geometry.supports.gearbox_supports); ``meshes``: the contact geometry
+    of the sun-planet ("outer", sun = gear 1 of hand +1 in the +z half) and the planet-ring ("inner", planet = gear
+    1 of hand -1) mesh, with ``[contact_assumed] stiffness_harmonics`` harmonics in the contact-line series.
     """
 
     spec: GearboxSpec
@@ -67,6 +68,13 @@ class Design:
 
 
 _DESIGNS: dict[str, Design] = {}
+_PART_MASSES: list[Callable[[Design, str], MassProperties]] = []
+
+
+def register_part_masses(compute: Callable[[Design, str], MassProperties]) -> None:
+    """How the exact mass properties of a ``[components_geometry]`` part are found: ``compute(design, component)``
+    (flexgear.fe.imported_mass registers it when flexgear.fe is imported)."""
+    _PART_MASSES[:] = [compute]
 _MAX_DESIGNS = 64
 
 
@@ -81,8 +89,9 @@ def design(spec: GearboxSpec) -> Design:
         profiles = tooth_profiles(geo, spec.gears_assumed.root_fillet_coefficient)
         layouts = {c: gear_set_layout(spec, geo, c) for c in GEOMETRY_COMPONENTS}
         rho = spec.material_assumed.density_kg_m3
+        imported = [c for c in GEOMETRY_COMPONENTS if c in spec.components_geometry]
         masses = {c: cached_mass_properties(spec, c, lambda c=c: layout_mass_properties(layouts[c], profiles, rho))
-                  for c in GEOMETRY_COMPONENTS}
+                  for c in GEOMETRY_COMPONENTS if c not in imported}
         supports = seat_supports(spec, layouts["input_shaft"], layouts["output_shaft"])
         harmonics = spec.contact_assumed.stiffness_harmonics
         meshes = {kind: mesh_contact_geometry(mesh, geo.helix_layout, geo.helix_face_width, geo.half_gap, hand,
@@ -92,6 +101,13 @@ def design(spec: GearboxSpec) -> Design:
         if len(_DESIGNS) >= _MAX_DESIGNS:
             _DESIGNS.pop(next(iter(_DESIGNS)))
         _DESIGNS[key] = made
+        if imported:  # the parts from files: their own geometry's (the readers take this design without them)
+            if not _PART_MASSES:
+                raise RuntimeError("no mass reader of [components_geometry] parts is registered (import flexgear.fe)")
+            for c in imported:
+                masses[c] = cached_mass_properties(spec, c, lambda c=c: _PART_MASSES[0](made, c),
+                                                   "the file's geometry (flexgear.fe.imported_mass)")
+            made = _DESIGNS[key] = replace(made, masses=masses)
     if made.spec is not spec:  # the same content from another spec object: its geometry, this spec
         made = _DESIGNS[key] = replace(made, spec=spec)
     return made

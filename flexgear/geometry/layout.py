@@ -370,10 +370,13 @@ def component_mass_properties(spec: GearboxSpec, component: str) -> MassProperti
     return cached_mass_properties(spec, component, lambda: exact_mass_properties(spec, component))
 
 
-def cached_mass_properties(spec: GearboxSpec, component: str, compute: Callable[[], MassProperties]) -> MassProperties:
+def cached_mass_properties(spec: GearboxSpec, component: str, compute: Callable[[], MassProperties],
+                           method: str = "exact section integrals") -> MassProperties:
     """:func:`component_mass_properties` from its JSON cache, else computed by ``compute()`` (the exact section
-    integrals of ``component``'s layout) and stored."""
-    path = cache_dir() / f"massprops-{component}-{geometry_hash(spec, component)}.json"
+    integrals of ``component``'s layout, or ``method``) and stored."""
+    key = geometry_hash(spec, component) if method == "exact section integrals" else geometry_hash(spec, component,
+                                                                                                   method)
+    path = cache_dir() / f"massprops-{component}-{key}.json"
     if path.exists():
         try:
             d = json.loads(path.read_text())
@@ -383,6 +386,6 @@ def cached_mass_properties(spec: GearboxSpec, component: str, compute: Callable[
             pass  # unreadable entry: recompute and overwrite
     props = compute()
     payload = {"component": component, "mass_kg": props.mass, "com_m": props.com.tolist(),
-               "inertia_kg_m2": props.inertia.tolist(), "method": "exact section integrals"}
+               "inertia_kg_m2": props.inertia.tolist(), "method": method}
     atomic_write_bytes(path, json.dumps(payload, indent=1).encode())
     return props
