@@ -307,6 +307,13 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
     changes = {}
     for table, values in overrides.items():
         _reject_removed(path, f"overrides.{table}")
+        if table == "components_geometry":  # per component, the file relative to the variant file
+            try:
+                entries = components_geometry_table(path, values)
+            except SpecError as exc:
+                raise SpecError(path, f"overrides.{exc.field}", str(exc).split(f"'{exc.field}': ", 1)[1]) from None
+            changes[table] = {**gearbox.components_geometry, **entries}
+            continue
         current = getattr(gearbox, table, None)
         if table == "source" or not dataclasses.is_dataclass(current) or not isinstance(values, dict):
             allowed = sorted(n for n, h in hints.items() if dataclasses.is_dataclass(h))
@@ -315,7 +322,8 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
         merged = {k: (dataclasses.asdict(v) if dataclasses.is_dataclass(v) else v) for k, v in merged.items()}
         merged.update(values)
         changes[table] = _build(type(current), merged, path, f"overrides.{table}")
-    kept = {f"{table}.{name}" for table, values in overrides.items() for name in values}
+    kept = {f"{table}.{name}" for table, values in overrides.items() if table != "components_geometry"
+            for name in values}
     return rederive(gearbox.with_changes(**changes), kept)
 
 
@@ -346,7 +354,9 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
     """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible.
 
     Optional ``[overrides.<table>]`` replace single fields of the gearbox's tables for this variant
-    (e.g. a shortened ``load_case`` for a quick run), validated like the gearbox file. ``text`` and
+    (e.g. a shortened ``load_case`` for a quick run), validated like the gearbox file;
+    ``[overrides.components_geometry]`` gives or replaces whole entries (a component from a file, its path relative
+    to the variant file) and keeps the gearbox file's others. ``text`` and
     ``gearbox_text``: the two files' contents, already read (e.g. shipped to a worker without the files);
     the paths then only name them in messages.
     """

@@ -298,3 +298,27 @@ def test_a_part_from_a_file_carries_its_own_exact_mass_properties(gearbox, tmp_p
         member = LumpedParameters.from_spec(spec).sun
         lumped = LumpedParameters.from_spec(other).sun  # apparent mass: d^2 / I_t amplifies the centre's error
         assert member.mass_kg == pytest.approx(lumped.mass_kg, rel=max(rtol, 1e-5)), file
+
+
+def test_a_variant_takes_a_part_from_a_file_by_its_overrides(gearbox, exported, tmp_path):
+    """``[overrides.components_geometry]`` in a variant of the study's own gearbox file: that variant's ring is the
+    file (its path relative to the variant file, its content in the spec hash), the gearbox file's other variants
+    keep the built-in ring; a bad entry is refused in one line naming the variant file and the override."""
+    (tmp_path / "parts").mkdir()
+    (tmp_path / "parts" / "ring.vtu").write_bytes((exported / "ring.vtu").read_bytes())
+    base = (f'name = "m"\ngearbox = "{GEARBOX}"\n[components]\ninput_shaft = "rigid"\nsun = "rigid"\n'
+            'planets = "rigid"\nring = "flexible"\noutput_shaft = "rigid"\n')
+    (tmp_path / "plain.toml").write_text(base)
+    (tmp_path / "imported.toml").write_text(
+        base + '[overrides.components_geometry]\nring = { file = "parts/ring.vtu", length_unit = "m" }\n')
+    plain, imported = fg.load_variant(tmp_path / "plain.toml"), fg.load_variant(tmp_path / "imported.toml")
+    assert plain.gearbox.components_geometry == {}
+    entry = imported.gearbox.components_geometry["ring"]
+    assert entry.source == (tmp_path / "parts" / "ring.vtu").resolve() and entry.kind == "mesh"
+    assert spec_hash(imported.gearbox) != spec_hash(plain.gearbox)
+    (tmp_path / "bad.toml").write_text(
+        base + '[overrides.components_geometry]\nring = { file = "parts/none.vtu", length_unit = "m" }\n')
+    with pytest.raises(SpecError) as err:
+        fg.load_variant(tmp_path / "bad.toml")
+    assert err.value.field == "overrides.components_geometry.ring.file" and "\n" not in str(err.value)
+    assert str(tmp_path / "bad.toml") in str(err.value)
