@@ -66,6 +66,11 @@ def test_the_example_is_the_study_gearbox_with_its_ring_from_a_file(example, gea
     study = tomllib.loads((EXAMPLE.parents[1] / "model_variants" / "gearbox.toml").read_text())
     raw = tomllib.loads((example / "gearbox.toml").read_text())
     assert raw.pop("components_geometry") == {"ring": {"file": "parts/ring_lightened.step", "length_unit": "mm"}}
+    coarse = raw["meshing_assumed"]["coarse"]  # the ring at the level's sizes: a quick example (its header says so)
+    assert (coarse.pop("ring_tooth_size_mm"), coarse.pop("ring_body_size_mm")) == (coarse["tooth_size_mm"],
+                                                                                 coarse["body_size_mm"])
+    for name in ("ring_tooth_size_mm", "ring_body_size_mm"):
+        study["meshing_assumed"]["coarse"].pop(name)
     assert {k: v for k, v in raw.items() if k != "title"} == {k: v for k, v in study.items() if k != "title"}
     assert "SI_UNIT(.MILLI.,.METRE.)" in (example / "parts" / "ring_lightened.step").read_text(errors="replace")
 
