@@ -18,7 +18,6 @@ import pytest
 import flexgear as fg
 from flexgear.design import as_design
 from flexgear.modal import linearize, modes
-from flexgear.spec import SpecError
 
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
 F_MAX = 10e3  # Hz
@@ -126,38 +125,3 @@ def test_planetary_modes_at_speed_in_the_carrier_frame_equal_lin_and_parker(vari
     np.testing.assert_allclose(m.frequencies_hz, expected, rtol=1e-4)
     at_rest = modes(linearize(variant, speed_rpm=0.0).in_plane().undamped(), F_MAX).frequencies_hz
     assert np.max(np.abs(m.frequencies_hz[:2] / at_rest[:2] - 1.0)) > 0.02  # the lowest pair splits
-
-
-def test_the_planetary_harmonic_response_is_refused_in_one_line(variant):
-    """The multibody harmonic response (``sweep-speed``) of the planetary stage is refused: see the next test."""
-    from flexgear.harmonic import harmonic_response
-
-    with pytest.raises(SpecError) as err:
-        harmonic_response(variant, [3000.0], harmonics=2)
-    assert err.value.field == "gears.arrangement" and "\n" not in str(err.value)
-
-
-@pytest.mark.xfail(strict=True, reason="the planetary stage's frequency-domain mesh forces are 30-45 % below its "
-                   "time integration (both linear models; the lumped and the multibody time models agree)")
-def test_planetary_frequency_domain_matches_time_integration(variant):
-    """The lumped model of the spur planetary example at 3000 rpm, no tooth friction: its harmonic response's 1x
-    and 2x mesh-force amplitudes against its own settled time run (0.12 s after 0.03 s ramps), within 10 % as the
-    star's are (tests/test_harmonic.py). Measured: 1x 349.7 against 469.4 N, 2x 67.9 against 129.1 N; the
-    multibody model's (linearised in the carrier's axes / time run) 349.6 / 485.1 N and 67.9 / 116.8 N."""
-    import math
-
-    from flexgear.harmonic import lumped_harmonic_response, mesh_frequency_hz
-    from flexgear.lumped.run import run_lumped
-    from flexgear.study.compare import harmonic_amplitudes
-
-    rpm = 3000.0
-    spec = variant.gearbox.with_fields("load_case", input_speed_rpm=rpm, ramp_time_s=0.03, end_time_s=0.15)
-    spec = spec.with_fields("contact", friction_coefficient=0.0)
-    response = lumped_harmonic_response(spec, [rpm], harmonics=spec.contact_assumed.stiffness_harmonics)
-    run = run_lumped(spec)
-    t = run.signals["time_s"].to_numpy()
-    dt, f_mesh = float(t[-1] - t[-2]), mesh_frequency_hz(spec, rpm)
-    n = int(math.floor(0.05 * f_mesh) / f_mesh / dt)
-    column = "outer_mesh_force_1_n"
-    timed = harmonic_amplitudes(run.signals[column].to_numpy()[-n:], dt, f_mesh, (1, 2))
-    np.testing.assert_allclose(response.amplitudes(column).iloc[0].to_numpy()[:2], timed, rtol=0.10)

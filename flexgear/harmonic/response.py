@@ -157,18 +157,6 @@ def _frame_row(lm: Any, components: Sequence[str], name: str) -> int:
     raise ValueError(f"no frame coordinate {name} of {components} in the linearised model")
 
 
-def _star_only(spec) -> None:
-    """Refuse another arrangement than the star in one line: the planetary stage's frequency-domain mesh forces
-    are 30-45 % below its time integration at 1x and 2x mesh (both linear models, the lumped one too, against both
-    time models; tests/test_planetary_modes.py), so its harmonic response is not given."""
-    from flexgear.spec import SpecError
-
-    if spec.gears.arrangement != "star":
-        raise SpecError(spec.source, "gears.arrangement", "expected 'star' for the harmonic response (sweep-speed): "
-                        "the planetary stage's is not yet consistent with its time integration",
-                        spec.gears.arrangement)
-
-
 def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmonics: int = DEFAULT_HARMONICS, *,
                       linearization: str = "spin", modal_cutoff_ratio: float | None = MODAL_CUTOFF_RATIO) -> Response:
     """Harmonic response (module docstring) of a variant at ``speeds_rpm`` [rpm], mesh harmonics 1..``harmonics``.
@@ -204,11 +192,9 @@ def harmonic_response(model_or_variant: Any, speeds_rpm: Sequence[float], harmon
         raise ValueError("speeds_rpm: expected a non-empty list of speeds")
     if isinstance(model_or_variant, LinearModel):
         variant = model_or_variant.variant
-        _star_only(variant.gearbox)
         nodes, models = np.array([model_or_variant.speed_rpm]), [model_or_variant]
     else:
         variant = model_or_variant if not isinstance(model_or_variant, str | Path) else load_variant(model_or_variant)
-        _star_only(variant.gearbox)
         variant = dataclasses.replace(variant, gearbox=excited_spec(variant.gearbox, harmonics))
         nodes, models = _linear_models(variant, speeds, linearization)
     spin = linearization == "spin" and len(models) == 2
