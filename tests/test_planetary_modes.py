@@ -125,3 +125,32 @@ def test_planetary_modes_at_speed_in_the_carrier_frame_equal_lin_and_parker(vari
     np.testing.assert_allclose(m.frequencies_hz, expected, rtol=1e-4)
     at_rest = modes(linearize(variant, speed_rpm=0.0).in_plane().undamped(), F_MAX).frequencies_hz
     assert np.max(np.abs(m.frequencies_hz[:2] / at_rest[:2] - 1.0)) > 0.02  # the lowest pair splits
+
+
+@pytest.mark.xfail(strict=True, reason="the first-order frequency domain misses the mesh-force harmonics of a spur "
+                   "mesh (large stiffness variation) by 20-45 %, star and planetary alike; the study's double-helical "
+                   "set agrees within 10 % (tests/test_harmonic.py)")
+def test_spur_frequency_domain_matches_time_integration(variant):
+    """The lumped model of the spur planetary example at 300 rpm (quasi-static: the mesh frequency, 93 Hz, far
+    below every mode), no tooth friction: its harmonic response's 1x and 2x mesh-force amplitudes against its own
+    settled time run, within 10 % as the study's are. Measured: 1.56 against 2.01 N at 1x, 2.19 against 3.66 N at
+    2x; the spur star example gives the same ratios (0.77, 0.59), and so does the multibody model at 3000 rpm
+    (linearised in the carrier's axes: 349.6 against 485.1 N at 1x)."""
+    import math
+
+    from flexgear.harmonic import lumped_harmonic_response, mesh_frequency_hz
+    from flexgear.lumped.run import run_lumped
+    from flexgear.study.compare import harmonic_amplitudes
+
+    rpm = 300.0
+    spec = variant.gearbox.with_fields("load_case", input_speed_rpm=rpm, ramp_time_s=0.05, end_time_s=0.4)
+    spec = spec.with_fields("contact", friction_coefficient=0.0)
+    response = lumped_harmonic_response(spec, [rpm], harmonics=spec.contact_assumed.stiffness_harmonics)
+    run = run_lumped(spec)
+    t = run.signals["time_s"].to_numpy()
+    dt, f_mesh = float(t[-1] - t[-2]), mesh_frequency_hz(spec, rpm)
+    n = int(math.floor(0.1 * f_mesh) / f_mesh / dt)
+    column = "outer_mesh_force_1_n"
+    timed = harmonic_amplitudes(run.signals[column].to_numpy()[-n:], dt, f_mesh, (1, 2))
+    np.testing.assert_allclose(response.amplitudes(column).iloc[0].to_numpy()[:2], timed, rtol=0.10)
+
