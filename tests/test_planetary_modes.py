@@ -127,9 +127,9 @@ def test_planetary_modes_at_speed_in_the_carrier_frame_equal_lin_and_parker(vari
     assert np.max(np.abs(m.frequencies_hz[:2] / at_rest[:2] - 1.0)) > 0.02  # the lowest pair splits
 
 
-@pytest.mark.xfail(strict=True, reason="the first-order frequency domain misses the mesh-force harmonics of a spur "
-                   "mesh (large stiffness variation) by 20-45 %, star and planetary alike; the study's double-helical "
-                   "set agrees within 10 % (tests/test_harmonic.py)")
+@pytest.mark.xfail(strict=True, reason="the frequency domain misses the mesh-force harmonics of a spur mesh (large "
+                   "stiffness variation; first order in it) by 20-45 %, star and planetary alike; the study's "
+                   "double-helical set agrees within 10 % (tests/test_harmonic.py)")
 def test_spur_frequency_domain_matches_time_integration(variant):
     """The lumped model of the spur planetary example at 300 rpm (quasi-static: the mesh frequency, 93 Hz, far
     below every mode), no tooth friction: its harmonic response's 1x and 2x mesh-force amplitudes against its own
