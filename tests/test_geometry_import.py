@@ -165,13 +165,14 @@ def _held_frequencies(body, name: str) -> np.ndarray:
     return np.sqrt(la.eigh(basis.T @ stiffness @ basis, basis.T @ mass @ basis, eigvals_only=True)) / (2 * np.pi)
 
 
-@pytest.mark.heavy  # about 100 s of CPU (STEP read, remeshing, reduction): make test-heavy
+@pytest.mark.heavy  # about 5 min of CPU (STEP read, remeshing, reduction of the 2.5 / 4 mm ring): make test-heavy
 def test_step_round_trip_gives_the_built_in_reduced_body(gearbox, exported, tmp_path, monkeypatch):
-    """The solid is meshed anew from the STEP file: Netgen meshes the translated solid differently (69560 nodes
-    against 69888), so the bodies agree to the coarse mesh's variation, not to round-off. Measured: mass 2.8e-7,
-    the 52 clamped modes below 3x the mesh frequency 0.07 % (median), 1.3 % at most (near-degenerate pairs split
-    differently by the two meshes), compliance at the contact bands within 0.8 % of its largest term, row sums
-    within 1.2 %. The imported body is built in a private cache (a STEP file carries its time of writing)."""
+    """The solid is meshed anew from the STEP file: Netgen meshes the translated solid a little differently, so the
+    bodies agree to the mesh's variation, not to round-off. At the ring's 2.5 / 4 mm sizes that variation is small:
+    the asked mass (1e-6) and compliance at the contact bands (0.5 % of its largest term) hold, and the clamped
+    modes below 3x the mesh frequency agree within 0.1 % in the median and 0.3 % at most (the asked 0.1 % for every
+    mode is missed by one near-degenerate mode, benchmarks/RESULTS.md). The imported body is built in a private
+    cache (a STEP file carries its time of writing)."""
     from flexgear.fe.reduced import component_contacts, component_load_circles, component_reduced_body
     from flexgear.theory import mesh_frequency_hz
 
@@ -187,13 +188,13 @@ def test_step_round_trip_gives_the_built_in_reduced_body(gearbox, exported, tmp_
     got = _held_frequencies(imported, "bolt_patches")[:len(ref)]
     assert len(ref) >= 5
     error = np.abs(got / ref - 1)
-    assert np.median(error) < 2e-3 and error.max() < 0.02, (np.median(error), error.max())
+    assert np.median(error) < 1e-3 and error.max() < 3e-3, (np.median(error), error.max())
     points, normals = component_contacts(gearbox, "ring")
     kernel = component_load_circles(gearbox, "ring", gearbox.reduction_assumed.contact_fourier_order)
     c_imp, c_ref = (fg.static_compliance(b, points, normals, "bolt_patches", kernel=kernel)
                     for b in (imported, built_in))
-    assert np.max(np.abs(c_imp - c_ref)) < 0.015 * np.max(np.abs(c_ref))
-    np.testing.assert_allclose(c_imp.sum(axis=1), c_ref.sum(axis=1), rtol=0.02)
+    assert np.max(np.abs(c_imp - c_ref)) < 0.005 * np.max(np.abs(c_ref))
+    np.testing.assert_allclose(c_imp.sum(axis=1), c_ref.sum(axis=1), rtol=0.005)
 
 
 # --------------------------------------------------------------------------- bad files
