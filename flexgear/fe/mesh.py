@@ -31,7 +31,7 @@ import io
 import json
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import numpy as np
@@ -211,6 +211,27 @@ def _refine_teeth(geo, layout: ComponentLayout, size: float, mp) -> None:
                     mp.RestrictH(p.x, p.y, p.z, size)
 
 
+TOOTH_RETRY_FACTORS = (1.0, 0.8, 0.64)
+"""Tooth sizes tried in turn, relative to the level's, where Netgen's surface mesher fails on a solid ("Meshing
+failed!": a few valid gear sets' tooth spaces at the coarse level, benchmarks/RESULTS.md, gear-set grid). The
+first that meshes is kept (deterministic: the same solid fails the same way), and its factor is recorded in the
+entry's summary."""
+
+
+def _netgen_mesh_retried(brep: Path, layout: ComponentLayout, sizes: MeshSizes):
+    """(first-order Netgen mesh, tooth factor): :func:`_netgen_mesh` at the level's tooth size, else at the next of
+    :data:`TOOTH_RETRY_FACTORS` (the body size never finer than the teeth); the last failure is raised."""
+    from netgen.libngpy._meshing import NgException
+
+    for k, factor in enumerate(TOOTH_RETRY_FACTORS):
+        try:
+            return _netgen_mesh(brep, layout, replace(sizes, tooth=factor * sizes.tooth)), factor
+        except NgException:
+            if k == len(TOOTH_RETRY_FACTORS) - 1:
+                raise
+    raise AssertionError("unreachable")
+
+
 def _netgen_mesh(brep: Path, layout: ComponentLayout, sizes: MeshSizes):
     """The first-order Netgen mesh of the solid of ``layout``, its OCC geometry attached (a second order is raised
     from it)."""
@@ -371,8 +392,9 @@ def _build_mesh(source: MeshSource, order: int, paths: dict[str, Path], brep: Pa
     component, level = source.name, source.level
     paths["json"].unlink(missing_ok=True)  # written last: until then readers find no entry, not a mixed one
     t0 = time.perf_counter()
+    factor = 1.0
     if order == 1:
-        ngmesh = _netgen_mesh(brep, source.layout, source.sizes)
+        ngmesh, factor = _netgen_mesh_retried(brep, source.layout, source.sizes)
     else:
         first = source_mesh(source, 1, progress)
         ngmesh = _load_netgen_mesh(first.vol_path, brep)  # as stored: the same raised mesh cold or warm
@@ -390,7 +412,7 @@ def _build_mesh(source: MeshSource, order: int, paths: dict[str, Path], brep: Pa
                         **{f"region_{k}": v for k, v in regions.items()})
     atomic_write_bytes(paths["npz"], buf.getvalue())
     info = {"component": component, "level": level, "order": order, "nodes": mesh.n_nodes,
-            "elements": mesh.n_elements, "build_time_s": build,
+            "elements": mesh.n_elements, "build_time_s": build, "tooth_size_factor": factor,
             "regions": {k: len(v) for k, v in regions.items()}}
     atomic_write_bytes(paths["json"], json.dumps(info, indent=1).encode())
     role = "" if order == source.element_order else " (topology for the reduction)"
