@@ -40,8 +40,10 @@ def _fixture_of(node: ast.FunctionDef) -> tuple[str, bool] | None:
 
 def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
     """Per test module (its path as in node ids): the names of its test functions that use one of its
-    module-scoped fixtures, directly or through another fixture of the module ({"*"}: all of them, the fixture
-    being autouse)."""
+    module-scoped fixtures or one of this file's, directly or through another fixture of the module ({"*"}: all of
+    them, the fixture being autouse)."""
+    common = {n.name for n in ast.walk(ast.parse(Path(__file__).read_text()))
+              if isinstance(n, ast.FunctionDef) and (_fixture_of(n) or ("", False))[0] == "module"}
     out: dict[str, set[str]] = {}
     for path in sorted(folder.rglob("test_*.py")):
         fixtures: dict[str, tuple[tuple[str, bool], set[str]]] = {}
@@ -54,13 +56,14 @@ def _module_fixture_users(folder: Path) -> dict[str, set[str]]:
                     fixtures[node.name] = (kind, args)
                 elif node.name.startswith("test"):
                     tests[node.name] = args
-        shared = {name for name, ((scope, _), _) in fixtures.items() if scope == "module"}
+        shared = {name for name, ((scope, _), _) in fixtures.items() if scope == "module"} | (common - set(fixtures))
         grown = True
         while grown:  # fixtures of the module that request a shared one
             extra = {name for name, (_, args) in fixtures.items() if args & shared} - shared
             shared |= extra
             grown = bool(extra)
-        users = {"*"} if any(fixtures[n][0][1] for n in shared) else {t for t, args in tests.items() if args & shared}
+        autouse = any(fixtures[n][0][1] for n in shared if n in fixtures)
+        users = {"*"} if autouse else {t for t, args in tests.items() if args & shared}
         if users:
             out[path.relative_to(ROOT).as_posix()] = users
     return out
@@ -252,3 +255,13 @@ def coarse_fe():
     against full FE (and shared with the tied pair's build of ``--prebuild``); the functions those tests and that
     build call leave a model unchanged."""
     return _coarse_fe_model
+
+
+@pytest.fixture(scope="module")
+def example_cache(request, tmp_path_factory):
+    """One private cache folder (``FLEXGEAR_CACHE_DIR``) for a test module of an example study: its runs and
+    checks share its bodies, and the project's cache stays untouched."""
+    path = tmp_path_factory.mktemp(f"{request.module.__name__}_cache")
+    with pytest.MonkeyPatch.context() as mp:
+        mp.setenv("FLEXGEAR_CACHE_DIR", str(path))
+        yield path

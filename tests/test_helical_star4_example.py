@@ -38,15 +38,6 @@ STATES_EVERY = 2
 
 
 @pytest.fixture(scope="module")
-def example_cache(tmp_path_factory):
-    """One private cache for the module."""
-    path = tmp_path_factory.mktemp("helical_star4_cache")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("FLEXGEAR_CACHE_DIR", str(path))
-        yield path
-
-
-@pytest.fixture(scope="module")
 def gearbox():
     return fg.load_gearbox(EXAMPLE / "gearbox.toml")
 

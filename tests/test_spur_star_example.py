@@ -26,15 +26,6 @@ EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "spur_star"
 
 
 @pytest.fixture(scope="module")
-def example_cache(tmp_path_factory):
-    """One private cache for the module: the matrix and the ring's check share the ring's coarse body."""
-    path = tmp_path_factory.mktemp("spur_star_cache")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("FLEXGEAR_CACHE_DIR", str(path))
-        yield path
-
-
-@pytest.fixture(scope="module")
 def gearbox():
     return fg.load_gearbox(EXAMPLE / "gearbox.toml")
 
