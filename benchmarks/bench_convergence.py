@@ -222,7 +222,7 @@ def band(spec, body: str, level: str, cutoff_orders: list[float], band_orders: f
     if rigid:  # the reference holds the rigid patches rigid too
         full = _patch_reference(fe, itfs, rigid, 1.02 * f_band)
     else:
-        full = np.sqrt(np.maximum(lowest_eigenpairs(lambda k, found: free.eigen(fe, k, m, found),
+        full = np.sqrt(np.maximum(lowest_eigenpairs(lambda k, found, below=None: free.eigen(fe, k, m, found, below),
                                                      max_hz=1.02 * f_band)[0], 0.0))
         full /= 2 * np.pi
     full = full[full < f_band]

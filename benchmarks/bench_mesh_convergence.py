@@ -112,7 +112,7 @@ def free_modes(fe, f_max_hz: float) -> tuple[np.ndarray, np.ndarray]:
     solver = FreeBodySolver(fe)
     m = fe.mass_operator()
     free = solver.constrained((m @ solver.R).T)  # rigid-body modes removed: (M R)^T phi = 0
-    lam, vec = lowest_eigenpairs(lambda k, found: free.eigen(fe, k, m, found), max_hz=f_max_hz)
+    lam, vec = lowest_eigenpairs(lambda k, found, below=None: free.eigen(fe, k, m, found, below), max_hz=f_max_hz)
     return np.sqrt(np.maximum(lam, 0.0)) / (2 * np.pi), vec
 
 

@@ -77,6 +77,44 @@ def test_deflated_shift_invert_continues_where_the_last_call_stopped():
     np.testing.assert_allclose(vec.T @ (m @ vec), np.eye(lam.size), atol=1e-8)
 
 
+def _bar(n: int):
+    """Stiffness and mass of a fixed-free bar of ``n`` linear elements (E A = 1, rho A = 1, length 1)."""
+    import scipy.sparse as sp
+
+    h = 1.0 / n
+    main = np.full(n, 2.0)
+    main[-1] = 1.0  # the free end
+    k = sp.diags([main / h, -np.ones(n - 1) / h, -np.ones(n - 1) / h], [0, -1, 1], format="csc")
+    m = sp.diags([main * h / 3, np.full(n - 1, h / 6), np.full(n - 1, h / 6)], [0, -1, 1], format="csc")
+    return k, m
+
+
+@pytest.mark.parametrize("count", [3, 40, 90])
+def test_pairs_below_a_limit_in_one_krylov_space(count):
+    """An ``eigen`` that takes ``below``: one call finds every pair below the limit (fewer, as many or more than the
+    first count the limit search reads T at) and the first beyond it, equal to the dense solution."""
+    import scipy.linalg as la
+    import scipy.sparse.linalg as sla
+
+    from flexgear.fe.spectrum import shift_invert_pairs
+
+    k, m = _bar(600)
+    lu = sla.splu(k)
+    v0 = np.random.default_rng(1).standard_normal(600)
+    calls: list[int] = []
+
+    def eigen(n: int, found: np.ndarray | None, below: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        calls.append(n)
+        return shift_invert_pairs(lu.solve, m, n, v0, found, below=below)
+
+    exact = la.eigh(k.toarray(), m.toarray(), eigvals_only=True)
+    max_hz = np.sqrt(0.5 * (exact[count - 1] + exact[count])) / (2 * np.pi)
+    lam, vec = lowest_eigenpairs(eigen, max_hz=max_hz)
+    assert len(calls) == 1
+    np.testing.assert_allclose(lam, exact[:count], rtol=1e-9)
+    np.testing.assert_allclose(vec.T @ (m @ vec), np.eye(count), atol=1e-8)
+
+
 def test_block_lanczos_finds_both_members_of_double_pairs():
     """Two identical fixed-free bars side by side (as a cyclic ring's modes come in pairs): every eigenvalue is
     double, and the block Lanczos returns each twice, equal to the dense solution to 1e-10, with M-orthonormal

@@ -198,13 +198,13 @@ class _Constrained:
         u[s.free] += y - self.z @ lam
         return u
 
-    def eigen(self, fe: FEModel, k: int, m: sp.spmatrix | sla.LinearOperator, found: np.ndarray | None = None
-              ) -> tuple[np.ndarray, np.ndarray]:
-        """Lowest k eigenpairs of K phi = omega^2 M phi on {C phi = 0} beyond the eigenvectors ``found``
-        (flexgear.fe.spectrum.shift_invert_pairs)."""
+    def eigen(self, fe: FEModel, k: int, m: sp.spmatrix | sla.LinearOperator, found: np.ndarray | None = None,
+              below: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+        """Lowest k eigenpairs of K phi = omega^2 M phi on {C phi = 0} beyond the eigenvectors ``found``, or every
+        pair with omega^2 below ``below`` [1/s^2] and the next (flexgear.fe.spectrum.shift_invert_pairs)."""
         v0 = self.solve(m @ np.random.default_rng(0).standard_normal(self.s.n))[:, 0]
         k = min(k, self.s.n - self.p - 2)
-        return shift_invert_pairs(self.solve, m, k, v0, found)
+        return shift_invert_pairs(self.solve, m, k, v0, found, below=below)
 
 
 @threadpool_limits.wrap(limits=1, user_api="blas")
@@ -357,8 +357,9 @@ def _rigid_patch_basis(fe: FEModel, interfaces: list[Interface], rigid: set[str]
     m_ii = fe.mass_operator(np.setdiff1d(np.arange(fe.n_nodes), bnodes))  # rows and columns idofs
     v0 = solve(m_ii @ np.random.default_rng(0).standard_normal((len(idofs), 1)))[:, 0]
 
-    def eigen(k: int, found: np.ndarray | None) -> tuple[np.ndarray, np.ndarray]:  # reads K_ii only through solve
-        return shift_invert_pairs(solve, m_ii, k, v0, found)
+    def eigen(k: int, found: np.ndarray | None, below: float | None = None
+              ) -> tuple[np.ndarray, np.ndarray]:  # reads K_ii only through solve
+        return shift_invert_pairs(solve, m_ii, k, v0, found, below=below)
 
     vec = lowest_eigenpairs(eigen, n_modes, max_hz, limit=len(idofs) - c.shape[0] - 2)[1]
     fixed = np.zeros((fe.n_dof, vec.shape[1]))
@@ -398,7 +399,7 @@ def reduction_basis(fe: FEModel, itfs: list[Interface], n_modes: int | None, kin
     con = solver.constrained(sp.vstack([rbe3_rows(fe, i) for i in itfs]))
     static = con.solve(None, np.eye(con.p))
     m = fe.mass_operator()
-    vec = lowest_eigenpairs(lambda k, found: con.eigen(fe, k, m, found), n_modes, max_hz,
+    vec = lowest_eigenpairs(lambda k, found, below=None: con.eigen(fe, k, m, found, below), n_modes, max_hz,
                             limit=con.s.n - con.p - 2)[1]
     fixed = vec if vec.shape[1] else np.zeros((fe.n_dof, 0))
     attached = con.solve(patterns, np.zeros((con.p, patterns.shape[1]))) if circles else patterns

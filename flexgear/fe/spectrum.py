@@ -48,7 +48,9 @@ def lowest_eigenpairs(eigen: Callable[[int, np.ndarray | None], tuple[np.ndarray
     Exactly one of ``n_modes`` (the count) and ``max_hz`` (every pair with omega / 2 pi below it [Hz]) is given.
     ``limit``: the most pairs the problem has; a frequency limit beyond them returns them all. A frequency limit
     asks for more pairs until the highest found lies above it; each further call asks only for the pairs beyond
-    those already found, so that no pair is computed twice.
+    those already found, so that no pair is computed twice. An ``eigen`` that takes the keyword ``below``
+    (lambda [1/s^2], e.g. :func:`shift_invert_pairs`) is asked once for every pair below the limit and the first
+    beyond it, in one Krylov space instead of one per call.
     """
     if (n_modes is None) == (max_hz is None):
         raise ValueError("lowest_eigenpairs: give exactly one of n_modes and max_hz")
@@ -60,7 +62,8 @@ def lowest_eigenpairs(eigen: Callable[[int, np.ndarray | None], tuple[np.ndarray
         raise ValueError(f"lowest_eigenpairs: max_hz must be > 0, got {max_hz}")
     lam_max = (2.0 * math.pi * max_hz) ** 2
     k = _FIRST_COUNT if limit is None else min(_FIRST_COUNT, limit)
-    lam, vec = eigen(k, None)
+    lam, vec = eigen(k, None, below=lam_max) if _takes_limit(eigen) else eigen(k, None)
+    k = lam.size
     while not (lam[-1] >= lam_max or (limit is not None and k >= limit)):
         ratio = math.sqrt(lam_max / max(lam[-1], 1e-300))  # frequency ratio still to go
         k_next = math.ceil(k * ratio ** _DENSITY_EXPONENT)
@@ -73,9 +76,19 @@ def lowest_eigenpairs(eigen: Callable[[int, np.ndarray | None], tuple[np.ndarray
     return lam[keep], vec[:, keep]
 
 
+def _takes_limit(eigen: Callable) -> bool:
+    """Whether ``eigen`` takes the keyword ``below`` (:func:`lowest_eigenpairs`)."""
+    import inspect
+
+    try:
+        return "below" in inspect.signature(eigen).parameters
+    except (TypeError, ValueError):
+        return False
+
+
 def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, v0: np.ndarray,
                        found: np.ndarray | None = None, tol: float = LANCZOS_TOLERANCE,
-                       block: int = LANCZOS_BLOCK) -> tuple[np.ndarray, np.ndarray]:
+                       block: int = LANCZOS_BLOCK, below: float | None = None) -> tuple[np.ndarray, np.ndarray]:
     """The ``k`` lowest eigenpairs of K x = lambda M x beyond the M-orthonormal eigenvectors ``found`` (n, j):
     block Lanczos in shift-invert mode about 0 on the deflated operator
 
@@ -84,8 +97,10 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     which has the found pairs' eigenvalues 1 / lambda moved to 0 and every other pair unchanged (K^-1 M keeps the
     M-orthogonal complement of its eigenvectors), so that its largest eigenvalues theta = 1 / lambda are the next
     lowest pairs. OP is self-adjoint in the M inner product: blocks Q_j of ``block`` M-orthonormal vectors,
-    W = OP Q_j orthogonalised against every block before (classical Gram-Schmidt, a second pass where the first
-    took more than :data:`REORTHOGONALISE_BELOW` of a column's M-norm squared) and M-orthonormalised,
+    W = OP Q_j orthogonalised against Q_j and Q_(j-1) (the three-term recurrence, whose large coefficients would
+    otherwise call for a second pass every time), then against every block before (classical Gram-Schmidt, a
+    second pass where the first took more than :data:`REORTHOGONALISE_BELOW` of a column's M-norm squared) and
+    M-orthonormalised,
     W = Q_(j+1) B_(j+1) (Cholesky QR, twice), make T = Q^T M OP Q block tridiagonal; its eigenpairs (theta, s)
     give the Ritz pairs (1 / theta, Q s), converged when the residual ||B_(j+1) s_last|| (M norm) is at most
     ``tol`` theta, as ARPACK's test. A block of vectors costs one solve of ``block`` columns and dense products.
@@ -93,6 +108,13 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     ``solve(y)`` = K^-1 y for y (n, c) [the problem's units]; ``mass`` M (n, n), anything with ``@`` on (n, c);
     ``v0`` (n,) the first start vector (the others are seeded random). Returns lambda ascending and M-orthonormal
     vectors (n, k).
+
+    ``below`` (lambda [the problem's units]): instead of ``k`` pairs, every pair below it and the first pair beyond
+    (which shows that no other lies below), ``k`` only the count at which T is first read. The Krylov space grows
+    until the Ritz pairs with theta > 1 / ``below`` and the next one have converged: Ritz values approach the
+    extreme theta from inside (Cauchy interlacing), so an unconverged pair beyond the limit may still come below it,
+    and a converged one beyond it closes the count. (Without a space of its own per count, as deflated calls with
+    growing ``k`` need, no Krylov vector is built twice.)
     """
     import scipy.linalg as la
 
@@ -115,6 +137,7 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
     chunks: list[np.ndarray] = []  # the Lanczos vectors, in chunks of LANCZOS_CHUNK blocks (never copied)
     t = np.zeros((k + 3 * b,) * 2)  # T to its first reading (k + b vectors) and one block beyond; doubled as needed
     m = 0
+    recent: list[tuple[int, np.ndarray, np.ndarray]] = []  # the last two blocks: (first column, Q_j, M Q_j)
     while True:
         if m % (LANCZOS_CHUNK * b) == 0:
             chunks.append(np.empty((n, LANCZOS_CHUNK * b)))
@@ -122,9 +145,15 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
             t = np.pad(t, ((0, t.shape[0]), (0, t.shape[0])))
         j = m % (LANCZOS_CHUNK * b)
         chunks[-1][:, j:j + b] = q
+        recent = [*recent[-1:], (m, chunks[-1][:, j:j + b], mq)]
         w = op(mq)
         h = np.zeros((m + b, b))
         mw = np.asarray(mass @ w)
+        for first, qj, mqj in recent:  # the recurrence's own terms first, M W kept by the blocks' M Q_j
+            coef = qj.T @ mw
+            w -= qj @ coef
+            mw -= mqj @ coef
+            h[first:first + b] += coef
         for _ in range(2):  # full reorthogonalisation: classical Gram-Schmidt, a second pass where needed
             before = np.einsum("ij,ij->j", w, mw)
             for i, c in enumerate(_filled(chunks, m + b, LANCZOS_CHUNK * b)):
@@ -142,10 +171,14 @@ def shift_invert_pairs(solve: Callable[[np.ndarray], np.ndarray], mass, k: int, 
         if m < k + b and m + b <= free:  # T is first read with a block beyond the k pairs (or all there is)
             continue
         theta, s_ = la.eigh(t[:m, :m], lower=False)  # T's upper triangle: the coefficients as computed
+        if below is not None:  # every Ritz pair below the limit and the first beyond it
+            k = min(int(np.count_nonzero(theta * below > 1.0)) + 1, m)
         top = np.arange(m - k, m)  # the k largest theta: the lowest lambda
         resid = np.linalg.norm(r @ s_[m - b:m, top], axis=0)
         if np.all(resid <= tol * np.abs(theta[top])):
             break
+        if m + b > free and below is not None:
+            break  # the whole space: T's pairs are the problem's
         if m + b > free:
             raise RuntimeError(f"shift_invert_pairs: {k} pairs not converged in {m} Lanczos vectors")
     vec = sum(c @ s_[i * LANCZOS_CHUNK * b:i * LANCZOS_CHUNK * b + c.shape[1], top]
