@@ -30,7 +30,7 @@ def main() -> None:
     s, th = r.signals, r.meta["theory"]
     w = s[s.time_s >= 0.55]
     print(f"{variant.name}: best {min(walls):.2f} s, median {statistics.median(walls):.2f} s over {a.repeat} runs")
-    print(f"output speed {w.output_speed_deg_per_s.mean():.4f} deg/s (theory {th['output_speed_deg_per_s']:.4f})")
+    print(f"output speed {w.output_speed_rad_per_s.mean():.6f} rad/s (theory {th['output_speed_rad_per_s']:.6f})")
     for kind in ("outer", "inner"):
         f = w[[f"{kind}_mesh_force_{i}_n" for i in range(1, 6)]].mean()
         print(f"{kind} mesh force {f.mean():.4f} N (theory {th['mesh_force_n']:.4f}), spread {f.max() - f.min():.4f} N")

@@ -73,7 +73,7 @@ def mode_track(t: np.ndarray, phase: np.ndarray, load: np.ndarray, order: int, f
 def interference(result, side: str, ridge, crossings, per_rpm: float) -> tuple[float, float, int]:
     """(residual with, residual without the matched mode (and its degenerate partner), number of modes fitted)."""
     s = result.signals
-    t, n = s["time_s"].to_numpy(), s["input_speed_deg_per_s"].to_numpy() / 6.0
+    t, n = s["time_s"].to_numpy(), s["input_speed_rad_per_s"].to_numpy() * 30.0 / np.pi  # rpm
     phase, load, k = mesh_phase(t, n, per_rpm), mesh_excitation(s), int(ridge["order"])
     ramp = float(result.meta.get("ramp_time_s") or t[-1])
     hop = int(round(DEFAULT_HOP_S / (t[1] - t[0])))

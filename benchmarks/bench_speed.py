@@ -224,7 +224,7 @@ def variants_table(a: argparse.Namespace) -> None:
         if r.ok:
             s, th = r.signals, r.meta["theory"]
             w = s[s.time_s >= 0.9 * s.time_s.iloc[-1]]
-            row["output_speed_err_pct"] = 100 * (w.output_speed_deg_per_s.mean() / th["output_speed_deg_per_s"] - 1)
+            row["output_speed_err_pct"] = 100 * (w.output_speed_rad_per_s.mean() / th["output_speed_rad_per_s"] - 1)
             for kind in ("outer", "inner"):
                 forces = [c for c in w.columns if c.startswith(f"{kind}_mesh_force")]
                 row[f"{kind}_force_n"] = w[forces].to_numpy().mean()

@@ -22,7 +22,13 @@ import pandas as pd
 
 from flexgear.cache import atomic_write_bytes
 
-__all__ = ["RunResult", "SIGNAL_TYPES", "signal_columns", "save_result", "load_result", "envelope"]
+__all__ = ["RunResult", "SIGNAL_TYPES", "LEGACY_SPEED_COLUMNS", "signal_columns", "save_result", "load_result",
+           "envelope"]
+
+LEGACY_SPEED_COLUMNS = {"input_speed_deg_per_s": "input_speed_rad_per_s",
+                        "output_speed_deg_per_s": "output_speed_rad_per_s"}
+"""Speed columns (and ``theory`` keys) of results written before every signal took SI units: old name -> name now;
+:func:`load_result` reads them as the new columns, converted from deg/s to rad/s."""
 
 SIGNAL_TYPES: dict[str, tuple[str, str]] = {
     "input_speed": ("input speed", "speed [°/s]"),
@@ -40,7 +46,7 @@ def signal_columns(planet_count: int) -> list[str]:
     """Column names of the signal table, in order (units in the names).
 
     - ``time_s``
-    - ``input_speed_deg_per_s``, ``output_speed_deg_per_s``: spin speeds of input and output shaft
+    - ``input_speed_rad_per_s``, ``output_speed_rad_per_s``: spin speeds of input and output shaft
     - ``transmission_ratio``: output / input speed
     - ``input_torque_nm``: drive torque on the input shaft
     - ``outer_mesh_force_{i}_n``: normal force of the sun-planet mesh of planet i (1-based)
@@ -57,7 +63,7 @@ def signal_columns(planet_count: int) -> list[str]:
       deflection of the flexible gears of mesh i along the tooth normal, relative to each gear's bore or seat
       interface, load-induced and centrifugal parts (present when a gear of the mesh is flexible)
     """
-    cols = ["time_s", "input_speed_deg_per_s", "output_speed_deg_per_s", "transmission_ratio", "input_torque_nm"]
+    cols = ["time_s", "input_speed_rad_per_s", "output_speed_rad_per_s", "transmission_ratio", "input_torque_nm"]
     cols += [f"outer_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
     cols += [f"inner_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
     cols += [f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y")]
@@ -92,7 +98,7 @@ class RunResult:
         if s is None:
             raise ValueError(f"run {self.name!r} has no signals")
         if kind in ("input_speed", "output_speed"):
-            return s[f"{kind}_deg_per_s"].to_numpy()
+            return np.degrees(s[f"{kind}_rad_per_s"].to_numpy())
         if kind in ("outer_mesh_force", "inner_mesh_force"):
             mesh = kind.split("_")[0]
             return s[[c for c in s.columns if c.startswith(f"{mesh}_mesh_force_")]].to_numpy().mean(axis=1)
@@ -153,11 +159,19 @@ def save_result(result: RunResult, run_dir: str | Path, inputs: dict[str, bytes]
 
 
 def load_result(run_dir: str | Path) -> RunResult:
-    """Read a run directory written by :func:`save_result`."""
+    """Read a run directory written by :func:`save_result` (speeds written in deg/s by earlier versions as the
+    rad/s columns of :data:`LEGACY_SPEED_COLUMNS`)."""
     run_dir = Path(run_dir)
     meta = json.loads((run_dir / "run.json").read_text())
     signals_path = run_dir / "signals.parquet"
     signals = pd.read_parquet(signals_path) if signals_path.exists() and meta.get("status") == "ok" else None
+    theory = meta.get("theory")
+    for old, new in LEGACY_SPEED_COLUMNS.items():
+        if signals is not None and old in signals.columns:
+            signals = signals.rename(columns={old: new})
+            signals[new] = np.radians(signals[new].to_numpy())
+        if isinstance(theory, dict) and old in theory:
+            theory[new] = float(np.radians(theory.pop(old)))
     extra = {n: pd.read_parquet(run_dir / f"{n}.parquet") for n in meta.get("extra_tables", [])}
     return RunResult(meta, signals, extra)
 
@@ -182,7 +196,7 @@ def run_metadata(name: str, backend: str, config_hash: str, t_end_s: float, load
     """The metadata block every backend writes beside its signals (``run.json``).
 
     ``load_case``: the spec's LoadCase (step and ramp times [s]); ``theory``: flexgear.theory.Theory of the
-    same spec (the study's theoretical values, SI, speeds in deg/s only in the keys that say so).
+    same spec (the study's theoretical values, SI).
     """
     import datetime as _dt
 
@@ -191,8 +205,7 @@ def run_metadata(name: str, backend: str, config_hash: str, t_end_s: float, load
         "t_end_s": t_end_s, "step_size_s": load_case.step_size_s, "ramp_time_s": load_case.ramp_time_s,
         "planet_count": planet_count,
         "theory": {
-            "input_speed_deg_per_s": theory.input_speed_deg_per_s,
-            "output_speed_deg_per_s": theory.output_speed_deg_per_s,
+            "input_speed_rad_per_s": theory.input_speed, "output_speed_rad_per_s": theory.output_speed,
             "ratio": theory.ratio, "input_torque_nm": theory.input_torque, "output_torque_nm": theory.output_torque,
             "mesh_force_n": theory.mesh_force, "mesh_frequency_hz": theory.mesh_frequency,
         },

@@ -102,8 +102,8 @@ def radial_rms(ax: np.ndarray, ay: np.ndarray) -> float:
 
 def settling_values(signals: pd.DataFrame, slices: list[slice]) -> dict[str, np.ndarray]:
     """Each settling signal's value in each segment (module docstring): key -> array over ``slices``."""
-    speed = {"input_speed": signals["input_speed_deg_per_s"].to_numpy(),
-             "output_speed": signals["output_speed_deg_per_s"].to_numpy()}
+    speed = {"input_speed": signals["input_speed_rad_per_s"].to_numpy(),
+             "output_speed": signals["output_speed_rad_per_s"].to_numpy()}
     forces = {"outer": mesh_forces(signals, "outer"), "inner": mesh_forces(signals, "inner")}
     acc = {side: (signals[f"{side}_bearing_accel_x_m_per_s2"].to_numpy(),
                   signals[f"{side}_bearing_accel_y_m_per_s2"].to_numpy()) for side in ("input", "output")}

@@ -38,7 +38,7 @@ TABLE7_MBD = {1: (0.0549, 0.0590), 2: (0.0020, 0.0008), 4: (0.0126, 0.0014), 6: 
 
 def theory_meta() -> dict:
     th = theory(load_gearbox(GEARBOX))
-    return {"input_speed_deg_per_s": th.input_speed_deg_per_s, "output_speed_deg_per_s": th.output_speed_deg_per_s,
+    return {"input_speed_rad_per_s": th.input_speed, "output_speed_rad_per_s": th.output_speed,
             "ratio": th.ratio, "input_torque_nm": th.input_torque, "output_torque_nm": th.output_torque,
             "mesh_force_n": th.mesh_force, "mesh_frequency_hz": th.mesh_frequency}
 
@@ -67,8 +67,8 @@ def synthetic_result(name: str, bias: dict[str, float] | None = None, cv: dict[s
 
     cols = signal_columns(planets)
     data = {"time_s": t,
-            "input_speed_deg_per_s": indicator("input_speed", th["input_speed_deg_per_s"]),
-            "output_speed_deg_per_s": indicator("output_speed", th["output_speed_deg_per_s"]),
+            "input_speed_rad_per_s": indicator("input_speed", th["input_speed_rad_per_s"]),
+            "output_speed_rad_per_s": indicator("output_speed", th["output_speed_rad_per_s"]),
             "transmission_ratio": indicator("transmission_ratio", th["ratio"]),
             "input_torque_nm": np.full(n, th["input_torque_nm"])}
     for mesh in ("outer", "inner"):

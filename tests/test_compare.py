@@ -18,8 +18,8 @@ def synthetic(name: str, backend: str, amps_in: dict[int, float], amps_out: dict
     t = np.arange(int(round(t_end / DT)) + 1) * DT
     df = pd.DataFrame(0.0, index=np.arange(t.size), columns=signal_columns(n))
     df["time_s"] = t
-    df["input_speed_deg_per_s"] = 36000.0
-    df["output_speed_deg_per_s"] = -11647.0588
+    df["input_speed_rad_per_s"] = np.radians(36000.0)
+    df["output_speed_rad_per_s"] = np.radians(-11647.0588)
     df["transmission_ratio"] = -11647.0588 / 36000.0
     for i in range(1, n + 1):
         df[f"outer_mesh_force_{i}_n"] = force + 5.0 * np.sin(2 * np.pi * F_MESH * t + i)
@@ -30,7 +30,7 @@ def synthetic(name: str, backend: str, amps_in: dict[int, float], amps_out: dict
         df[f"{side}_bearing_accel_x_m_per_s2"] = ax
         df[f"{side}_bearing_accel_y_m_per_s2"] = ay
     meta = {"variant": name, "backend": backend, "status": "ok", "ramp_time_s": ramp, "t_end_s": t_end,
-            "theory": {"input_speed_deg_per_s": 36000.0, "output_speed_deg_per_s": -11647.0588,
+            "theory": {"input_speed_rad_per_s": np.radians(36000.0), "output_speed_rad_per_s": np.radians(-11647.0588),
                        "mesh_force_n": 798.21, "mesh_frequency_hz": F_MESH}}
     return RunResult(meta, df)
 

@@ -30,8 +30,8 @@ def test_flexible_model4_runs_at_theory(flex_run):
     s = flex_run.signals
     w = s[s.time_s >= 0.08]
     th = flex_run.meta["theory"]
-    assert w.input_speed_deg_per_s.mean() == pytest.approx(36000.0, rel=1e-9)
-    assert w.output_speed_deg_per_s.mean() == pytest.approx(th["output_speed_deg_per_s"], rel=2e-4)
+    assert w.input_speed_rad_per_s.mean() == pytest.approx(np.radians(36000.0), rel=1e-9)  # 6000 rpm, Table 5
+    assert w.output_speed_rad_per_s.mean() == pytest.approx(th["output_speed_rad_per_s"], rel=2e-4)
     for kind in ("outer", "inner"):
         mean = np.mean([w[f"{kind}_mesh_force_{i}_n"].mean() for i in range(1, 6)])
         # within 1 % of the rigid-gear value (friction shifts both meshes by < 0.2 %)

@@ -89,10 +89,10 @@ def _decaying(tau: float, rel: float):
     for kind in ("outer", "inner"):
         for i, off in enumerate(np.linspace(-4.0, 4.0, 5)):
             s[f"{kind}_mesh_force_{i + 1}_n"] = th["mesh_force_n"] + off + 5.0 * np.sin(2 * np.pi * f * t)
-    for key, col in (("input_speed_deg_per_s", "input_speed_deg_per_s"), ("ratio", "transmission_ratio")):
+    for key, col in (("input_speed_rad_per_s", "input_speed_rad_per_s"), ("ratio", "transmission_ratio")):
         s[col] = th[key]
-    a = th["output_speed_deg_per_s"]
-    s["output_speed_deg_per_s"] = a * (1.0 + rel * np.exp(-np.clip(t - 0.5, 0.0, None) / tau))
+    a = th["output_speed_rad_per_s"]
+    s["output_speed_rad_per_s"] = a * (1.0 + rel * np.exp(-np.clip(t - 0.5, 0.0, None) / tau))
     return res
 
 

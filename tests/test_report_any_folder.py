@@ -216,3 +216,27 @@ def test_cli_report_of_a_non_results_path_is_one_line(tmp_path, capsys, kind):
     assert "Traceback" not in err and not output.exists()
     with pytest.raises(NotResultsFolder):
         gather(path)
+
+
+def test_results_written_with_speeds_in_deg_per_s_load_in_rad_per_s(tmp_path):
+    """A run folder of an earlier version (speed columns and theory keys in deg/s) loads in the SI schema, the
+    values converted exactly, and screens as the same run written now."""
+    from flexgear.results import LEGACY_SPEED_COLUMNS, load_result
+    from flexgear.study.indicators import indicator_segments
+
+    now = synthetic_result("model1", bias={"output_speed": 2e-4})
+    old_signals = now.signals.rename(columns={new: old for old, new in LEGACY_SPEED_COLUMNS.items()})
+    for old in LEGACY_SPEED_COLUMNS:
+        old_signals[old] = np.degrees(old_signals[old].to_numpy())
+    theory = {({v: k for k, v in LEGACY_SPEED_COLUMNS.items()}.get(k, k)): (np.degrees(v) if "speed" in k else v)
+              for k, v in now.meta["theory"].items()}
+    save_result(RunResult(dict(now.meta, theory=theory), old_signals), tmp_path / "old")
+    loaded = load_result(tmp_path / "old")
+    assert list(loaded.signals.columns) == list(now.signals.columns)
+    for new in LEGACY_SPEED_COLUMNS.values():
+        np.testing.assert_allclose(loaded.signals[new], now.signals[new], rtol=1e-14)
+        assert loaded.meta["theory"][new] == pytest.approx(now.meta["theory"][new], rel=1e-14)
+    slices = [slice(0, len(now.signals))]
+    f_mesh = now.meta["theory"]["mesh_frequency_hz"]
+    a, b = (indicator_segments(r.signals, slices, f_mesh) for r in (loaded, now))
+    assert a.keys() == b.keys() and all(np.allclose(a[k], b[k], rtol=1e-12) for k in a)

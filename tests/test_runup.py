@@ -124,7 +124,7 @@ def test_fast_sweep_ridges_lie_at_their_swept_predictions():
 def test_mesh_excitation_is_the_normalised_mesh_load():
     t, n, load = _fast_runup()
     signals = pd.DataFrame({"time_s": t, "outer_mesh_force_1_n": 300.0 * load, "inner_mesh_force_1_n": 500.0 * load,
-                            "input_speed_deg_per_s": 6.0 * n})
+                            "input_speed_rad_per_s": np.pi / 30.0 * n})
     e = mesh_excitation(signals, window_s=1e-4)
     assert np.allclose(e[100:-100], load[100:-100], atol=1e-6)
     assert mesh_excitation(signals.drop(columns=["outer_mesh_force_1_n", "inner_mesh_force_1_n"])) is None

@@ -382,7 +382,7 @@ def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: 
     n = model.system.params.planet_count
     nm = 2 * n
     t = np.arange(rec.shape[0]) * lc.step_size_s
-    w_in, w_out = np.degrees(rec[:, 0]), np.degrees(rec[:, 1])
+    w_in, w_out = rec[:, 0], rec[:, 1]  # rad/s
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(w_in != 0.0, w_out / w_in, np.nan)
     data = np.column_stack([t, w_in, w_out, ratio, rec[:, 2], rec[:, 3:3 + nm], rec[:, 3 + nm:7 + nm]])

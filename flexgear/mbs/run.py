@@ -69,8 +69,8 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     speed_in, speed_out = data("input_speed"), data("output_speed")
     n = model.spec.gears.planet_count
     cols: dict[str, np.ndarray] = {"time_s": speed_in[:, 0]}
-    cols["input_speed_deg_per_s"] = np.degrees(speed_in[:, 3])
-    cols["output_speed_deg_per_s"] = np.degrees(speed_out[:, 3])
+    cols["input_speed_rad_per_s"] = speed_in[:, 3]
+    cols["output_speed_rad_per_s"] = speed_out[:, 3]
     with np.errstate(divide="ignore", invalid="ignore"):
         cols["transmission_ratio"] = np.where(speed_in[:, 3] != 0, speed_out[:, 3] / speed_in[:, 3], np.nan)
     cols["input_torque_nm"] = -data("input_torque")[:, 1]  # constraint reaction -> torque applied by the drive
@@ -130,8 +130,7 @@ class RunGuard:
         th = model.theory
         factor = variant.gearbox.solver_assumed.runaway_speed_factor
         self.nodes = {"input": model.bodies[model.input_body].node, "output": model.bodies[model.output_body].node}
-        self.limits = {"input": factor * abs(math.radians(th.input_speed_deg_per_s)),
-                       "output": factor * abs(math.radians(th.output_speed_deg_per_s))}
+        self.limits = {"input": factor * abs(th.input_speed), "output": factor * abs(th.output_speed)}
         self.budget_s, self.t_end = budget_s, t_end
         self.reason = ""
         self.steps = 0

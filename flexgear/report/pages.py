@@ -16,6 +16,7 @@ screening tables, one page per signal type with all variants overlaid, bearing s
 from __future__ import annotations
 
 import datetime as _dt
+import math
 import textwrap
 from collections.abc import Callable
 from pathlib import Path
@@ -181,7 +182,8 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
             tv = pd.DataFrame({"theoretical value": ["input speed [°/s]", "output speed [°/s]", "ratio",
                                                      "input torque [N·m]", "output torque [N·m]",
                                                      "normal mesh force per planet [N]", "mesh frequency [Hz]"],
-                               "value": [th["input_speed_deg_per_s"], th["output_speed_deg_per_s"], th["ratio"],
+                               "value": [math.degrees(th["input_speed_rad_per_s"]),
+                                         math.degrees(th["output_speed_rad_per_s"]), th["ratio"],
                                          th["input_torque_nm"], th["output_torque_nm"], th["mesh_force_n"],
                                          th["mesh_frequency_hz"]]})
             right.text(0, y - 0.04, "Theory (flexgear.theory; study: 798.1894 N, -11647.0554 °/s)", fontsize=9,

@@ -147,7 +147,9 @@ def compare_results(a: RunResult, b: RunResult, window: tuple[float, float] | No
     rows = ["input_speed_deg_per_s", "output_speed_deg_per_s", "outer_mesh_force_n", "inner_mesh_force_n",
             "input_bearing_peak_accel_m_per_s2", "output_bearing_peak_accel_m_per_s2"]
     table6 = pd.DataFrame(index=pd.Index(rows, name="indicator"))
-    table6["theory"] = [th.get("input_speed_deg_per_s", np.nan), th.get("output_speed_deg_per_s", np.nan),
+    # Table 6 of the study, in its units: speeds in deg/s
+    table6["theory"] = [np.degrees(th.get("input_speed_rad_per_s", np.nan)),
+                        np.degrees(th.get("output_speed_rad_per_s", np.nan)),
                         th.get("mesh_force_n", np.nan), th.get("mesh_force_n", np.nan), np.nan, np.nan]
     t7 = {}
     for run, label in zip((a, b), _labels(a, b), strict=True):
@@ -155,7 +157,8 @@ def compare_results(a: RunResult, b: RunResult, window: tuple[float, float] | No
         outer = sel.filter(regex=r"^outer_mesh_force_\d+_n$").to_numpy()
         inner = sel.filter(regex=r"^inner_mesh_force_\d+_n$").to_numpy()
         peaks = [float(np.hypot(_accel(sel, side, "x"), _accel(sel, side, "y")).max()) for side in ("input", "output")]
-        table6[label] = [sel["input_speed_deg_per_s"].mean(), sel["output_speed_deg_per_s"].mean(),
+        table6[label] = [np.degrees(sel["input_speed_rad_per_s"].mean()),
+                         np.degrees(sel["output_speed_rad_per_s"].mean()),
                          outer.mean(), inner.mean(), *peaks]
         dt = float(np.median(np.diff(sel["time_s"].to_numpy())))
         for side in ("input", "output"):
@@ -172,7 +175,7 @@ def compare_results(a: RunResult, b: RunResult, window: tuple[float, float] | No
 
 
 _LOAD_CASE_KEYS = (("t_end_s", "end time [s]"), ("step_size_s", "step [s]"), ("ramp_time_s", "ramp time [s]"),
-                   ("theory.input_speed_deg_per_s", "input speed [deg/s]"), ("theory.input_torque_nm",
+                   ("theory.input_speed_rad_per_s", "input speed [rad/s]"), ("theory.input_torque_nm",
                                                                              "input torque [N m]"))
 
 

@@ -85,8 +85,8 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     """
     wanted = tuple(ALL_INDICATORS) if keys is None else keys
     has_te = "transmission_error_m" in signals.columns
-    cols = {k: signals[c].to_numpy() for k, c in (("input_speed", "input_speed_deg_per_s"),
-                                                   ("output_speed", "output_speed_deg_per_s"),
+    cols = {k: signals[c].to_numpy() for k, c in (("input_speed", "input_speed_rad_per_s"),
+                                                   ("output_speed", "output_speed_rad_per_s"),
                                                    ("transmission_ratio", "transmission_ratio"))}
     fo, fi = mesh_forces(signals, "outer"), mesh_forces(signals, "inner")
     acc = {side: (signals[f"{side}_bearing_accel_x_m_per_s2"].to_numpy(),

@@ -95,7 +95,7 @@ random: its maxima are noise)."""
 ORDERS = tuple(range(1, 11))
 """Mesh orders k tracked: 1x to 10x (the Campbell diagram's)."""
 
-RPM_PER_DEG_PER_S = 1.0 / 6.0  # 1 deg/s = 1/360 rev/s = 60/360 rpm
+RPM_PER_RAD_PER_S = 30.0 / math.pi  # 1 rad/s = 1/(2 pi) rev/s = 60/(2 pi) rpm
 
 
 def mesh_phase(time_s: np.ndarray, speed_rpm: np.ndarray, mesh_hz_per_rpm: float) -> np.ndarray:
@@ -404,7 +404,7 @@ def runup(result: RunResult, side: str = "output", axis: str = "x", campbell: An
     s = result.signals
     column = f"{side}_bearing_accel_{axis}_m_per_s2"
     t = s["time_s"].to_numpy()
-    n = s["input_speed_deg_per_s"].to_numpy() * RPM_PER_DEG_PER_S
+    n = s["input_speed_rad_per_s"].to_numpy() * RPM_PER_RAD_PER_S
     meta = result.meta
     nominal = float(((meta.get("spec") or {}).get("load_case") or {}).get("input_speed_rpm", 0.0))
     f_mesh = float((meta.get("theory") or {}).get("mesh_frequency_hz", 0.0))

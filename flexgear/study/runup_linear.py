@@ -56,7 +56,7 @@ from flexgear.study.runup import (
     DEFAULT_WINDOW_S,
     MIN_MESH_CYCLES,
     ORDERS,
-    RPM_PER_DEG_PER_S,
+    RPM_PER_RAD_PER_S,
     mesh_excitation,
     mesh_phase,
     order_tracks,
@@ -209,7 +209,7 @@ def linear_runup(result: RunResult, variant: Any, along_ramp: bool = False, harm
 
     s = result.signals
     t = s["time_s"].to_numpy()
-    n = s["input_speed_deg_per_s"].to_numpy() * RPM_PER_DEG_PER_S
+    n = s["input_speed_rad_per_s"].to_numpy() * RPM_PER_RAD_PER_S
     lc = variant.gearbox.load_case
     per_rpm = float(result.meta["theory"]["mesh_frequency_hz"]) / lc.input_speed_rpm
     ramp = float(result.meta.get("ramp_time_s") or t[-1])

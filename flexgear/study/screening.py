@@ -73,8 +73,8 @@ INDICATORS: dict[str, str] = STUDY_INDICATORS
 """The study's five indicators (section 2.2): key -> readable name."""
 
 _THEORY_KEYS = {
-    "input_speed": "input_speed_deg_per_s",
-    "output_speed": "output_speed_deg_per_s",
+    "input_speed": "input_speed_rad_per_s",
+    "output_speed": "output_speed_rad_per_s",
     "transmission_ratio": "ratio",
     "outer_mesh_force": "mesh_force_n",
     "inner_mesh_force": "mesh_force_n",
