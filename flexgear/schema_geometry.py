@@ -47,11 +47,12 @@ LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 """Length unit of a file's coordinates -> metres per unit."""
 _COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft")
 SELECTABLE_REGIONS = {"sun": ("bore", "flanks"), "planet": ("bore", "flanks"),
-                      "ring": ("flanks", "bolt_holes", "bolt_hole_<k>"),
+                      "ring": ("flanks", "bolt_holes", "bolt_hole_<k>", "bolt_discs"),
                       "input_shaft": ("bearing_seat", "gear_seat"),
-                      "output_shaft": ("bearing_seat", "bolt_holes", "bolt_hole_<k>")}
+                      "output_shaft": ("bearing_seat", "bolt_holes", "bolt_hole_<k>", "bolt_discs")}
 """Component -> the mesh regions its reduction's interfaces and contact bands stand on (``bolt_hole_<k>``: the
-k-th bolt hole alone, k = 0, 1, ...)."""
+k-th bolt hole alone, k = 0, 1, ...; ``bolt_discs``: the bolts' clamped discs on the flange or web face, one
+patch per bolt, in place of the discs the bolt circle and ``bolt_clamp_diameter_mm`` give, flexgear.fe.bolted)."""
 SELECTOR_KINDS = ("cylinder", "points", "physical_group")
 """The kinds of a region selector (module docstring)."""
 _GROUP_SUFFIXES = (".msh", ".inp")

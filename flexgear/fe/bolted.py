@@ -47,14 +47,22 @@ def bolt_axes(spec: GearboxSpec | Design) -> tuple[np.ndarray, float, float]:
     return flange.section.hole_centres(), flange.section.hole_radius, flange.z1
 
 
-def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float | None = None) -> list[np.ndarray]:
+def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float | None = None,
+                    component: str | None = None) -> list[np.ndarray]:
     """Per bolt, the nodes of ``fe`` on the interface plane z_j within the clamped disc around its axis.
 
     ``clamp_radius`` [m] defaults to half of ``[joints_assumed] bolt_clamp_diameter_mm``; the hole's edge
     (at the hole radius) is included. Works for the ring (flange face) and the output shaft (web face).
+    ``component`` (the ring or the output shaft that ``fe`` models): when its part comes from a file whose
+    ``regions`` name ``bolt_discs`` (flexgear.schema_geometry), the discs that selector picks on ``fe`` instead
+    (one per bolt, bolt k nearest the polar angle 2 pi k / n; flexgear.fe.selectors.selected_discs), unless a
+    ``clamp_radius`` is given.
     """
     d = as_design(spec)
     centres, hole_radius, z_j = bolt_axes(d)
+    selected = _selected_discs(fe, d, component, len(centres)) if clamp_radius is None else None
+    if selected is not None:
+        return selected
     radius = d.spec.joints_assumed.bolt_clamp_diameter_mm * 1e-3 / 2 if clamp_radius is None else clamp_radius
     on_plane = np.abs(fe.nodes[:, 2] - z_j) < _TOL
     out = []
@@ -66,6 +74,18 @@ def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float
                              f"of radius {radius:.4f} m; refine the mesh or widen bolt_clamp_diameter_mm")
         out.append(nodes)
     return out
+
+
+def _selected_discs(fe: FEModel, d: Design, component: str | None, n_bolts: int) -> list[np.ndarray] | None:
+    """The clamped discs of ``component``'s imported part by its ``bolt_discs`` selector (None: no such selector)."""
+    entry = d.spec.components_geometry.get(component) if component is not None else None
+    chosen = next((s for s in entry.regions if s.region == "bolt_discs"), None) if entry is not None else None
+    if chosen is None:
+        return None
+    from flexgear.fe.selectors import group_points, selected_discs
+
+    groups = group_points(entry.source, entry.scale) if chosen.group else None
+    return selected_discs(chosen, fe.nodes, fe.surface_triangles, n_bolts, groups)
 
 
 def shape_functions(bary: np.ndarray, n_nodes: int) -> np.ndarray:

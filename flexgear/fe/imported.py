@@ -229,7 +229,10 @@ def check_imported_mesh(d: Design, component: str, mesh: ComponentMesh, entry: C
     """Refuse (:class:`GeometryFileError`) an imported mesh whose regions find no node (or, but the flanks, nodes
     that hold no whole boundary face: no surface), or whose teeth do not match the gear data
     (:func:`_check_teeth`); the bolts' clamped discs must each hold nodes (flexgear.fe.bolted)."""
+    selected = {s.region for s in entry.regions}
     for name in _REGIONS[component]:
+        if name == "bolt_discs" and name not in selected:
+            continue  # the built-in discs: checked below
         nodes = mesh.regions.get(name, np.zeros(0, np.int64))
         if not len(nodes) or (name != "flanks" and not len(whole_faces(nodes, mesh.nodes, mesh.surface))):
             plural = "s" if len(nodes) > 1 else ""
@@ -237,7 +240,7 @@ def check_imported_mesh(d: Design, component: str, mesh: ComponentMesh, entry: C
             raise GeometryFileError(component, entry, f"region {name!r} finds no node{found} on its mesh (by the "
                                     "gear data's rule, flexgear.fe.mesh.region_nodes): is the part in the "
                                     "component's frame and of the gear data's dimensions?")
-    if component in ("ring", "output_shaft"):
+    if component in ("ring", "output_shaft") and "bolt_discs" not in selected:
         from flexgear.fe.bolted import clamped_patches
 
         try:

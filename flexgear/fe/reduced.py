@@ -73,7 +73,7 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
         bore = getattr(c, f"{component}_bore_diameter_mm") * 1e-3 / 2
         return [_interface(fe, d, component, np.abs(r - bore) < _TOL, "bore")]
     if component == "ring":
-        return [patch_union(fe, d, BOLT_PATCHES)]
+        return [patch_union(fe, d, BOLT_PATCHES, component)]
     tube = [p for p in d.layouts[component].prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
@@ -83,15 +83,16 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
         joints = [_interface(fe, d, component, on_tube & (z > z0 - _TOL) & (z < z1 + _TOL), "sun_seat")]
         far = (z < tube.z0 + seat + _TOL)
     else:
-        joints = [patch_union(fe, d, BOLT_PATCHES)]
+        joints = [patch_union(fe, d, BOLT_PATCHES, component)]
         far = (z > tube.z1 - seat - _TOL)
     return [*joints, _interface(fe, d, component, on_tube & far, "bearing_seat")]
 
 
 SELECTED_INTERFACES = {"bore": "bore", "bearing_seat": "bearing_seat", "sun_seat": "gear_seat"}
 """Interface -> the region of ``[components_geometry] <component>.regions`` that places it on an imported part
-(flexgear.schema_geometry.RegionSelector). The bolt patches stay on the bolt circle of the gear data
-(flexgear.fe.bolted), the contact bands on the gear data's meshes."""
+(flexgear.schema_geometry.RegionSelector). The bolt patches are the clamped discs a ``bolt_discs`` selector picks,
+else those of the bolt circle (flexgear.fe.bolted.clamped_patches); the contact bands stay on the gear data's
+meshes."""
 
 
 def _interface(fe, d: Design, component: str, builtin: np.ndarray, name: str) -> Interface:
@@ -109,13 +110,15 @@ def _interface(fe, d: Design, component: str, builtin: np.ndarray, name: str) ->
     return interface(fe, picked_nodes(chosen, fe.nodes, fe.surface_triangles, groups), name)
 
 
-def patch_union(fe, spec: GearboxSpec | Design, name: str) -> Interface:
+def patch_union(fe, spec: GearboxSpec | Design, name: str, component: str | None = None) -> Interface:
     """The clamped discs of ``fe`` (the ring's flange face or the output shaft's web face,
     flexgear.fe.bolted.clamped_patches) as one interface ``name``: their nodes in ascending order, each disc's
     nodes weighted equally and each disc in all 1 / (number of bolts), the point their weighted centroid (on the
     axis in the flange-web plane, to the mesh's asymmetry). Rigid (RBE2) as a reduction interface: the weights
-    only define its RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid motion."""
-    patches = clamped_patches(fe, spec)
+    only define its RBE3 reading (flexgear.fe.cms.rbe3_weights), which for a rigid patch is its rigid motion.
+    ``component``: the ring or output shaft ``fe`` models, whose imported part may select its discs
+    (flexgear.fe.bolted.clamped_patches)."""
+    patches = clamped_patches(fe, spec, component=component)
     nodes = np.concatenate(patches)
     weights = np.concatenate([np.full(len(p), 1.0 / len(p)) for p in patches]) / len(patches)
     order = np.argsort(nodes)

@@ -80,14 +80,14 @@ def tied_pair(ring: FEModel, shaft: FEModel, spec: GearboxSpec, clamp_radius: fl
     web face as slave nodes, the ring's flange face the master, the plane z = z_j): the tie of
     flexgear.fe.bolted.tie_matrix, as a flexgear.fe.tied.TiedFE with parts named as :data:`PAIR`."""
     _, _, z_j = bolt_axes(spec)
-    slaves = np.concatenate(clamped_patches(shaft, spec, clamp_radius))
+    slaves = np.concatenate(clamped_patches(shaft, spec, clamp_radius, component="output_shaft"))
     return tie_parts([ring, shaft], [Tie(0, 1, slaves, (0.0, 0.0, z_j))], PAIR)
 
 
 def ring_seat(ring: FEModel, spec: GearboxSpec) -> Interface:
     """The ring's side of the joint: the union of its clamped discs (node indices of ``ring``), each disc's nodes
     weighted equally and each disc in all 1 / (number of bolts)."""
-    return patch_union(ring, spec, RING_SEAT)
+    return patch_union(ring, spec, RING_SEAT, "ring")
 
 
 def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> list[Interface]:

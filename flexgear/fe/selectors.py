@@ -15,7 +15,8 @@ built-in holes are: hole k nearest 2 pi k / n); ``bolt_hole_<k>`` named alone re
   hold nodes but no whole face);
 - its faces form another number of connected patches (faces sharing a node are connected) than the region is
   made of: one for ``bore``, ``bearing_seat``, ``gear_seat`` and each ``bolt_hole_<k>``, the layout's number of
-  holes for ``bolt_holes``, any number for ``flanks`` (two per tooth);
+  holes for ``bolt_holes`` and for ``bolt_discs`` (one clamped disc per bolt), any number for ``flanks`` (two per
+  tooth);
 - two of its faces sharing an edge turn by more than :data:`FEATURE_ANGLE_DEG` (the selection goes round an edge
   of the part onto another surface, such as a bore and the end face it meets at a right angle).
 
@@ -37,7 +38,7 @@ import numpy as np
 from flexgear.schema_geometry import RegionSelector
 
 __all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "whole_faces", "check_surface",
-           "selected_regions"]
+           "patches_by_angle", "selected_discs", "selected_regions"]
 
 FEATURE_ANGLE_DEG = 75.0
 """Two faces of one selection that share an edge may turn by at most this angle [deg] (module docstring)."""
@@ -179,14 +180,33 @@ def check_surface(selector: RegionSelector, picked: np.ndarray, nodes: np.ndarra
     return of_node[picked]
 
 
-def _holes(picked: np.ndarray, label: np.ndarray, nodes: np.ndarray) -> dict[str, np.ndarray]:
-    """``bolt_hole_<k>`` of a ``bolt_holes`` selection: the nodes of each patch, k by the polar angle of its
-    centroid (hole k nearest 2 pi k / n, as the built-in holes)."""
+def patches_by_angle(picked: np.ndarray, label: np.ndarray, nodes: np.ndarray) -> list[np.ndarray]:
+    """The nodes of each patch of a selection (``label`` from :func:`check_surface`), patch k the one whose centroid
+    lies nearest the polar angle 2 pi k / n (as the built-in bolt holes are numbered). A node off the selection's
+    whole faces (label -1: an edge node) joins the patch whose centroid is nearest."""
     n = int(label.max()) + 1
-    sets = [picked[label == j] for j in range(n)]
-    angle = [math.atan2(*nodes[s, 1::-1].mean(axis=0)) for s in sets]
-    order = np.argsort([(a + math.pi / n) % (2 * math.pi) for a in angle])
-    return {f"bolt_hole_{k}": sets[j] for k, j in enumerate(order)}
+    centres = np.array([nodes[picked[label == j]].mean(axis=0) for j in range(n)])
+    label = label.copy()
+    off = label < 0
+    if off.any():
+        label[off] = np.argmin(np.linalg.norm(nodes[picked[off]][:, None, :] - centres[None], axis=2), axis=1)
+    angle = np.arctan2(centres[:, 1], centres[:, 0])
+    order = np.argsort((angle + math.pi / n) % (2 * math.pi))
+    return [np.sort(picked[label == j]) for j in order]
+
+
+def _holes(picked: np.ndarray, label: np.ndarray, nodes: np.ndarray) -> dict[str, np.ndarray]:
+    """``bolt_hole_<k>`` of a ``bolt_holes`` selection (:func:`patches_by_angle`)."""
+    return {f"bolt_hole_{k}": s for k, s in enumerate(patches_by_angle(picked, label, nodes))}
+
+
+def selected_discs(selector: RegionSelector, nodes: np.ndarray, surface: np.ndarray, n_bolts: int,
+                   groups: dict[str, np.ndarray] | None = None) -> list[np.ndarray]:
+    """The bolts' clamped discs that a ``bolt_discs`` selector picks on a mesh (``nodes`` [m], boundary triangles
+    ``surface``): one patch per bolt, ``n_bolts`` of them on one plane surface each (:func:`check_surface`), bolt k
+    the patch nearest the polar angle 2 pi k / n (:func:`patches_by_angle`)."""
+    picked = picked_nodes(selector, nodes, surface, groups)
+    return patches_by_angle(picked, check_surface(selector, picked, nodes, surface, n_bolts), nodes)
 
 
 def selected_regions(selectors: tuple[RegionSelector, ...], builtin: dict[str, np.ndarray], n_holes: int,
@@ -199,7 +219,8 @@ def selected_regions(selectors: tuple[RegionSelector, ...], builtin: dict[str, n
     out = dict(builtin)
     for s in selectors:
         picked = picked_nodes(s, nodes, surface, groups, strict)
-        expected = n_holes if s.region == "bolt_holes" else 1 if s.region in _SINGLE or "_hole_" in s.region else None
+        expected = (n_holes if s.region in ("bolt_holes", "bolt_discs")
+                    else 1 if s.region in _SINGLE or "_hole_" in s.region else None)
         if s.region.startswith("bolt_hole_") and strict and int(s.region.removeprefix("bolt_hole_")) >= n_holes:
             raise SelectorError(f"{s.describe()}: the part has {n_holes} bolt holes (bolt_hole_0 .. "
                                 f"bolt_hole_{n_holes - 1})")
