@@ -320,8 +320,8 @@ def _args_meshes(p: argparse.ArgumentParser) -> None:
 
 
 def cmd_meshes(a: argparse.Namespace) -> int:
-    from flexgear.fe.build import build_components
-    from flexgear.spec import GEOMETRY_COMPONENTS, SpecError
+    from flexgear.fe.build import build_components, build_items
+    from flexgear.spec import SpecError
 
     spec = _gearbox_or_variant(a.gearbox)
     if a.level not in spec.meshing_assumed:
@@ -330,8 +330,8 @@ def cmd_meshes(a: argparse.Namespace) -> int:
     if a.workers < 1:
         raise SystemExit(f"flexgear meshes: --workers must be >= 1, got {a.workers}")
     what = "meshes" if a.no_reduce else "meshes and reduced bodies"
-    with Progress(len(GEOMETRY_COMPONENTS), f"{what} ({a.level})", "parts", fmt="{:.0f}",
-                  plain_step=1 / len(GEOMETRY_COMPONENTS)) as bar:
+    items = build_items(not a.no_reduce)
+    with Progress(len(items), f"{what} ({a.level})", "parts", fmt="{:.0f}", plain_step=1 / len(items)) as bar:
         def done(c) -> None:
             modes = "" if c.n_modes is None else f", {c.n_modes} modes, first {c.first_frequency_hz:.0f} Hz"
             bar.update_to(bar.value + 1, postfix=f"{c.component}: {c.n_elements} tetrahedra, order "

@@ -8,7 +8,7 @@ import pytest
 import scipy.sparse.linalg as sla
 from test_flexible import STEEL, ring_mesh
 
-from flexgear.fe.build import COLD_BUILD_ORDER, build_components
+from flexgear.fe.build import COLD_BUILD_ORDER, build_components, build_items
 from flexgear.fe.cholesky import SparseCholesky
 from flexgear.fe.fem import fe_model
 from flexgear.spec import GEOMETRY_COMPONENTS
@@ -54,7 +54,10 @@ def test_cholesky_refuses_a_coordinate_without_stiffness():
 
 
 def test_cold_build_schedules_every_component_and_checks_its_workers(gearbox):
-    assert sorted(COLD_BUILD_ORDER) == sorted(GEOMETRY_COMPONENTS)
+    from flexgear.fe.ring_shaft import TIED_PAIR
+
+    assert sorted(COLD_BUILD_ORDER) == sorted(build_items()) == sorted((*GEOMETRY_COMPONENTS, TIED_PAIR))
+    assert build_items(reduce=False) == GEOMETRY_COMPONENTS
     with pytest.raises(ValueError, match="workers"):
         build_components(gearbox, "coarse", workers=0)
 

@@ -2,12 +2,13 @@
 
 ``build_components(spec, level, reduce=True, workers=2)`` runs one task per component, each in a worker
 process: mesh (one Netgen run; flexgear.fe.mesh keeps the first-order mesh in memory for the reduction),
-then the reduced body (flexgear.fe.reduced, cached like any other call). The components are independent,
-so the results are those of the serial build (same cache entries). Longest tasks are started first
-(:data:`COLD_BUILD_ORDER`) so that two workers finish together. Memory: each worker holds one
-component at a time, and its large arrays go back to the system when freed (flexgear.heap); at the coarse
-level with the default bolt-patch joint the largest process (the ring's) peaks at 1.45 GB and the whole
-process tree at 2.06 GB (sum of proportional set sizes; benchmarks/bench_cold.py measures both).
+then the reduced body (flexgear.fe.reduced, cached like any other call). With ``reduce`` one more task builds
+the tied ring and output shaft (flexgear.fe.ring_shaft, :data:`~flexgear.fe.ring_shaft.TIED_PAIR`), the one
+body of a variant whose ring and output shaft are both flexible. The tasks are independent (a mesh two tasks need
+is built by the first and waited for by the other, flexgear.cache), so the results are those of the serial build
+(same cache entries). Longest tasks are started first (:data:`COLD_BUILD_ORDER`) so that two workers finish
+together. Memory: each worker holds one task at a time, and its large arrays go back to the system when freed
+(flexgear.heap).
 """
 
 from __future__ import annotations
@@ -17,15 +18,21 @@ from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
 
+from flexgear.fe.ring_shaft import PAIR, TIED_PAIR
 from flexgear.heap import lean_heap
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
 
-__all__ = ["ComponentSummary", "build_components", "COLD_BUILD_ORDER"]
+__all__ = ["ComponentSummary", "build_components", "build_items", "COLD_BUILD_ORDER"]
 
-COLD_BUILD_ORDER = ("ring", "planet", "sun", "output_shaft", "input_shaft")
-"""Components longest cold build first (coarse level, measured with benchmarks/bench_cold.py: ring about
-twice the planet or the sun, the output shaft half of those, the input shaft a few seconds). Only the
-schedule depends on it; a component missing here is built last."""
+COLD_BUILD_ORDER = (TIED_PAIR, "planet", "sun", "input_shaft", "output_shaft", "ring")
+"""Tasks in the order they start (coarse level, benchmarks/RESULTS.md): the tied ring and output shaft, the
+longest by far (it meshes both parts first), takes one worker; the other builds the rest, the ring last, whose mesh
+the tied pair's task has made by then. Only the schedule depends on it; a task missing here starts last."""
+
+
+def build_items(reduce: bool = True) -> tuple[str, ...]:
+    """The tasks of :func:`build_components`: every component, and with ``reduce`` the tied ring and output shaft."""
+    return (*GEOMETRY_COMPONENTS, *((TIED_PAIR,) if reduce else ()))
 
 
 @dataclass(frozen=True)
@@ -40,28 +47,33 @@ class ComponentSummary:
 
 
 def build_component(spec: GearboxSpec, component: str, level: str, reduce: bool = True) -> ComponentSummary:
-    """Mesh of ``component`` at ``level`` (the level's element order) and, if ``reduce``, its reduced body."""
+    """Mesh of ``component`` at ``level`` (the level's element order) and, if ``reduce``, its reduced body;
+    ``component`` :data:`~flexgear.fe.ring_shaft.TIED_PAIR`: the meshes of the ring and the output shaft (their
+    elements summed) and their tied body."""
     from flexgear.fe.mesh import component_mesh
     from flexgear.fe.reduced import component_reduced_body
+    from flexgear.fe.ring_shaft import tied_pair_body
 
-    mesh = component_mesh(spec, component, level)
+    meshes = [component_mesh(spec, c, level) for c in (PAIR if component == TIED_PAIR else (component,))]
+    elements, order = sum(m.n_elements for m in meshes), meshes[0].order
     if not reduce:
-        return ComponentSummary(component, mesh.n_elements, mesh.order)
-    body = component_reduced_body(spec, component, level)
-    return ComponentSummary(component, mesh.n_elements, mesh.order, body.n_modes, float(body.frequencies_hz[0]))
+        return ComponentSummary(component, elements, order)
+    body = (tied_pair_body(spec, level) if component == TIED_PAIR else component_reduced_body(spec, component, level))
+    return ComponentSummary(component, elements, order, body.n_modes, float(body.frequencies_hz[0]))
 
 
 def build_components(spec: GearboxSpec, level: str, reduce: bool = True, workers: int = 2,
                      on_done: Callable[[ComponentSummary], None] | None = None) -> list[ComponentSummary]:
-    """:func:`build_component` of every component, in ``workers`` processes (1: in this process).
+    """:func:`build_component` of every task of :func:`build_items`, in ``workers`` processes (1: in this process).
 
-    ``on_done`` is called in this process as each component finishes. Returns the summaries in the order
-    of flexgear.spec.GEOMETRY_COMPONENTS.
+    ``on_done`` is called in this process as each task finishes. Returns the summaries in the order of
+    :func:`build_items`.
     """
     if int(workers) != workers or workers < 1:
         raise ValueError(f"build_components: workers must be an integer >= 1, got {workers!r}")
     rank = {c: i for i, c in enumerate(COLD_BUILD_ORDER)}
-    order = sorted(GEOMETRY_COMPONENTS, key=lambda c: rank.get(c, len(rank)))
+    items = build_items(reduce)
+    order = sorted(items, key=lambda c: rank.get(c, len(rank)))
     done: dict[str, ComponentSummary] = {}
 
     def finish(summary: ComponentSummary) -> None:
@@ -80,4 +92,4 @@ def build_components(spec: GearboxSpec, level: str, reduce: bool = True, workers
             futures = [pool.submit(build_component, spec, c, level, reduce) for c in order]
             for future in as_completed(futures):
                 finish(future.result())
-    return [done[c] for c in GEOMETRY_COMPONENTS]
+    return [done[c] for c in items]

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import dataclasses
 import math
+from collections import OrderedDict
 from collections.abc import Callable
 from pathlib import Path
 
@@ -319,6 +320,10 @@ def _component_reduction(spec: GearboxSpec | Design, component: str, level: str,
 
 
 CACHE_FORMAT_VERSION = 1  # bump when ReducedBody's content or the reduction changes
+LOADED_BODIES_KEPT = 8
+"""Reduced bodies one process keeps loaded (:func:`cached_reduced_body`): a Campbell diagram, a period's modes or a
+report builds the same model at many speeds and angles, and would read each body's file every time."""
+_LOADED: OrderedDict[tuple, ReducedBody] = OrderedDict()
 
 
 def reduced_cache_path(key: str, directory: str | Path | None = None) -> Path:
@@ -333,9 +338,19 @@ def cached_reduced_body(key: str, build: Callable[[], ReducedBody],
     ``key`` must be a hash of every input (flexgear.spec.spec_hash of geometry, mesh and reduction
     settings): a changed input gives a new key and a rebuild. A file that cannot be read (every member is
     read, its zip checksum checked) is rebuilt with a flexgear.cache.CacheWarning naming it; a missing body is
-    built by one process at a time, the others load its file (flexgear.cache.load_or_build).
+    built by one process at a time, the others load its file (flexgear.cache.load_or_build). A body loaded from
+    its file is kept in the process (:data:`LOADED_BODIES_KEPT`), and the same object is returned while the file is
+    unchanged: callers do not modify it.
     """
     path = reduced_cache_path(key, directory)
+    try:  # the file's identity: a file rebuilt or replaced is read again
+        stat = path.stat()
+        seen = (str(path.resolve()), stat.st_mtime_ns, stat.st_size)
+    except OSError:
+        seen = None
+    if seen in _LOADED:
+        _LOADED.move_to_end(seen)
+        return _LOADED[seen]
 
     def load() -> ReducedBody | None:
         # np.load reads each member from the file: no copy of the whole file
@@ -346,4 +361,9 @@ def cached_reduced_body(key: str, build: Callable[[], ReducedBody],
         atomic_write_bytes(path, body.save())
         return body
 
-    return load_or_build(path, load, store)
+    body = load_or_build(path, load, store)
+    if seen is not None:  # loaded from its file: kept for the next call (the least recently used one dropped)
+        _LOADED[seen] = body
+        while len(_LOADED) > LOADED_BODIES_KEPT:
+            _LOADED.popitem(last=False)
+    return body

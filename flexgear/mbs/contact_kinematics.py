@@ -23,6 +23,7 @@ rate includes the transport of material under the contact point.
 from __future__ import annotations
 
 import math
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -56,8 +57,34 @@ def modal_contact_fourier(nodes: np.ndarray, modes: np.ndarray, point: np.ndarra
     ``point`` the contact point relative to the gear centre at zero spin; ``normal`` the tooth normal;
     nodes within ``radial_band`` of the contact radius and ``half_width`` of its axial position (the
     band of flexgear.fe.attachment.circle_band, the same the attachment modes load) are fitted by a
-    least-squares Fourier series of ``order`` harmonics in alpha.
+    least-squares Fourier series of ``order`` harmonics in alpha. A fit is kept with ``modes`` (while that array
+    lives) and returned again, read-only, for the same arguments: a model built at many speeds or angles fits once.
     """
+    fits = _fits_of(modes)
+    key = (id(nodes), np.asarray(point, float).tobytes(), np.asarray(normal, float).tobytes(), float(half_width),
+           float(radial_band), int(order))
+    if key not in fits:
+        fits[key] = _fourier_fit(nodes, modes, point, normal, half_width, radial_band, order)
+        fits[key].flags.writeable = False
+    return fits[key]
+
+
+_FITS: dict[int, dict] = {}
+"""id of a live mode array -> its fits by :func:`modal_contact_fourier`'s other arguments (dropped with the array)."""
+
+
+def _fits_of(modes: np.ndarray) -> dict:
+    """The fits kept for the array ``modes`` (a new dict, forgotten when the array is freed)."""
+    key = id(modes)
+    if key not in _FITS:
+        _FITS[key] = {}
+        weakref.finalize(modes, _FITS.pop, key, None)
+    return _FITS[key]
+
+
+def _fourier_fit(nodes: np.ndarray, modes: np.ndarray, point: np.ndarray, normal: np.ndarray, half_width: float,
+                 radial_band: float, order: int) -> np.ndarray:
+    """:func:`modal_contact_fourier` computed."""
     r, z, psi = math.hypot(point[0], point[1]), point[2], math.atan2(point[1], point[0])
     circle = LoadCircle(r, z - half_width, z + half_width, order, radial_band_m=radial_band)
     sel = circle_band(nodes, circle)
