@@ -1,9 +1,11 @@
 """The runs of a variant matrix in a pool: local worker processes or a Dask cluster (flexgear.study.matrix).
 
-A run goes to a worker as a :class:`RunTask` carrying the *content* of its variant and gearbox files (no paths to
-open); the worker runs it (:func:`run_task`) and sends the :class:`~flexgear.results.RunResult` back, which the
-caller saves in the run's results folder as it arrives (:func:`save_task_result`). Beside the runs, jobs that need
-no run (the modal and speed screenings) take a worker the runs leave free. A worker that dies is retried alone
+A run goes to a worker as a :class:`RunTask` carrying the *content* of its variant and gearbox files and of the part
+files its ``[components_geometry]`` names (no paths to open: the worker lays the files out in a folder of its own,
+as they lie relative to each other); the worker runs it (:func:`run_task`) and sends the
+:class:`~flexgear.results.RunResult` back, which the caller saves in the run's results folder as it arrives
+(:func:`save_task_result`), with copies of those files. Beside the runs, jobs that need no run (the modal and speed
+screenings) take a worker the runs leave free. A worker that dies is retried alone
 once, then its run is recorded as failed.
 """
 
@@ -11,8 +13,10 @@ from __future__ import annotations
 
 import dataclasses
 import datetime as _dt
+import os
 import socket
 import sys
+import tempfile
 import time
 from collections.abc import Callable, Sequence
 from concurrent.futures import ProcessPoolExecutor
@@ -76,6 +80,7 @@ class RunTask:
     time_budget_s: float | None = None
     error_window_s: float = 0.0   # > 0: the run also solves its numerical error windows (the screening reference)
     out_dir: str = ""  # the caller's results folder of the run (not read by the worker)
+    parts: tuple[tuple[str, bytes], ...] = ()  # the part files of [components_geometry]: (caller's path, content)
 
     @property
     def key(self) -> tuple[str, str]:
@@ -83,9 +88,31 @@ class RunTask:
         return (self.out_dir, self.name)
 
     def inputs(self) -> dict[str, bytes]:
-        """The input files for ``inputs/`` of the run folder."""
-        return {Path(self.variant_file).name: self.variant_text.encode(),
-                Path(self.gearbox_file).name: self.gearbox_text.encode()}
+        """The input files for ``inputs/`` of the run folder: the variant and gearbox files, and each part file
+        under its path from the gearbox file's folder (its name alone where that path leaves the folder)."""
+        out = {Path(self.variant_file).name: self.variant_text.encode(),
+               Path(self.gearbox_file).name: self.gearbox_text.encode()}
+        for path, data in self.parts:
+            rel = Path(os.path.relpath(path, Path(self.gearbox_file).parent))
+            out[(rel if ".." not in rel.parts else Path(rel.name)).as_posix()] = data
+        return out
+
+    def laid_out(self, folder: Path) -> Path:
+        """Write the variant, gearbox and part files into ``folder`` as they lie relative to the variant file's
+        folder (as deep in ``folder`` as their ``..`` need); returns the variant file's path there."""
+        home = Path(self.variant_file).parent
+        files = [(Path(os.path.relpath(p, home)), data) for p, data in
+                 ((self.gearbox_file, self.gearbox_text.encode()), *self.parts)]
+        depth = max((sum(part == ".." for part in rel.parts) for rel, _ in files), default=0)
+        base = folder.joinpath(*["up"] * depth)
+        for rel, data in files:
+            target = Path(os.path.normpath(base / rel))
+            target.parent.mkdir(parents=True, exist_ok=True)
+            target.write_bytes(data)
+        variant = base / Path(self.variant_file).name
+        base.mkdir(parents=True, exist_ok=True)
+        variant.write_text(self.variant_text)
+        return variant
 
 
 def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None,
@@ -94,21 +121,27 @@ def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: floa
     or None (the load case's end: ``end_time_s``, or "settled" with ``[load_case] end = "settled"``)."""
     lc = variant.gearbox.load_case
     t_end = t_end_s if t_end_s is not None else ("settled" if lc.end == "settled" else lc.end_time_s)
-    return RunTask(variant.name, str(variant.source), Path(variant.source).read_text(),
-                   str(variant.gearbox.source), Path(variant.gearbox.source).read_text(), t_end_s,
-                   run_input_hash(variant, t_end, error_window_s), time_budget_s, error_window_s, str(out_dir))
+    parts = {str(Path(e.source).resolve()): Path(e.source).read_bytes()
+             for e in variant.gearbox.components_geometry.values()}
+    return RunTask(variant.name, str(Path(variant.source).resolve()), Path(variant.source).read_text(),
+                   str(Path(variant.gearbox.source).resolve()), Path(variant.gearbox.source).read_text(), t_end_s,
+                   run_input_hash(variant, t_end, error_window_s), time_budget_s, error_window_s, str(out_dir),
+                   tuple(sorted(parts.items())))
 
 
 def run_task(task: RunTask, runner: Runner | None = None) -> RunResult:
     """Worker side: load the variant from the shipped content, run it, return the result (writes nothing
-    but cache entries). Never raises for a model failure."""
+    but cache entries and, for a variant with part files, a temporary folder that holds them during the run,
+    :meth:`RunTask.laid_out`: the worker needs none of the caller's files). Never raises for a model failure."""
     wall0, cpu0 = time.perf_counter(), time.process_time()
     try:
-        variant = load_variant(task.variant_file, task.variant_text, task.gearbox_text)
-        extra: dict[str, Any] = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
-        if task.error_window_s > 0:
-            extra["error_window_s"] = task.error_window_s
-        result = (runner or _default_runner())(variant, t_end_s=task.t_end_s, progress=False, **extra)
+        with tempfile.TemporaryDirectory(prefix="flexgear-task-") as folder:
+            path = task.laid_out(Path(folder)) if task.parts else Path(task.variant_file)
+            variant = load_variant(path, task.variant_text, task.gearbox_text)
+            extra: dict[str, Any] = {} if task.time_budget_s is None else {"time_budget_s": task.time_budget_s}
+            if task.error_window_s > 0:
+                extra["error_window_s"] = task.error_window_s
+            result = (runner or _default_runner())(variant, t_end_s=task.t_end_s, progress=False, **extra)
     except Exception as exc:  # recorded, not raised: the other variants go on
         result = failed_result(task.name, f"{type(exc).__name__}: {exc}")
     result.meta.update(input_hash=task.input_hash, variant_file=task.variant_file, worker_host=socket.gethostname(),
