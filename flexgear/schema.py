@@ -215,6 +215,8 @@ class SolverSettings:
     spectral_radius: float = num_field(0.0, 1.0, default=0.8)
     newton_max_modified_iterations: int = num_field(1, 50, integer=True, default=3)
     newton_relative_tolerance: float = num_field(0.0, 1e-2, lo_open=True, default=1e-6)
+    # warm-started Newton's absolute tolerance over newton_relative_tolerance x N F_n (flexgear.mbs.newton)
+    newton_warm_start_tolerance_factor: float = num_field(1.0, 100.0, default=5.0)
     record_every_steps: int = num_field(1, integer=True, default=1)
     # "production": the package's formulation (linear body frames and floating frames about the prescribed spin,
     # linear joint and seat equations, Jacobian economy); "reference": Exudyn's nonlinear objects (ObjectRigidBody,
