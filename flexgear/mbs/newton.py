@@ -145,7 +145,8 @@ def newton_absolute_tolerance(spec: GearboxSpec) -> float:
     """
     th = theory(spec)
     sa = spec.solver_assumed
-    return sa.newton_warm_start_tolerance_factor * sa.newton_relative_tolerance * spec.gears.planet_count * th.mesh_force
+    zero_start_level = sa.newton_relative_tolerance * spec.gears.planet_count * th.mesh_force
+    return sa.newton_warm_start_tolerance_factor * zero_start_level
 
 
 class MultiplierWarmStart:
