@@ -33,11 +33,6 @@ _RUN_TIME_COLUMNS = ["variant", "components", "status", "reason", "t_end_s", "wa
                      "cpu_per_s", "adams_per_s"]
 
 
-
-def _deg_per_s(rad_per_s: float | None) -> float | None:
-    """A speed [rad/s] in deg/s, the unit the report plots speeds in (flexgear.results.SIGNAL_TYPES); None stays."""
-    return None if rad_per_s is None else float(np.degrees(rad_per_s))
-
 def shown_runs(d: ReportData) -> dict[str, RunResult]:
     """Finished runs to draw: the variants, then the lumped model."""
     out = {n: r for n, r in d.runs.items() if r.ok}
@@ -234,9 +229,8 @@ def overlay_pages(d: ReportData) -> list[Page]:
     window = _settled_words(_unsettled(d, runs))
     cycles = 5.0 / th.get("mesh_frequency_hz", 5000.0)
     pages = []
-    targets = {"input_speed": _deg_per_s(th.get("input_speed_rad_per_s")),  # plotted in deg/s (SIGNAL_TYPES)
-               "output_speed": _deg_per_s(th.get("output_speed_rad_per_s")),
-               "outer_mesh_force": th.get("mesh_force_n"), "inner_mesh_force": th.get("mesh_force_n")}
+    targets = dict.fromkeys(("outer_mesh_force", "inner_mesh_force"), th.get("mesh_force_n"))
+    targets |= {k: np.degrees(th[f"{k}_rad_per_s"]) for k in ("input_speed", "output_speed") if f"{k}_rad_per_s" in th}
     for kind, (title, ylabel) in SIGNAL_TYPES.items():
         having = {n: r for n, r in runs.items() if r.has(kind)}
         if not having or kind == "input_speed":
