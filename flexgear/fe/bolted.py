@@ -78,14 +78,10 @@ def clamped_patches(fe: FEModel, spec: GearboxSpec | Design, clamp_radius: float
 
 def _selected_discs(fe: FEModel, d: Design, component: str | None, n_bolts: int) -> list[np.ndarray] | None:
     """The clamped discs of ``component``'s imported part by its ``bolt_discs`` selector (None: no such selector)."""
-    entry = d.spec.components_geometry.get(component) if component is not None else None
-    chosen = next((s for s in entry.regions if s.region == "bolt_discs"), None) if entry is not None else None
-    if chosen is None:
-        return None
-    from flexgear.fe.selectors import group_points, selected_discs
+    from flexgear.fe.selectors import named_selector, selected_discs
 
-    groups = group_points(entry.source, entry.scale) if chosen.group else None
-    return selected_discs(chosen, fe.nodes, fe.surface_triangles, n_bolts, groups)
+    found = named_selector(d.spec.components_geometry.get(component) if component is not None else None, "bolt_discs")
+    return None if found is None else selected_discs(found[0], fe.nodes, fe.surface_triangles, n_bolts, found[1])
 
 
 def shape_functions(bary: np.ndarray, n_nodes: int) -> np.ndarray:

@@ -100,15 +100,12 @@ def _interface(fe, d: Design, component: str, builtin: np.ndarray, name: str) ->
     """Interface ``name`` of ``component``: on the nodes a selector of its imported part's file picks
     (flexgear.fe.selectors.picked_nodes on the FE model's nodes and boundary, checked when the part was meshed),
     else on the built-in rule's nodes ``builtin`` (a mask over the FE nodes)."""
-    entry = d.spec.components_geometry.get(component)
-    region = SELECTED_INTERFACES.get(name)
-    chosen = next((sel for sel in entry.regions if sel.region == region), None) if entry is not None else None
-    if chosen is None:
-        return interface(fe, np.flatnonzero(builtin), name)
-    from flexgear.fe.selectors import group_points, picked_nodes
+    from flexgear.fe.selectors import named_selector, picked_nodes
 
-    groups = group_points(entry.source, entry.scale) if chosen.group else None
-    return interface(fe, picked_nodes(chosen, fe.nodes, fe.surface_triangles, groups), name)
+    found = named_selector(d.spec.components_geometry.get(component), SELECTED_INTERFACES.get(name, ""))
+    if found is None:
+        return interface(fe, np.flatnonzero(builtin), name)
+    return interface(fe, picked_nodes(found[0], fe.nodes, fe.surface_triangles, found[1]), name)
 
 
 def patch_union(fe, spec: GearboxSpec | Design, name: str, component: str | None = None) -> Interface:

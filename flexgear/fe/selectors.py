@@ -38,7 +38,7 @@ import numpy as np
 from flexgear.schema_geometry import RegionSelector
 
 __all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "whole_faces", "check_surface",
-           "patches_by_angle", "selected_discs", "selected_regions"]
+           "named_selector", "patches_by_angle", "selected_discs", "selected_regions"]
 
 FEATURE_ANGLE_DEG = 75.0
 """Two faces of one selection that share an edge may turn by at most this angle [deg] (module docstring)."""
@@ -198,6 +198,16 @@ def patches_by_angle(picked: np.ndarray, label: np.ndarray, nodes: np.ndarray) -
 def _holes(picked: np.ndarray, label: np.ndarray, nodes: np.ndarray) -> dict[str, np.ndarray]:
     """``bolt_hole_<k>`` of a ``bolt_holes`` selection (:func:`patches_by_angle`)."""
     return {f"bolt_hole_{k}": s for k, s in enumerate(patches_by_angle(picked, label, nodes))}
+
+
+def named_selector(entry, region: str) -> tuple[RegionSelector, dict[str, np.ndarray] | None] | None:
+    """The selector of ``region`` in an imported part's entry (flexgear.schema_geometry.ComponentGeometry, or None)
+    and its file's named groups (:func:`group_points`, read only for a ``physical_group``); None when the entry
+    names no such region."""
+    chosen = next((s for s in entry.regions if s.region == region), None) if entry is not None else None
+    if chosen is None:
+        return None
+    return chosen, (group_points(entry.source, entry.scale) if chosen.group else None)
 
 
 def selected_discs(selector: RegionSelector, nodes: np.ndarray, surface: np.ndarray, n_bolts: int,
