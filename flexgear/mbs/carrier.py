@@ -5,7 +5,8 @@ other side) at the planet's frame origin, realised as an ``ObjectConnectorCartes
 ``MarkerBodyPosition`` at the pin on the carrier to the planet's frame node (radial stiffness in x, y, axial in
 z: the bearing is isotropic about the axis, so the carrier's spin does not matter), plus tilt springs between
 the planet's and the carrier's tilt coordinates (both ground-frame tilts for small tilts); the planet's spin
-relative to the carrier stays free.
+relative to the carrier stays free. A flexible planet's bearing acts the same way at its bore: on the seat node of
+flexgear.mbs.joints.LinearSeat, whose coordinates are the bore's motion (:func:`add_pin_bearing`).
 
 Contacts (flexgear.mbs.contacts.GearContact) are linearised at the reference configuration, carrier
 angle 0. With the carrier at angle theta every contact's pitch point, normal and planet centre are
@@ -36,7 +37,7 @@ from flexgear.geometry.elements import BearingElement
 from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body
 
-__all__ = ["Carrier", "CarrierKinematics", "add_planet_bearing"]
+__all__ = ["Carrier", "CarrierKinematics", "add_pin_bearing", "add_planet_bearing"]
 
 
 @dataclass(frozen=True)
@@ -55,20 +56,28 @@ def _rotation(theta: float) -> np.ndarray:
 class CarrierKinematics:
     """Pre-step update of the contact constraint's gradient rows and offset for a rotating carrier.
 
-    ``rows`` (n_contacts, 6 n_bodies): the contacts' gradient rows at carrier angle 0 (one kinematic
-    row of every contact, over the frame coordinates in the order of ``bodies``). Bodies off the
-    carrier axis (other than the carrier) orbit with it. ``extra_rows`` are further row sets to turn
-    in place (the friction's sliding rows), given as arrays to overwrite.
+    ``rows`` (n_contacts, 6 n_bodies + n_modal): the contacts' gradient rows at carrier angle 0 (one kinematic
+    row of every contact, over the frame coordinates in the order of ``bodies``, then the flexible gears' modal
+    coordinates, zero here). Bodies off the carrier axis (other than the carrier) orbit with it. ``extra_rows``
+    are further row sets over the frame coordinates to turn in place (the friction's sliding rows), given as
+    arrays to overwrite. With flexible gears (modal columns) the update writes only the frame columns and the
+    offset: flexgear.mbs.contact_kinematics.ContactKinematics writes the modal ones, at the material angle of
+    each contact relative to the turning carrier.
     """
 
     def __init__(self, constraint, rows: np.ndarray, bodies: list[Body], carrier: Carrier, ramp_time: float,
                  drive_speed: float, extra_rows: list[np.ndarray] | None = None):
         self.constraint, self.carrier = constraint, carrier
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
-        self.rows0 = np.asarray(rows, float).copy()
+        self.n_frames = 6 * len(bodies)
+        self.rows0 = np.asarray(rows, float)[:, :self.n_frames].copy()
+        self.n_columns = np.asarray(rows).shape[1]
+        self.modal = self.n_columns > self.n_frames  # flexible gears: their modal columns are not written here
         names = [b.name for b in bodies]
         if carrier.body not in names:
             raise KeyError(f"carrier body {carrier.body!r} is not among the bodies {names}")
+        if next(b for b in bodies if b.name == carrier.body).flexible:
+            raise ValueError(f"carrier body {carrier.body!r} must be rigid")
         axis = next(b.position for b in bodies if b.name == carrier.body)
         self.axis = np.asarray(axis, float)
         self.positions = np.array([b.position for b in bodies], float)
@@ -96,14 +105,15 @@ class CarrierKinematics:
         return np.hstack([pos, np.zeros_like(pos)]).ravel()
 
     def matrix_and_offset(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Constraint scaling matrix and offset at time t (aux = G q - offset)."""
+        """Constraint scaling matrix and offset at time t (aux = G q - offset); the modal columns zero."""
         theta = self.theta(t)
-        g = self.turned(self.rows0, theta)
-        return g, g @ self.reference(theta) + self.spin_sum * theta
+        g = np.zeros((len(self.rows0), self.n_columns))
+        g[:, :self.n_frames] = self.turned(self.rows0, theta)
+        return g, g[:, :self.n_frames] @ self.reference(theta) + self.spin_sum * theta
 
     def __call__(self, mbs, t: float) -> bool:
         g, offset = self.matrix_and_offset(t)
-        self.constraint.set(mbs, g, offset)
+        self.constraint.set(mbs, g, offset, modal=not self.modal)
         theta = self.theta(t)
         for target, rows0 in self.extra:
             target[:] = self.turned(rows0, theta)
@@ -112,15 +122,27 @@ class CarrierKinematics:
 
 def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: BearingElement, name: str | None = None
                        ) -> list[int]:
-    """The ``bearing`` of ``planet`` on its pin of ``carrier`` (its DOF map: body ``planet.name``, other
-    ``carrier.name``), the spin free.
+    """The ``bearing`` of the rigid ``planet`` on its pin of ``carrier`` (its DOF map: body ``planet.name``, other
+    ``carrier.name``), the spin free: :func:`add_pin_bearing` at the planet's frame node, the bearing moved to the
+    frame origin (:meth:`BearingElement.at`). Returns the connectors."""
+    if (bearing.body, bearing.other) != (planet.name, carrier.name):
+        raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed as {planet.name!r} on "
+                         f"{carrier.name!r}")
+    return add_pin_bearing(mbs, carrier, planet.node, planet.position, bearing.at(np.zeros(3)),
+                           name or f"bearing_{planet.name}")
 
-    Moved to the planet's frame origin (:meth:`BearingElement.at`), where it must be diag(k_r, k_r, k_a, k_t, k_t, 0)
-    (a bearing centred on the planet's frame; ValueError otherwise). Translation: an
-    ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries between
-    the pin (the planet's reference centre, fixed in the carrier) and the planet's frame node; tilt: a coordinate
-    spring-damper k_t between the planet's and the carrier's tilt coordinates about x and y. Returns the
-    connectors.
+
+def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: BearingElement, name: str
+                    ) -> list[int]:
+    """A bearing between the rigid node ``node`` (a planet's frame, or a flexible planet's seat node,
+    flexgear.mbs.joints.LinearSeat) whose reference position is ``point`` [m, ground] and the pin of ``carrier``
+    there, the spin free.
+
+    ``bearing`` about ``point`` must be diag(k_r, k_r, k_a, k_t, k_t, 0) (ValueError otherwise). Translation: an
+    ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries
+    between the pin (``point`` fixed in the carrier) and the node (isotropic about the axis: the carrier's spin does
+    not matter); tilt: a coordinate spring-damper k_t between the node's and the carrier's tilt coordinates about
+    x and y (both ground-frame tilts for small tilts). Returns the connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
@@ -130,22 +152,17 @@ def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: BearingElement
         ObjectConnectorCoordinateSpringDamper,
     )
 
-    if (bearing.body, bearing.other) != (planet.name, carrier.name):
-        raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed as {planet.name!r} on "
-                         f"{carrier.name!r}")
-    at_frame = bearing.at(np.zeros(3))
-    k_r, k_a, k_t = at_frame.axisymmetric_entries()
-    d_r, d_a, d_t = at_frame.axisymmetric_entries(at_frame.damping)
-    label = name or f"bearing_{planet.name}"
+    k_r, k_a, k_t = bearing.axisymmetric_entries()
+    d_r, d_a, d_t = bearing.axisymmetric_entries(bearing.damping)
     pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
-                                           localPosition=list(planet.position - carrier.position)))
+                                           localPosition=list(np.asarray(point, float) - carrier.position)))
     out = [mbs.AddObject(ObjectConnectorCartesianSpringDamper(
-        name=label, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=planet.node))],
+        name=name, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],
         stiffness=[k_r, k_r, k_a], damping=[d_r, d_r, d_a]))]
     for axis in (3, 4):
         out.append(mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
-            name=f"{label}_tilt{axis - 2}",
+            name=f"{name}_tilt{axis - 2}",
             markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=carrier.node, coordinate=axis)),
-                           mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=planet.node, coordinate=axis))],
+                           mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))],
             stiffness=k_t, damping=d_t)))
     return out

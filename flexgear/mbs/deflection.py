@@ -130,7 +130,7 @@ def mesh_deflection_signals(model, time_s: np.ndarray, modal: dict[str, np.ndarr
                                       body.coordinates_of(q_c_unit))
             motion, p_seat, q_c_unit = offsets[body_name]
             row = _column_row(kin, j, body_name)
-            ang = spin * theta  # nominal spin angle of the body
+            ang = kin.spin[row] * theta  # nominal spin angle of the body relative to the contacts (the carrier)
             rel = np.asarray(contact.point, float) - body.position
             ca, sa = np.cos(ang), np.sin(ang)
             # contact point and tooth normal in the body frame: R(-ang) x

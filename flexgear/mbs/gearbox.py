@@ -43,7 +43,7 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
-           "run_cost"]
+           "run_cost", "add_component", "component_sources", "joint_axes", "linear_frame_tolerance"]
 
 
 @dataclass
@@ -72,6 +72,8 @@ class GearboxModel:
     linear_joints: tuple[str, ...] = ()
     body_axes_joints: tuple[str, ...] = ()
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
+    # planet -> the rigid-body node of its seat on a turning carrier (flexgear.mbs.joints.LinearSeat): it orbits
+    carrier_seat_nodes: dict[str, int] = field(default_factory=dict)
 
     @property
     def spec(self) -> GearboxSpec:
@@ -154,6 +156,22 @@ def _mass_source(variant: Variant, d: Design, reduced: ReducedSource, default_bo
     return lambda spec, component: d.masses[component]  # "exact"
 
 
+def component_sources(variant: Variant, d: Design, mass_source: MassSource | None = None,
+                      reduced_source: ReducedSource | None = None) -> tuple[MassSource, ReducedSource]:
+    """The mass properties of ``variant``'s rigid components and its reduced bodies, for one build: each reduced body
+    loaded once (``reduced_source`` (spec, component, level), default the cached bodies), the rigid mass properties
+    those of :func:`mass_source_of` unless ``mass_source`` is given."""
+    source = reduced_source or _default_reduced_source
+    loaded: dict[tuple[str, str], object] = {}
+
+    def reduced(spec: GearboxSpec, component: str, level: str):  # each component loaded once per build
+        if (component, level) not in loaded:
+            loaded[component, level] = source(spec, component, level)
+        return loaded[component, level]
+
+    return mass_source or _mass_source(variant, d, reduced, reduced_source is None), reduced
+
+
 GEARS = ("sun", "planet", "ring")
 """Geometries that carry gear contacts: their modes above the dynamic cut-off become residual compliance."""
 
@@ -191,7 +209,7 @@ def run_cost(variant: Variant) -> float | None:
     return cost
 
 
-def _joint_axes(shaft: Body) -> str:
+def joint_axes(shaft: Body) -> str:
     """The axes of a linear gear-shaft joint's equations (flexgear.mbs.joints): body axes where the ``shaft`` is
     flexible, ground axes where it is rigid."""
     return "body" if shaft.flexible else "ground"
@@ -211,14 +229,14 @@ def _is_gear_seat(body: Body, interface: str) -> bool:
     return gear_seat(body.reduced, body.name).name == interface
 
 
-def _linear_frame_tolerance(spec: GearboxSpec) -> float | None:
+def linear_frame_tolerance(spec: GearboxSpec) -> float | None:
     """The axisymmetry tolerance of the production formulation's linear body frames, None for the reference's
     ``ObjectRigidBody`` (flexgear.mbs.bodies.add_linear_frame)."""
     sv = spec.solver_assumed
     return None if sv.reference else sv.frame_axisymmetry_tolerance
 
 
-def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
+def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray, spec: GearboxSpec,
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: BearingElement | None = None,
                    cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
@@ -235,7 +253,7 @@ def _add_component(mbs, name: str, form: str, geometry: str, position: np.ndarra
     ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node;
     ``source``: the reduced body to load when it is not ``geometry``'s own (the tied ring and output shaft).
     """
-    frame_tol = _linear_frame_tolerance(spec)
+    frame_tol = linear_frame_tolerance(spec)
     reference = spec.solver_assumed.reference
     if form == "rigid":
         return add_rigid_body(mbs, name, props(spec, geometry), position, spin_rad_s, frame_tol)
@@ -307,15 +325,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     if spec.gears.arrangement != "star":
         raise ValueError(f"{spec.source}: field 'gears.arrangement': expected 'star' here: build_star_gearbox builds "
                          "the star; flexgear.mbs.assemble.build_gearbox builds any arrangement")
-    source = reduced_source or _default_reduced_source
-    loaded: dict[tuple[str, str], object] = {}
-
-    def reduced(spec: GearboxSpec, component: str, level: str):  # each component loaded once per build
-        if (component, level) not in loaded:
-            loaded[component, level] = source(spec, component, level)
-        return loaded[component, level]
-
-    props = mass_source or _mass_source(variant, d, reduced, reduced_source is None)
+    props, reduced = component_sources(variant, d, mass_source, reduced_source)
     form = variant.components
     th, geo = d.theory, d.gears
     level = variant.mesh_level
@@ -331,19 +341,19 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     for gear, shaft, spin in (("sun", "input_shaft", th.input_speed), ("ring", "output_shaft", th.output_speed)):
         if form[gear] == "rigid" and form[shaft] == "rigid":
             merged = combine_mass_properties(props(spec, gear), props(spec, shaft))
-            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), spin, _linear_frame_tolerance(spec)))
+            bodies.append(add_rigid_body(mbs, gear, merged, np.zeros(3), spin, linear_frame_tolerance(spec)))
             ends[gear] = gear
         elif gear == "ring" and form[gear] == form[shaft]:  # both flexible: one body, reduced together
-            bodies.append(_add_component(mbs, gear, "flexible", gear, np.zeros(3), spec, level, props, reduced,
+            bodies.append(add_component(mbs, gear, "flexible", gear, np.zeros(3), spec, level, props, reduced,
                                          support=supports[shaft], spin_rad_s=spin, superelement=superelements,
                                          contacts=contacts, source=TIED_PAIR))
             ends[gear] = gear
         else:
             joints = [FixedJointElement.gear_shaft(gear, shaft, j) for j in gear_shaft_joints(d, gear)]
-            lead = _add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
+            lead = add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
                                   {j.interface: j.point for j in joints}, cutoff_hz=cutoff, dropped=dropped,
                                   spin_rad_s=spin, superelement=superelements, contacts=contacts)
-            other = _add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
+            other = add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
                                    {j.other_interface: j.point for j in joints}, supports[shaft], spin_rad_s=spin,
                                    superelement=superelements)
             bodies += [lead, other]
@@ -351,7 +361,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             ends[gear] = shaft
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
-        bodies.append(_add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
+        bodies.append(add_component(mbs, f"planet{i + 1}", form["planets"], "planet", pos, spec, level,
                                      props, reduced, support=supports["planet"],
                                      cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed,
                                      superelement=superelements, contacts=contacts))
@@ -367,7 +377,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
             # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
             carried = (_seat_loads_carried(lead) and len(found) == 1
                        and _is_gear_seat(lead, found[0].interface))
-            axes = _joint_axes(other)
+            axes = joint_axes(other)
             made = [LinearInterfaceJoint(mbs, lead, other, j, ratio, label + (f"_{k}" if k else ""),
                                          residual=carried, axes=axes) for k, j in enumerate(found)]
             if axes == "body":

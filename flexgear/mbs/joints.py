@@ -215,28 +215,46 @@ class LinearSeat:
     seat coordinates; :meth:`turning` gives the block that a :class:`TurningBlocks` pre-step function turns.
     ``residual``: the seat coordinates are the kept motion plus six more, ``residual_node``, the dropped modes'
     seat motion e_s (flexgear.mbs.residual: the bearing acts on the seat in series with it).
+    ``carrier``: the rigid body on the bearing's other side (``bearing.other``; a planet on its pin of a turning
+    carrier) instead of ground: the seat coordinates are then those of a rigid-body node at the bearing centre
+    (displacement from its reference place and rotation, the same six numbers) and the bearing a pin bearing on the
+    carrier (flexgear.mbs.carrier.add_pin_bearing); no residual then.
     """
 
-    def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False):
+    def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False,
+                 carrier: Body | None = None):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
+            NodeRigidBodyRxyz,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
 
-        bearing.check_to_ground(body.name)
+        if carrier is None:
+            bearing.check_to_ground(body.name)
+        elif (bearing.body, bearing.other) != (body.name, carrier.name) or residual:
+            raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed on {body.name!r} at "
+                             f"{carrier.name!r}{' with a residual' if residual else ''}")
         self.spin = float(spin_per_drive_angle)
         centre = np.array(bearing.centre)
         modal_nodes, self.rows = body.span(interface_rows(body, bearing.interface, centre))
         frame = frame_rows(centre)
-        self.node = resting_node(mbs, f"{body.name}_seat", 6)
         self.centre = centre
         self.residual_node = -1
-        if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
-            self.residual_node = resting_node(mbs, f"{body.name}_seat_residual", 6)
-        linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
-                       series_node=self.residual_node if residual else None)
+        seat_ref = np.zeros(6)  # the seat node's reference coordinates (the markers measure reference + coordinates)
+        if carrier is not None:
+            from flexgear.mbs.carrier import add_pin_bearing
+
+            seat_ref[:3] = body.position + centre
+            self.node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{body.name}_seat", referenceCoordinates=seat_ref))
+            add_pin_bearing(mbs, carrier, self.node, body.position + centre, bearing, f"bearing_{body.name}")
+        else:
+            self.node = resting_node(mbs, f"{body.name}_seat", 6)
+            if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
+                self.residual_node = resting_node(mbs, f"{body.name}_seat_residual", 6)
+            linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
+                           series_node=self.residual_node if residual else None)
         span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],
                                                jacobianUserFunction=zero_user_jacobian(12)))
         # Exudyn's equation: scalingMarker1 q - scalingMarker0 (s, frame) - offset = 0, i.e.
@@ -249,7 +267,7 @@ class LinearSeat:
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
             name=f"{body.name}_seat_tie",
             markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
-            scalingMarker0=np.hstack([np.eye(6), -frame]), scalingMarker1=self.rows, offset=frame @ q_ref))
+            scalingMarker0=np.hstack([np.eye(6), -frame]), scalingMarker1=self.rows, offset=frame @ q_ref - seat_ref))
 
     def turning(self) -> list[tuple]:
         """The seat tie's modal block, which turns with the spin (:class:`TurningBlocks` entry)."""

@@ -88,10 +88,12 @@ class MeshConstraint:
         """Indices of the blocks (gear pairs) that hold any of ``rows``."""
         return [i for i, (_, r, _) in enumerate(self.blocks) if np.isin(r, rows).any()]
 
-    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None) -> None:
-        """Write G (and the offset, if given) into the constraints (a pre-step hot path)."""
+    def set(self, mbs, matrix: np.ndarray, offset: np.ndarray | None = None, modal: bool = True) -> None:
+        """Write G (and the offset, if given) into the constraints (a pre-step hot path). ``modal`` False: leave the
+        flexible gears' modal columns as they are (flexgear.mbs.contact_kinematics writes them)."""
         for (block, rows, sub), frames in zip(self.blocks, self.frame_blocks, strict=True):
-            mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
+            if modal or frames is None:
+                mbs.SetObjectParameter(block, "scalingMarker1", matrix[sub])
             if frames is not None:
                 mbs.SetObjectParameter(block, "scalingMarker0", np.hstack([np.eye(len(rows)),
                                                                            -matrix[np.ix_(*frames)]]))

@@ -1,34 +1,56 @@
-"""Model: a single-stage planetary gearbox (ring fixed, carrier output) assembled from rigid bodies.
+"""Model: a single-stage planetary gearbox (ring fixed, carrier output), rigid or flexible gears.
 
 The same gear set, contacts, bearings and load case as the star (flexgear.mbs.gearbox), arranged as a planetary
-stage (``[gears] arrangement = "planetary"``): the input shaft drives the sun, the ring is held by the housing
-(a fixed joint on all six frame coordinates), the carrier turns at z_s / (z_s + z_r) of the input and carries
-the planets' bearings on its pins (flexgear.mbs.carrier.add_planet_bearing) and the output shaft, which takes
-the output bearing and the load torque. Each contact's geometry turns with the carrier
+stage (``[gears] arrangement = "planetary"``): the input shaft drives the sun, the ring is held by the housing,
+the carrier turns at z_s / (z_s + z_r) of the input and carries the planets' bearings on its pins and the output
+shaft, which takes the output bearing and the load torque. Each contact's geometry turns with the carrier
 (flexgear.mbs.carrier.CarrierKinematics); the planets' frames are absolute, so their orbit's Coriolis and
 centripetal terms come from the rigid-body equations themselves.
 
-Components: the input shaft and the sun are one rigid body (their fixed joint is then exact), the output shaft and
-the carrier one rigid body. The carrier is not a component of the gearbox file: its mass and polar inertia are
-``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped model's, eq. 1-13; derived from
-the gear set when the file leaves them out, flexgear.sizing), its transverse inertia half the polar (a disc).
-Every component is rigid: the multibody model's rotating carrier takes rigid gears only (flexgear.mbs.train), and a
-variant with a flexible component is refused when it is loaded (flexgear.spec).
+Components. The output shaft and the carrier are one rigid body: the carrier is not a component of the gearbox file,
+its mass and polar inertia are ``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped
+model's, eq. 1-13; derived from the gear set when the file leaves them out, flexgear.sizing), its transverse inertia
+half the polar (a disc). The input shaft, the sun, the planets and the ring are each rigid or a reduced flexible body
+of the production formulation, as in the star (flexgear.mbs.gearbox.add_component):
+
+- the sun and the input shaft: one rigid body when both are rigid, else two bodies and the linear fixed joint of
+  the star (flexgear.mbs.joints.LinearInterfaceJoint); the input bearing at the shaft's seat;
+- a flexible planet: its bore's motion on a seat node, the bearing a pin bearing on the carrier
+  (flexgear.mbs.joints.LinearSeat with ``carrier``); the modal equations spin at the planet's absolute speed
+  (flexgear.mbs.spin). Its frame orbits, but its modes are mass-orthogonal to the rigid translations (mean axes),
+  so the orbit's uniform acceleration does not load them;
+- the ring: rigid, held on all six frame coordinates; flexible, held at its bolts' clamped discs by a fixed joint
+  to the housing (a rigid body held to ground);
+- the gears' contact columns follow each gear's spin relative to the carrier (flexgear.mbs.train.modal_columns).
+
+Every mode of a flexible gear stays dynamic here (no residual compliance, flexgear.mbs.residual): the planets'
+dropped modes would answer their bearing's reaction in axes that turn with the carrier, which that model does not
+hold. The reference formulation (``[solver_assumed] formulation = "reference"``) builds the star only.
 """
 
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.elements import BearingElement
+from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.carrier import Carrier, add_planet_bearing
 from flexgear.mbs.elements import add_fixed_joint, add_load_torque, add_speed_drive, add_support, interface_spin_marker
-from flexgear.mbs.gearbox import GearboxModel, helix_halves, mass_source_of, mesh_contacts
+from flexgear.mbs.gearbox import (
+    GearboxModel,
+    add_component,
+    component_sources,
+    helix_halves,
+    joint_axes,
+    mesh_contacts,
+)
+from flexgear.mbs.joints import LinearInterfaceJoint, LinearSeat, TurningBlocks
+from flexgear.mbs.spin import SpinSchedule
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import GearboxSpec, Variant
 
@@ -42,43 +64,104 @@ def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
     return MassProperties(la.carrier_mass_kg, np.zeros(3), np.diag([0.5 * j, 0.5 * j, j]))
 
 
-def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Design | None = None):
-    """Assemble the planetary gearbox of ``variant`` (every component rigid) into ``mbs``; returns its
-    flexgear.mbs.gearbox.GearboxModel (output body: the carrier). ``mass_source`` (spec, geometry) ->
-    MassProperties overrides the variant's rigid mass properties, as in flexgear.mbs.assemble.build_gearbox."""
+def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Design | None = None,
+                            reduced_source=None) -> GearboxModel:
+    """Assemble the planetary gearbox of ``variant`` into ``mbs`` (module docstring); returns its
+    flexgear.mbs.gearbox.GearboxModel (output body: the carrier). ``mass_source`` (spec, component) ->
+    MassProperties overrides the variant's rigid mass properties, ``reduced_source`` (spec, component, level) its
+    reduced bodies, as in flexgear.mbs.assemble.build_gearbox."""
+    from flexgear.fe.reduced import gear_shaft_joints
+
     d = as_design(variant.gearbox if design is None else design)
     spec, th, geo = d.spec, d.theory, d.gears
-    flexible = [c for c, f in variant.components.items() if f != "rigid"]
-    if flexible:
-        raise ValueError(f"{variant.source}: field 'components.{flexible[0]}': the planetary arrangement takes rigid "
-                         "components only")
-    props = mass_source or mass_source_of(variant, d)
-    lc = spec.load_case
+    form = variant.components
+    flexible = [c for c, f in form.items() if f != "rigid"]
+    if form["output_shaft"] != "rigid":
+        raise ValueError(f"{variant.source}: field 'components.output_shaft': expected 'rigid': in the planetary "
+                         "arrangement the output shaft and the carrier are one rigid body")
+    if flexible and spec.solver_assumed.reference:
+        raise ValueError(f"{variant.source}: field 'components.{flexible[0]}': the reference formulation builds "
+                         "flexible bodies in the star arrangement only")
+    props, reduced = component_sources(variant, d, mass_source, reduced_source)
+    lc, level = spec.load_case, variant.mesh_level
     ratio = th.output_speed / th.input_speed  # carrier spin per drive angle
-    sun = add_rigid_body(mbs, "sun", combine_mass_properties(props(spec, "sun"), props(spec, "input_shaft")),
-                         np.zeros(3))
-    ring = add_rigid_body(mbs, "ring", props(spec, "ring"), np.zeros(3))
+    contacts = mesh_contacts(d, math.copysign(1.0, lc.input_speed_rad_s))
+    supports = d.supports
+
+    def component(name: str, geometry: str, position, spin: float, **kw) -> Body:
+        """A rigid body (Exudyn's ``ObjectRigidBody``) or a flexible one (flexgear.mbs.gearbox.add_component)."""
+        if form["planets" if geometry == "planet" else geometry] == "rigid":
+            return add_rigid_body(mbs, name, props(spec, geometry), position)
+        return add_component(mbs, name, "flexible", geometry, position, spec, level, props, reduced, spin_rad_s=spin,
+                             contacts=contacts, **kw)
+
+    turning, joints, linear_gears, body_axes = [], {}, [], []
+    if form["sun"] == "rigid" and form["input_shaft"] == "rigid":
+        sun = add_rigid_body(mbs, "sun", combine_mass_properties(props(spec, "sun"), props(spec, "input_shaft")),
+                             np.zeros(3))
+        shafts, input_end = [], sun
+    else:
+        found = [FixedJointElement.gear_shaft("sun", "input_shaft", j) for j in gear_shaft_joints(d, "sun")]
+        sun = component("sun", "sun", np.zeros(3), th.input_speed, joints={j.interface: j.point for j in found})
+        input_end = component("input_shaft", "input_shaft", np.zeros(3), th.input_speed,
+                              joints={j.other_interface: j.point for j in found}, support=supports["input_shaft"])
+        shafts = [input_end]
+        made = [LinearInterfaceJoint(mbs, sun, input_end, j, 1.0, "joint_sun_input_shaft" + (f"_{k}" if k else ""),
+                                     axes=joint_axes(input_end)) for k, j in enumerate(found)]
+        turning += [e for j in made for e in j.turning()]
+        joints["sun"] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
+        linear_gears.append("sun")
+        if joint_axes(input_end) == "body":
+            body_axes.append("sun")
+    ring_joints = [FixedJointElement("ring", gi, "housing", si, p) for gi, si, p in gear_shaft_joints(d, "ring")]
+    ring = component("ring", "ring", np.zeros(3), 0.0, joints={j.interface: j.point for j in ring_joints})
     carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
                                                                      props(spec, "output_shaft")), np.zeros(3))
-    bodies: list[Body] = [sun, ring, carrier]
     planets = []
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
-        planets.append(add_rigid_body(mbs, f"planet{i + 1}", props(spec, "planet"), pos))
-    bodies += planets
-    contacts = mesh_contacts(d, math.copysign(1.0, lc.input_speed_rad_s))
-    supports = d.supports
-    train = add_gear_train(mbs, bodies, [], contacts, lc.ramp_time_s, lc.input_speed_rad_s,
-                           friction=spec.contact.friction_coefficient > 0.0, carrier=Carrier("carrier", ratio))
-    add_support(mbs, sun, supports["input_shaft"].on("sun"))
-    add_support(mbs, carrier, supports["output_shaft"].on("carrier"))
-    add_fixed_joint(mbs, ring, name="ring_housing")
+        planets.append(component(f"planet{i + 1}", "planet", pos, th.planet_speed, support=supports["planet"]))
+    bodies: list[Body] = [sun, ring, carrier, *planets]
+    if ring.flexible:  # held at its bolts' clamped discs by the housing
+        housing = add_rigid_body(mbs, "housing", props(spec, "ring"), np.zeros(3))
+        add_fixed_joint(mbs, housing, name="housing_ground")
+        made = [LinearInterfaceJoint(mbs, ring, housing, j, 0.0, "joint_ring_housing" + (f"_{k}" if k else ""))
+                for k, j in enumerate(ring_joints)]
+        turning += [e for j in made for e in j.turning()]
+        joints["ring"] = [(j.obj, np.array(e.point)) for j, e in zip(made, ring_joints, strict=True)]
+        linear_gears.append("ring")
+    else:
+        add_fixed_joint(mbs, ring, name="ring_housing")
+    seat_nodes = {}
     for planet in planets:
-        add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
-                                                                             other="carrier"))
-    spin_in = interface_spin_marker(mbs, sun, None)
+        bearing = replace(supports["planet"].on(planet.name), other="carrier")
+        if planet.flexible:
+            seat = LinearSeat(mbs, planet, bearing, th.planet_speed / th.input_speed, carrier=carrier)
+            turning += seat.turning()
+            seat_nodes[planet.name] = seat.node
+        else:
+            add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
+                                                                                 other="carrier"))
+    if input_end.flexible:
+        seat = LinearSeat(mbs, input_end, supports["input_shaft"].on(input_end.name), 1.0)
+        turning += seat.turning()
+    else:
+        add_support(mbs, input_end, supports["input_shaft"].on(input_end.name))
+    add_support(mbs, carrier, supports["output_shaft"].on("carrier"))
+    extra = []
+    if turning:
+        extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
+    linear = [b for b in [*bodies, *shafts] if getattr(b, "spin", None) is not None]
+    frames = [b.frame for b in [*bodies, *shafts] if b.frame is not None]
+    if linear or frames:
+        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s, frames))
+    train = add_gear_train(mbs, [*bodies, *shafts], [], contacts, lc.ramp_time_s, lc.input_speed_rad_s,
+                           friction=spec.contact.friction_coefficient > 0.0, carrier=Carrier("carrier", ratio),
+                           extra_pre_steps=extra, contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
+                           radial_band=spec.gears.normal_module_m)
+    spin_in = interface_spin_marker(mbs, input_end, "bearing_seat" if input_end.flexible else None)
     spin_out = interface_spin_marker(mbs, carrier, None)
-    drive = add_speed_drive(mbs, sun, lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
+    drive = add_speed_drive(mbs, input_end, lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
     load = add_load_torque(mbs, carrier, -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s,
                            spin_out[0])
     springs = train.springs
@@ -86,5 +169,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     per_planet = 2 * halves
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(d, {b.name: b for b in bodies}, outer, inner, drive, load, contacts, train.friction,
-                        train.kinematics, tuple(train.aux_nodes), "sun", "carrier", {}, spin_out[1:])
+    return GearboxModel(d, {b.name: b for b in [*bodies, *shafts]}, outer, inner, drive, load, contacts,
+                        train.friction, train.kinematics, tuple(train.aux_nodes), input_end.name, "carrier", joints,
+                        spin_out[1:], linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
+                        carrier_seat_nodes=seat_nodes)

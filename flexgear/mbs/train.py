@@ -56,8 +56,13 @@ class GearTrain:
         return out
 
 
-def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: int, radial_band: float) -> list:
-    """Contact-deflection coefficients of the flexible gears' modal coordinates (contact_kinematics)."""
+def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: int, radial_band: float,
+                  carrier_spin: float = 0.0) -> list:
+    """Contact-deflection coefficients of the flexible gears' modal coordinates (contact_kinematics).
+
+    ``carrier_spin``: the carrier's nominal spin per drive angle. The contact points turn with the carrier, so the
+    material angle of a contact on a gear is alpha = psi - (spin - carrier_spin) theta (theta the drive angle), for
+    the central gears and for the planets, whose contact points sit still in the carrier's frame."""
     from flexgear.mbs.contact_kinematics import ModalColumn, modal_contact_coefficients
 
     columns = []
@@ -69,7 +74,8 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
             rel = np.asarray(c.point) - body.position
             values = body.to_coordinates(modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel,
                                                                     c.normal, 0.5 * c.half_width, radial_band, order))
-            columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin, values))
+            columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin - carrier_spin,
+                                       values))
     return columns
 
 
@@ -101,7 +107,9 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
 
     ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
     (flexgear.mbs.contacts.drive_angle) drives the mesh phase. ``friction``: add tooth friction for
-    contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; rigid gears only).
+    contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; the carrier body rigid): the contacts'
+    geometry turns with it (flexgear.mbs.carrier), and the flexible gears' material angles under the contacts follow
+    their spin relative to it (:func:`modal_columns`).
     Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
     from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
     tooth height). ``extra_pre_steps``: further pre-step callables (mbs, t) -> bool, run first.
@@ -117,9 +125,6 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
             if name not in by_name:
                 raise KeyError(f"contact {c.name!r} names unknown body {name!r}; bodies: {sorted(by_name)}")
     flexible = [b for b in bodies if b.flexible]
-    if carrier is not None and flexible:
-        raise NotImplementedError("a rotating carrier with flexible bodies is not supported yet: the modal "
-                                  "columns assume contact points fixed in space")
     offsets, n_total = {}, 6 * len(bodies)
     for b in flexible:
         offsets[b.name] = n_total
@@ -149,7 +154,8 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         from flexgear.mbs.residual import CentrifugalYield
 
         pre_steps.append(CentrifugalYield(residual, residual_obj, ramp_time, drive_speed))
-    columns = modal_columns(contacts, by_name, contact_fourier_order, radial_band) if flexible else []
+    carrier_spin = 0.0 if carrier is None else carrier.spin_per_drive_angle
+    columns = modal_columns(contacts, by_name, contact_fourier_order, radial_band, carrier_spin) if flexible else []
     if columns:
         from flexgear.mbs.contact_kinematics import ContactKinematics
 
@@ -163,7 +169,7 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
         extra = [train.friction.sliding_rows] if train.friction is not None else []
         train.carrier = CarrierKinematics(constraint, base, bodies, carrier, ramp_time, drive_speed, extra)
         g, offset = train.carrier.matrix_and_offset(0.0)
-        constraint.set(mbs, g, offset)
+        constraint.set(mbs, g, offset, modal=not train.carrier.modal)
         pre_steps.append(train.carrier)  # before friction: friction uses the turned sliding rows
     if train.friction is not None and schedule is not None and carrier is None:
         from flexgear.mbs.mesh_updates import MeshUpdates

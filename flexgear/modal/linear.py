@@ -295,6 +295,10 @@ def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3
         q0[i + 5], v0[i + 5] = theta * w / th.input_speed, w
         if name.startswith("planet") and "carrier" in model.bodies:
             q0[i:i + 2], v0[i:i + 2] = orbit(body.position, theta_c, omega_c)
+            if name in model.carrier_seat_nodes:  # its seat node (at the bore centre, on the planet's axis) too
+                j = mbs.GetNodeODE2Index(model.carrier_seat_nodes[name])
+                q0[j:j + 2], v0[j:j + 2] = q0[i:i + 2], v0[i:i + 2]
+                q0[j + 5], v0[j + 5] = q0[i + 5], v0[i + 5]
     mbs.systemData.SetODE2Coordinates(q0, exu.ConfigurationType.Initial)
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
     pre = mbs.GetPreStepUserFunction()

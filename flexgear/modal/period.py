@@ -48,12 +48,17 @@ def is_gear(component: str) -> bool:
 
 
 def _spin(model: LinearModel, component: str) -> float:
-    """|Omega| [rad/s] of ``component`` at the model's speed (flexgear.theory)."""
+    """|Omega| [rad/s] of ``component`` relative to the carrier (its contacts' frame) at the model's speed
+    (flexgear.theory): the star's carrier stands still, the planetary's turns at the output speed and holds the
+    ring."""
     from flexgear.design import design
 
-    th = design(model.variant.gearbox).theory
-    speed = {"sun": th.input_speed, "ring": th.output_speed}.get(component, th.planet_speed)
-    return abs(speed) * model.speed_rpm / model.variant.gearbox.load_case.input_speed_rpm
+    spec = model.variant.gearbox
+    th = design(spec).theory
+    carrier = th.output_speed if spec.gears.arrangement == "planetary" else 0.0
+    ring = 0.0 if spec.gears.arrangement == "planetary" else th.output_speed
+    speed = {"sun": th.input_speed, "ring": ring}.get(component, th.planet_speed) - carrier
+    return abs(speed) * model.speed_rpm / spec.load_case.input_speed_rpm
 
 
 def period_samples(model: LinearModel, samples: int = DEFAULT_SAMPLES) -> np.ndarray:

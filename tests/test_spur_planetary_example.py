@@ -1,0 +1,114 @@
+"""The spur planetary example (examples/spur_planetary/: 24/30/84, 3 planets, ring fixed, carrier output) with
+flexible gears on the turning carrier.
+
+Loss-free hand theory, independent of the package (the carrier's torque T_c, its speed Omega_c = Omega_in z_s /
+(z_s + z_r), N planets on the centre distance a_w):
+
+- ratio Omega_c / Omega_in = z_s / (z_s + z_r); every mesh's mean normal force F_n = T_sun / (N r_b,sun cos beta_b),
+  T_sun = T_c z_s / (z_s + z_r) (tooth friction, mu = 0.02, moves the means by a few tenths of a percent: 1 %);
+- without friction, each planet's bearing on its pin carries, in the carrier's axes, the tangential force
+  T_c / (N a_w) (the planet's share of the carrier torque) and the radial force m_p Omega_c^2 a_w (the planet's
+  orbit, m_p its mass): its two mesh forces' radial parts cancel on a spur planet with equal operating pressure
+  angles; the sun's joint to its shaft carries T_sun and the ring's joint to the housing T_c z_r / (z_s + z_r).
+
+The flexible planets sit on their pins through their bores' motion (flexgear.mbs.joints.LinearSeat with a carrier),
+their contact columns follow their spin relative to the carrier; the flexible ring is held at its bolts' clamped
+discs. Every body is built in a private cache from coarse meshes (about a minute of CPU).
+"""
+
+from __future__ import annotations
+
+import math
+import tomllib
+from pathlib import Path
+
+import numpy as np
+import pytest
+from test_validation import to_toml
+
+from flexgear.spec import load_variant
+
+EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
+
+
+def _mesh_force(spec) -> float:
+    """F_n [N] of the module docstring (spur: cos beta_b = 1), r_b = m_n z_s cos(alpha_n) / 2."""
+    g = spec.gears
+    r_b = g.normal_module_mm * 1e-3 * g.sun_teeth * math.cos(math.radians(g.normal_pressure_angle_deg)) / 2
+    t_sun = spec.load_case.load_torque_nm * g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    return t_sun / (g.planet_count * r_b)
+
+
+def test_rigid_and_flexible_variants_meet_hand_theory(tmp_path, example_cache):
+    from flexgear.cli import main
+    from flexgear.results import load_result
+
+    variants = [str(EXAMPLE / f"{name}.toml") for name in ("rigid", "flexible")]
+    assert main(["matrix", *variants, "--out", str(tmp_path / "out")]) == 0
+    spec = load_variant(EXAMPLE / "flexible.toml").gearbox
+    g = spec.gears
+    for name in ("rigid", "flexible"):
+        s = load_result(tmp_path / "out" / name).signals
+        late = s[s.time_s >= 0.05]
+        assert late.transmission_ratio.mean() == pytest.approx(g.sun_teeth / (g.sun_teeth + g.ring_teeth),
+                                                               rel=1e-3), name
+        forces = late[[f"{mesh}_mesh_force_{i}_n" for mesh in ("outer", "inner")
+                       for i in range(1, g.planet_count + 1)]].mean()
+        np.testing.assert_allclose(forces, _mesh_force(spec), rtol=0.01, err_msg=name)
+
+
+def _without_friction(tmp_path: Path) -> Path:
+    """A copy of the example with frictionless teeth (the reduced bodies' keys do not depend on friction)."""
+    data = tomllib.loads((EXAMPLE / "gearbox.toml").read_text())
+    data["contact"] = {"friction_coefficient": 0.0}
+    (tmp_path / "gearbox.toml").write_text(to_toml(data))
+    (tmp_path / "flexible.toml").write_text((EXAMPLE / "flexible.toml").read_text())
+    return tmp_path / "flexible.toml"
+
+
+def test_flexible_planets_and_ring_carry_their_loads_on_the_turning_carrier(tmp_path, example_cache):
+    import exudyn as exu
+    from exudyn.itemInterface import SensorObject
+
+    from flexgear.design import design
+    from flexgear.laws.ramps import drive_angle
+    from flexgear.mbs.assemble import build_gearbox
+    from flexgear.mbs.recording import joint_axis_torque, simulation_settings
+
+    variant = load_variant(_without_friction(tmp_path))
+    d = design(variant.gearbox)
+    spec, th, lc = d.spec, d.theory, d.spec.load_case
+    g = spec.gears
+    sc = exu.SystemContainer()
+    mbs = sc.AddSystem()
+    model = build_gearbox(mbs, variant, design=d)
+    assert all(model.bodies[n].flexible for n in ("sun", "ring", "planet1", "input_shaft"))
+    ovt = exu.OutputVariableType
+    bearings = [mbs.AddSensor(SensorObject(objectNumber=mbs.GetObjectNumber(f"bearing_planet{i + 1}"),
+                                           outputVariableType=ovt.Force, storeInternal=True))
+                for i in range(g.planet_count)]
+    joints = {f"joint_{gear}_0": mbs.AddSensor(SensorObject(objectNumber=model.joints[gear][0][0],
+                                                            outputVariableType=ovt.Force, storeInternal=True))
+              for gear in ("sun", "ring")}
+    mbs.Assemble()
+    t_end = lc.end_time_s
+    mbs.SolveDynamic(simulation_settings(variant, t_end, False), solverType=exu.DynamicSolverType.GeneralizedAlpha)
+    window = 0.5 * (lc.ramp_time_s + t_end)
+    omega_c = th.output_speed
+    ratio = omega_c / th.input_speed
+    a_w = d.gears.centre_distance
+    mass = model.bodies["planet1"].reduced.props.mass  # the flexible planet's own mass (its mesh)
+    for i, sensor in enumerate(bearings):
+        data = np.asarray(mbs.GetSensorStoredData(sensor))
+        late = data[data[:, 0] >= window]
+        psi = d.gears.planet_angles[i] + ratio * np.array(
+            [float(drive_angle(t, lc.ramp_time_s, lc.input_speed_rad_s)) for t in late[:, 0]])
+        radial = np.mean(late[:, 1] * np.cos(psi) + late[:, 2] * np.sin(psi))
+        tangential = np.mean(-late[:, 1] * np.sin(psi) + late[:, 2] * np.cos(psi))
+        assert tangential == pytest.approx(lc.load_torque_nm / (g.planet_count * a_w), rel=2e-3), i
+        assert radial == pytest.approx(mass * omega_c ** 2 * a_w, rel=5e-3), i
+    share = g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    for gear, torque in (("sun", share * lc.load_torque_nm), ("ring", (1 - share) * lc.load_torque_nm)):
+        t, moment = joint_axis_torque(mbs, model, joints, gear)
+        assert abs(moment[t >= window].mean()) == pytest.approx(torque, rel=1e-3), gear
+    sc.Reset()
