@@ -28,6 +28,8 @@ from test_validation import to_toml
 
 from flexgear.spec import load_variant
 
+pytestmark = pytest.mark.slow  # four cold reductions: about a minute of CPU
+
 EXAMPLE = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
 
 

@@ -346,7 +346,9 @@ def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_te
     a, b = models
     sel_a, sel_b = selectors(a), selectors(b)
     for x, y in zip(sel_a[:3], sel_b[:3], strict=True):
-        if not np.allclose(x, y, rtol=1e-9, atol=1e-12 * max(np.abs(x).max(), 1e-300)):
+        # entries far below the largest are round-off of the null-space basis (1e-11 of it for the flexible
+        # planetary's carrier-frame basis): compared against the largest entry
+        if not np.allclose(x, y, rtol=1e-9, atol=1e-9 * max(np.abs(x).max(), 1e-300)):
             raise ValueError("the two linearisations select different contact or output coordinates: use "
                              "linearization='each'")
     rows, acc, te, _ = sel_a
