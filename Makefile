@@ -50,7 +50,7 @@ lint: install
 	$(PY) -c "from importlinter.cli import lint_imports; raise SystemExit(lint_imports(no_cache=True, no_logo=True))"
 
 test: lint
-	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadgroup --prebuild
+	$(PY) -m pytest -q -n $(TEST_WORKERS) --dist loadgroup --prebuild --durations=25
 
 test-heavy: install
 	$(PY) -m pytest -q -m heavy
