@@ -152,6 +152,8 @@ class ScreeningSettings:
     settle_final_blocks: int = num_field(1, 1000, integer=True, default=8)
     settle_mean_tolerance_pct: float = num_field(0.0, 100.0, lo_open=True, default=0.05)
     settle_amplitude_tolerance_pct: float = num_field(0.0, 100.0, lo_open=True, default=5.0)
+    # a bearing-acceleration RMS that moves by less than this [m/s^2] counts as settled (a level below it is noise)
+    settle_acceleration_floor_m_per_s2: float = num_field(0.0, default=1e-3)
     # "" = the study's mode (Bias against theory); a variant name = Bias against that variant's values
     reference: str = text_field(default="")
     # numerical error bars: the reference's final state solved over this window at h and at h/2 (0: none)

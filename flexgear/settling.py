@@ -6,7 +6,10 @@ After the STEP ramps the run is cut into blocks of ``block_mesh_cycles`` mesh cy
 signal gets one value per block: the planet-mean mesh forces and the two speeds their block means (a
 drift), the mesh-force ripples and bearing accelerations RMS their block values (a decaying vibration).
 Its final value is the mean of the last ``final_blocks`` blocks, and must differ from the mean of the
-``final_blocks`` blocks just before by at most the tolerance (else the run has not settled). The run has
+``final_blocks`` blocks just before by at most the tolerance (else the run has not settled). A bearing RMS may
+move by ``acceleration_floor`` whatever its level: a level that low is noise (the bearing of a rigid stage whose
+planets mesh in phase, where the mesh forces on the sun and the carrier cancel, carries 1e-8 to 1e-6 m/s^2 of
+round-off), and a relative tolerance of it would never hold. The run has
 settled at the start of the first block from which the mean over every later group of ``final_blocks``
 consecutive blocks of every settling signal lies within the tolerance of its final value, if at least
 ``min_blocks`` blocks remain: ``mean_tolerance_pct`` for the drifts, ``amplitude_tolerance_pct`` for the
@@ -49,12 +52,14 @@ class SettleRule:
     mean_tolerance_pct: float
     amplitude_tolerance_pct: float
     min_blocks: int = 1
+    acceleration_floor: float = 0.0  # [m/s^2]: a bearing RMS may move by this much whatever its level
 
     @classmethod
     def from_settings(cls, settings) -> SettleRule:
         """From :class:`flexgear.schema.ScreeningSettings` (the settled part holds one block per sample)."""
         return cls(settings.settle_block_mesh_cycles, settings.settle_final_blocks, settings.settle_mean_tolerance_pct,
-                   settings.settle_amplitude_tolerance_pct, settings.sample_count)
+                   settings.settle_amplitude_tolerance_pct, settings.sample_count,
+                   settings.settle_acceleration_floor_m_per_s2)
 
 
 @dataclass(frozen=True)
@@ -154,6 +159,8 @@ def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: floa
             v = values[key]
             final = v[-rule.final_blocks:].mean()
             tol = tol_pct / 100.0 * abs(final)
+            if key.endswith("_bearing_rms"):  # a level at the noise floor (rigid in-phase planets: 1e-6 m/s^2)
+                tol = max(tol, rule.acceleration_floor)
             moved = abs(final - v[-2 * rule.final_blocks:-rule.final_blocks].mean())
             if moved > tol:
                 groups = _groups_to_settle(v, rule.final_blocks, tol)

@@ -222,3 +222,21 @@ def test_a_failed_reference_is_refused_and_the_matrix_writes_why(settings, tmp_p
     text = (tmp_path / "selection.txt").read_text()
     assert text.startswith("selected: None") and "did not finish" in text
     assert set(table["status"]) == {"not screened"}
+
+
+def test_a_bearing_level_at_the_noise_floor_settles(settings):
+    """A bearing whose acceleration is round-off (the rigid stage with in-phase planets: 1e-8 to 1e-6 m/s^2, its
+    RMS changing by tens of percent from block to block) settles: it may move by the configured floor, 1e-3 m/s^2;
+    with no floor the relative tolerance never holds and names it."""
+    res = synthetic_result("m")
+    rng = np.random.default_rng(7)
+    f = res.meta["theory"]["mesh_frequency_hz"]
+    t = res.signals["time_s"].to_numpy()
+    level = 1e-7 * np.exp(rng.standard_normal(len(t) // 50 + 1))[np.arange(len(t)) // 50]  # wanders, factor ~e
+    for axis in ("x", "y"):
+        res.signals[f"output_bearing_accel_{axis}_m_per_s2"] = level * rng.standard_normal(len(t))
+    rule = dataclasses.replace(SettleRule.from_settings(settings), min_blocks=1)
+    assert rule.acceleration_floor == pytest.approx(1e-3)
+    assert settled_start(res.signals, 0.5, f, rule).start_s is not None
+    bare = settled_start(res.signals, 0.5, f, dataclasses.replace(rule, acceleration_floor=0.0))
+    assert bare.start_s is None and "output_bearing_rms" in bare.reason

@@ -240,3 +240,19 @@ def test_results_written_with_speeds_in_deg_per_s_load_in_rad_per_s(tmp_path):
     f_mesh = now.meta["theory"]["mesh_frequency_hz"]
     a, b = (indicator_segments(r.signals, slices, f_mesh) for r in (loaded, now))
     assert a.keys() == b.keys() and all(np.allclose(a[k], b[k], rtol=1e-12) for k in a)
+
+
+def test_the_report_screens_with_the_gearbox_file_saved_with_the_runs(tmp_path):
+    """A matrix of another gearbox (the spur planetary example: its settling blocks follow its 84-tooth ring) is
+    screened with that gearbox's own settings, read from the copy saved with its runs, not the study's."""
+    from flexgear.cli import main
+    from flexgear.report.data import gather
+    from flexgear.spec import load_gearbox
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
+    assert main(["matrix", str(example / "rigid.toml"), "--out", str(tmp_path)]) == 0
+    data = gather(tmp_path)
+    assert data.gearbox_file == tmp_path / "rigid" / "inputs" / "gearbox.toml", data.gearbox_note
+    assert data.gearbox.gears.arrangement == "planetary" and data.gearbox.gears.ring_teeth == 84
+    own = load_gearbox(example / "gearbox.toml").screening
+    assert data.settings.settle_block_mesh_cycles == own.settle_block_mesh_cycles != 17  # the study's: 136 / 8

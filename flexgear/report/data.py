@@ -104,11 +104,28 @@ def _natural(name: str) -> tuple:
     return (name.rstrip("0123456789"), int(digits) if digits else -1, name)
 
 
+def saved_gearbox(results_dir: Path, run: RunResult) -> Path | None:
+    """The gearbox file saved with ``run`` in its ``inputs/`` (flexgear.results.save_result: the run's input files
+    under their names): the saved TOML file with a ``[gears]`` table; None if there is none."""
+    import tomllib
+
+    for rel in (run.meta.get("inputs") or {}).values():
+        path = results_dir / run.name / rel
+        if path.suffix != ".toml" or not path.is_file():
+            continue
+        try:
+            if "gears" in tomllib.loads(path.read_text()):
+                return path
+        except (tomllib.TOMLDecodeError, UnicodeDecodeError):
+            continue
+    return None
+
+
 def _find_gearbox(results_dir: Path, runs: list[RunResult]) -> tuple[Path, str]:
     for r in runs:
-        rel = (r.meta.get("inputs") or {}).get("gearbox")
-        if rel and (results_dir / r.name / rel).exists():
-            return results_dir / r.name / rel, f"copy saved with run {r.name}"
+        path = saved_gearbox(results_dir, r)
+        if path is not None:
+            return path, f"copy saved with run {r.name}"
     return DEFAULT_GEARBOX, "no gearbox file saved with the runs: the package's model_variants/gearbox.toml"
 
 

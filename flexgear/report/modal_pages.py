@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 from matplotlib.figure import Figure
 
-from flexgear.report.data import ReportData
+from flexgear.report.data import ReportData, saved_gearbox
 from flexgear.report.figures import draw_table, fmt
 from flexgear.report.layout import Page, text_block
 from flexgear.results import RunResult
@@ -68,12 +68,12 @@ def variant_of(run: RunResult, results_dir: Path) -> Any:
     to the package's checkout) when the copies no longer validate."""
     from flexgear.spec import load_variant
 
-    inputs = run.meta.get("inputs") or {}
-    own = next((rel for name, rel in inputs.items() if name != "gearbox.toml"), None)
-    if own is not None and "gearbox.toml" in inputs:
-        path = results_dir / run.name / own
+    gearbox = saved_gearbox(results_dir, run)
+    own = next((results_dir / run.name / rel for rel in (run.meta.get("inputs") or {}).values()
+                if str(rel).endswith(".toml") and results_dir / run.name / rel != gearbox), None)
+    if own is not None and gearbox is not None:
         try:
-            return load_variant(path, path.read_text(), (results_dir / run.name / inputs["gearbox.toml"]).read_text())
+            return load_variant(own, own.read_text(), gearbox.read_text())
         except Exception:  # an older copy (schema changed): the package's file below
             pass
     rel = run.meta.get("variant_file") or run.meta.get("source")

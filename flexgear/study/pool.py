@@ -49,7 +49,8 @@ def run_input_hash(variant: Variant, t_end_s: float | str, error_window_s: float
     else:
         sc = variant.gearbox.screening
         extra = ("settled", sc.settle_block_mesh_cycles, sc.settle_final_blocks, sc.settle_mean_tolerance_pct,
-                 sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s)
+                 sc.settle_amplitude_tolerance_pct, sc.sample_count, sc.after_ramp_delay_s,
+                 sc.settle_acceleration_floor_m_per_s2)
     if error_window_s > 0:
         extra = (*extra, "error_window", float(error_window_s))
     return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn")
