@@ -1,6 +1,6 @@
-"""Modes of the planetary stage (ring fixed, carrier output) at rest: the linearised multibody model against the
-lumped model's modal analysis (flexgear.lumped.modal, Lin & Parker 1999 with the carrier's equations), and at speed
-in the carrier's frame against Lin & Parker's rotating-frame equations.
+"""Modes of the planetary stage (ring fixed, carrier output) with 3, 4 and 5 planets, at rest: the linearised multibody
+model against the lumped model's modal analysis (flexgear.lumped.modal, Lin & Parker 1999 with the carrier's
+equations), and at speed in the carrier's frame against Lin & Parker's rotating-frame equations.
 
 With axial motion and tilts held, the multibody model of examples/spur_planetary (every component rigid, the exact
 geometry's mass properties, the ISO 6336 law at its mean stiffness) is the lumped model's planar
@@ -24,9 +24,35 @@ F_MAX = 10e3  # Hz
 
 
 @pytest.fixture(scope="module")
-def variant():
-    v = fg.load_variant(EXAMPLE / "rigid.toml")
+def example():
+    """examples/spur_planetary as it is (3 planets)."""
+    return fg.load_variant(EXAMPLE / "rigid.toml")
+
+
+SETS = {3: None, 4: (24, 30, 84), 5: (30, 30, 90)}
+"""Planet count -> the example's gear set with that many planets (None: the example as it is): z_s + z_r a multiple
+of N (equally spaced planets assemble), the planets' tip circles clear of each other."""
+
+
+@pytest.fixture(scope="module", params=sorted(SETS), ids=lambda n: f"{n}_planets")
+def variant(request, tmp_path_factory):
+    """examples/spur_planetary with N = 3, 4 and 5 planets (Lin & Parker's structure: N - 3 planet modes)."""
+    import tomllib
+
+    from test_validation import to_toml
+
+    n, teeth = request.param, SETS[request.param]
+    if teeth is None:
+        v = fg.load_variant(EXAMPLE / "rigid.toml")
+    else:
+        folder = tmp_path_factory.mktemp(f"planets_{n}")
+        data = tomllib.loads((EXAMPLE / "gearbox.toml").read_text())
+        data["gears"].update(sun_teeth=teeth[0], planet_teeth=teeth[1], ring_teeth=teeth[2], planet_count=n)
+        (folder / "gearbox.toml").write_text(to_toml(data))
+        (folder / "rigid.toml").write_text((EXAMPLE / "rigid.toml").read_text())
+        v = fg.load_variant(folder / "rigid.toml")
     assert v.gearbox.gears.arrangement == "planetary" and v.gearbox.contact.law == "iso6336"
+    assert v.gearbox.gears.planet_count == n
     return v
 
 
@@ -80,6 +106,12 @@ def test_planar_planetary_modes_equal_the_lumped_model_with_its_carrier(variant)
     carrier = m.energy["kinetic_carrier"].to_numpy()
     rotational = np.array([k == "rotational" for k in m.kinds])
     assert rotational.any() and carrier[rotational].max() > 0.1
+    # Lin & Parker's structure: translational modes in pairs, planet modes of multiplicity N - 3 (none for N = 3)
+    kinds = np.asarray(lumped.kinds)[keep]
+    n = variant.gearbox.gears.planet_count
+    assert np.count_nonzero(kinds == "translational") % 2 == 0
+    assert np.count_nonzero(kinds == "planet") % max(n - 3, 1) == 0
+    assert (np.count_nonzero(kinds == "planet") > 0) == (n > 3)
 
 
 def _rotating_frame_roots(params, omega_c: float) -> np.ndarray:
@@ -130,7 +162,7 @@ def test_planetary_modes_at_speed_in_the_carrier_frame_equal_lin_and_parker(vari
 @pytest.mark.xfail(strict=True, reason="the frequency domain misses the mesh-force harmonics of a spur mesh (large "
                    "stiffness variation; first order in it) by 20-45 %, star and planetary alike; the study's "
                    "double-helical set agrees within 10 % (tests/test_harmonic.py)")
-def test_spur_frequency_domain_matches_time_integration(variant):
+def test_spur_frequency_domain_matches_time_integration(example):
     """The lumped model of the spur planetary example at 300 rpm (quasi-static: the mesh frequency, 93 Hz, far
     below every mode), no tooth friction: its harmonic response's 1x and 2x mesh-force amplitudes against its own
     settled time run, within 10 % as the study's are. Measured: 1.56 against 2.01 N at 1x, 2.19 against 3.66 N at
@@ -144,7 +176,7 @@ def test_spur_frequency_domain_matches_time_integration(variant):
     from flexgear.study.compare import harmonic_amplitudes
 
     rpm = 300.0
-    spec = variant.gearbox.with_fields("load_case", input_speed_rpm=rpm, ramp_time_s=0.05, end_time_s=0.4)
+    spec = example.gearbox.with_fields("load_case", input_speed_rpm=rpm, ramp_time_s=0.05, end_time_s=0.4)
     spec = spec.with_fields("contact", friction_coefficient=0.0)
     response = lumped_harmonic_response(spec, [rpm], harmonics=spec.contact_assumed.stiffness_harmonics)
     run = run_lumped(spec)
