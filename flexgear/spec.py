@@ -386,11 +386,7 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
         if components["output_shaft"] == "flexible":
             raise SpecError(path, "components.output_shaft", "expected 'rigid': in the planetary arrangement "
                             "(gears.arrangement) the output shaft and the carrier are one rigid body", "flexible")
-        flexible = [name for name in COMPONENTS if components[name] == "flexible"]
-        if flexible and gearbox.solver_assumed.reference:
-            raise SpecError(path, f"components.{flexible[0]}", "expected 'rigid': the reference formulation "
-                            "([solver_assumed] formulation) builds flexible bodies in the star arrangement only",
-                            "flexible")
+
     level = raw.get("mesh_level", "default")
     if level not in gearbox.meshing_assumed:
         raise SpecError(path, "mesh_level", f"expected one of {sorted(gearbox.meshing_assumed)}", level)

@@ -63,7 +63,7 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[BearingElement],
     return obj, marker
 
 
-def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
+def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = None) -> list[int]:
     """The bearing ``bearing`` (acting on ``body``, ground on the other side) where it is.
 
     Rigid body on a linear frame (flexgear.mbs.bodies.add_linear_frame): the 6 x 6 bearing on its frame
@@ -72,7 +72,9 @@ def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
     ``MarkerSuperElementPosition`` on a virtual node moving rigidly with the interface ``bearing.interface`` of a
     flexible body (``FlexibleBody.point_markers``, placed at the same points, :func:`support_points`) or a
     body-fixed marker of a rigid body. Points on the axis: the spin does not move them, so the bearing leaves the
-    spin free and damps only translation and tilt. Returns the connectors.
+    spin free and damps only translation and tilt. ``other``: the rigid body on the bearing's other side
+    (``bearing.other``; a planet's pin on a turning carrier), whose points at the same places replace ground (the
+    springs are isotropic about the axis: the carrier's turning does not change them). Returns the connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
@@ -82,8 +84,12 @@ def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
         VObjectConnectorCartesianSpringDamper,
     )
 
-    bearing.check_to_ground(body.name)
-    if body.frame is not None and not body.flexible:  # a linear frame: one linear bearing on its coordinates
+    if other is None:
+        bearing.check_to_ground(body.name)
+    elif (bearing.body, bearing.other) != (body.name, other.name) or other.flexible:
+        raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed on {body.name!r} and "
+                         f"{other.name!r} (a rigid body)")
+    if body.frame is not None and not body.flexible and other is None:  # a linear frame: one linear bearing
         from flexgear.mbs.joints import add_frame_bearing
 
         return [add_frame_bearing(mbs, body, bearing)]
@@ -98,10 +104,15 @@ def add_support(mbs, body: Body, bearing: BearingElement) -> list[int]:
                    for sp in springs]
     out = []
     for k, (spring, marker) in enumerate(zip(springs, markers, strict=True)):
-        ground = mbs.AddNode(NodePointGround(referenceCoordinates=list(map(float, body.position + spring.point))))
+        place = body.position + spring.point
+        if other is None:
+            base = mbs.AddMarker(MarkerNodePosition(nodeNumber=mbs.AddNode(NodePointGround(
+                referenceCoordinates=list(map(float, place))))))
+        else:
+            base = mbs.AddMarker(MarkerBodyPosition(bodyNumber=other.obj,
+                                                    localPosition=[float(v) for v in place - other.position]))
         out.append(mbs.AddObject(ObjectConnectorCartesianSpringDamper(
-            name=f"bearing_{body.name}_{k}", markerNumbers=[mbs.AddMarker(MarkerNodePosition(nodeNumber=ground)),
-                                                            marker],
+            name=f"bearing_{body.name}_{k}", markerNumbers=[base, marker],
             stiffness=[float(v) for v in spring.stiffness], damping=[float(v) for v in spring.damping],
             visualization=VObjectConnectorCartesianSpringDamper(show=False))))
     return out

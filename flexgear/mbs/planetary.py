@@ -25,7 +25,10 @@ of the production formulation, as in the star (flexgear.mbs.gearbox.add_componen
 
 Every mode of a flexible gear stays dynamic here (no residual compliance, flexgear.mbs.residual): the planets'
 dropped modes would answer their bearing's reaction in axes that turn with the carrier, which that model does not
-hold. The reference formulation (``[solver_assumed] formulation = "reference"``) builds the star only.
+hold. The reference formulation (``[solver_assumed] formulation = "reference"``) builds the same stage from Exudyn's
+nonlinear objects (``ObjectFFRFreducedOrder`` with its floating-frame terms, generic joints on interface markers,
+a flexible planet's bearing as spring-dampers between its bore's point markers and the carrier's pin points): the
+check of the production formulation on the turning carrier.
 """
 
 from __future__ import annotations
@@ -40,7 +43,14 @@ from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
 from flexgear.mbs.carrier import Carrier, add_planet_bearing
-from flexgear.mbs.elements import add_fixed_joint, add_load_torque, add_speed_drive, add_support, interface_spin_marker
+from flexgear.mbs.elements import (
+    add_fixed_joint,
+    add_interface_joint,
+    add_load_torque,
+    add_speed_drive,
+    add_support,
+    interface_spin_marker,
+)
 from flexgear.mbs.gearbox import (
     GearboxModel,
     add_component,
@@ -75,13 +85,10 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     d = as_design(variant.gearbox if design is None else design)
     spec, th, geo = d.spec, d.theory, d.gears
     form = variant.components
-    flexible = [c for c, f in form.items() if f != "rigid"]
     if form["output_shaft"] != "rigid":
         raise ValueError(f"{variant.source}: field 'components.output_shaft': expected 'rigid': in the planetary "
                          "arrangement the output shaft and the carrier are one rigid body")
-    if flexible and spec.solver_assumed.reference:
-        raise ValueError(f"{variant.source}: field 'components.{flexible[0]}': the reference formulation builds "
-                         "flexible bodies in the star arrangement only")
+    reference = spec.solver_assumed.reference
     props, reduced = component_sources(variant, d, mass_source, reduced_source)
     lc, level = spec.load_case, variant.mesh_level
     ratio = th.output_speed / th.input_speed  # carrier spin per drive angle
@@ -106,13 +113,18 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         input_end = component("input_shaft", "input_shaft", np.zeros(3), th.input_speed,
                               joints={j.other_interface: j.point for j in found}, support=supports["input_shaft"])
         shafts = [input_end]
-        made = [LinearInterfaceJoint(mbs, sun, input_end, j, 1.0, "joint_sun_input_shaft" + (f"_{k}" if k else ""),
-                                     axes=joint_axes(input_end)) for k, j in enumerate(found)]
-        turning += [e for j in made for e in j.turning()]
-        joints["sun"] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
-        linear_gears.append("sun")
-        if joint_axes(input_end) == "body":
-            body_axes.append("sun")
+        labels = ["joint_sun_input_shaft" + (f"_{k}" if k else "") for k in range(len(found))]
+        if reference:
+            joints["sun"] = [(add_interface_joint(mbs, sun, input_end, j, label), np.array(j.point))
+                             for j, label in zip(found, labels, strict=True)]
+        else:
+            made = [LinearInterfaceJoint(mbs, sun, input_end, j, 1.0, label, axes=joint_axes(input_end))
+                    for j, label in zip(found, labels, strict=True)]
+            turning += [e for j in made for e in j.turning()]
+            joints["sun"] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
+            linear_gears.append("sun")
+            if joint_axes(input_end) == "body":
+                body_axes.append("sun")
     ring_joints = [FixedJointElement("ring", gi, "housing", si, p) for gi, si, p in gear_shaft_joints(d, "ring")]
     ring = component("ring", "ring", np.zeros(3), 0.0, joints={j.interface: j.point for j in ring_joints})
     carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
@@ -125,24 +137,31 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     if ring.flexible:  # held at its bolts' clamped discs by the housing
         housing = add_rigid_body(mbs, "housing", props(spec, "ring"), np.zeros(3))
         add_fixed_joint(mbs, housing, name="housing_ground")
-        made = [LinearInterfaceJoint(mbs, ring, housing, j, 0.0, "joint_ring_housing" + (f"_{k}" if k else ""))
-                for k, j in enumerate(ring_joints)]
-        turning += [e for j in made for e in j.turning()]
-        joints["ring"] = [(j.obj, np.array(e.point)) for j, e in zip(made, ring_joints, strict=True)]
-        linear_gears.append("ring")
+        labels = ["joint_ring_housing" + (f"_{k}" if k else "") for k in range(len(ring_joints))]
+        if reference:
+            joints["ring"] = [(add_interface_joint(mbs, ring, housing, j, label), np.array(j.point))
+                              for j, label in zip(ring_joints, labels, strict=True)]
+        else:
+            made = [LinearInterfaceJoint(mbs, ring, housing, j, 0.0, label)
+                    for j, label in zip(ring_joints, labels, strict=True)]
+            turning += [e for j in made for e in j.turning()]
+            joints["ring"] = [(j.obj, np.array(e.point)) for j, e in zip(made, ring_joints, strict=True)]
+            linear_gears.append("ring")
     else:
         add_fixed_joint(mbs, ring, name="ring_housing")
     seat_nodes = {}
     for planet in planets:
         bearing = replace(supports["planet"].on(planet.name), other="carrier")
-        if planet.flexible:
+        if planet.flexible and reference:  # springs on the bore's point markers, the pins' points on the carrier
+            add_support(mbs, planet, bearing, other=carrier)
+        elif planet.flexible:
             seat = LinearSeat(mbs, planet, bearing, th.planet_speed / th.input_speed, carrier=carrier)
             turning += seat.turning()
             seat_nodes[planet.name] = seat.node
         else:
             add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
                                                                                  other="carrier"))
-    if input_end.flexible:
+    if input_end.flexible and not reference:
         seat = LinearSeat(mbs, input_end, supports["input_shaft"].on(input_end.name), 1.0)
         turning += seat.turning()
     else:
