@@ -58,9 +58,10 @@ RESPONSE_STEPS = 66
 REFERENCE_STEPS = 27
 """Speeds of the reference's response (coarse: 250 rpm apart at 6000 rpm, every solve is of its full size)."""
 
-_COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
+_COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft", "carrier")  # carrier: a planetary stage's
 _COLOURS = {"input_shaft": "#1f77b4", "sun": "#ff7f0e", "planets": "#2ca02c", "ring": "#d62728",
-            "output_shaft": "#9467bd", "outer_mesh": "#8c564b", "inner_mesh": "#e377c2", "residual": "#7f7f7f"}
+            "output_shaft": "#9467bd", "carrier": "#bcbd22", "outer_mesh": "#8c564b", "inner_mesh": "#e377c2",
+            "residual": "#7f7f7f"}
 
 
 def variant_of(run: RunResult, results_dir: Path) -> Any:
