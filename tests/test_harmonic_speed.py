@@ -89,12 +89,18 @@ def _lightly_damped(variant, factor: float = 0.1):
 
 PROMINENCE = 2.0
 """A peak counts if it stands this many times above the higher of the lowest values on either side of it."""
+SIGNIFICANCE = 0.05
+"""... and holds at least this share of its curve's largest value: the stiffness variation's coupling of the
+harmonics adds humps of a few percent of a curve (model 1, lightly damped: 3.5 % at 1839 rpm on the input bearing's
+2x, 3-3.5 % between 1575 and 1648 rpm on its 3x), not resonances of a mode."""
 
 
 def test_peaks_lie_at_campbell_crossings(model1, iso_spec):
     """Each crossing that carries a peak (a prominent peak of some curve has it as its nearest crossing of the same
-    order) has one within 1 % of its speed (a curve may also show interference humps between two close modes:
-    those are attributed to a crossing but are not its peak)."""
+    order) has one within 1 % of its speed (a curve may also show interference humps between two close modes: those
+    are attributed to a crossing but are not its peak). The stiffness variation couples the harmonics
+    (flexgear.harmonic.base, Hill's method), so a harmonic's curve also peaks where another harmonic meets a mode:
+    a crossing whose peaks all lie within 1 % of a crossing of another order is carried by that one."""
     from flexgear.modal import campbell
 
     variant = _lightly_damped(dataclasses.replace(model1, gearbox=iso_spec))
@@ -110,14 +116,17 @@ def test_peaks_lie_at_campbell_crossings(model1, iso_spec):
             y = amp[h].to_numpy()
             crossings = diagram.crossings[diagram.crossings.order == h].speed_rpm.to_numpy()
             for i in np.flatnonzero((y[1:-1] > y[:-2]) & (y[1:-1] >= y[2:])) + 1:
-                if y[i] < PROMINENCE * max(y[:i].min(), y[i:].min()):
+                if y[i] < PROMINENCE * max(y[:i].min(), y[i:].min()) or y[i] < SIGNIFICANCE * y.max():
                     continue
                 nearest = float(crossings[np.argmin(np.abs(crossings - speeds[i]))])
                 attributed.setdefault((h, nearest), []).append(float(speeds[i]))
     assert len(attributed) >= 10
+    table = diagram.crossings
     for (h, crossing), peaks in attributed.items():
         closest = min(peaks, key=lambda n: abs(n - crossing))
-        assert abs(closest / crossing - 1.0) <= 0.01, (h, crossing, peaks)
+        others = table[table.order != h].speed_rpm.to_numpy()
+        coupled = all(np.min(np.abs(others / n - 1.0)) <= 0.01 for n in peaks)
+        assert abs(closest / crossing - 1.0) <= 0.01 or coupled, (h, crossing, peaks)
 
 
 @pytest.fixture(scope="module")

@@ -16,7 +16,8 @@ import pandas as pd
 from flexgear.theory import mesh_frequency_hz
 
 __all__ = ["Response", "mesh_frequency_hz", "INDICATOR_UNITS", "DEFAULT_HARMONICS", "RPM", "ACCEL_INDICATORS",
-           "excitation", "Operating", "mesh_force_name", "sweep_speeds", "excited_spec", "series_coefficients"]
+           "excitation", "Operating", "mesh_force_name", "sweep_speeds", "excited_spec", "series_coefficients",
+           "parametric_matrix", "parametric_forces"]
 
 DEFAULT_HARMONICS = 10
 """Mesh harmonics h = 1..H of the excitation and response."""
@@ -149,21 +150,138 @@ def excitation(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray]:
     return excite, force
 
 
-def _solve(op: Operating, harmonics: int) -> dict[str, np.ndarray]:
-    """Complex amplitudes (H,) of every indicator at one speed (module docstring)."""
+def parametric_matrix(coef: np.ndarray, k_t: np.ndarray) -> np.ndarray:
+    """The real matrix L ((2 H + 1) n_c, (2 H + 1) n_c) of the contacts' parametric forces P = L D (Hill's method).
+
+    With s - 1 = Re sum_k C_k e^{i k phi} and delta~ = D_0 + Re sum_j D_j e^{i j phi} (harmonics 1..H, phi the mesh
+    phase [rad]; D_0 the shift of the mean deflection), the force k_t (s - 1) delta~ has the mean and harmonics
+
+        P_0 = k_t / 2 sum_k Re(C_k conj(D_k)),
+        P_h = k_t [C_h D_0 + 1/2 (sum_{k + j = h} C_k D_j + sum_{k - j = h} C_k conj(D_j)
+                                  + sum_{j - k = h} conj(C_k) D_j)]
+
+    (the harmonics above H left out: the truncation). ``coef`` (n_c, H): C_k of each contact; ``k_t`` (n_c,).
+    Unknowns and results stacked as [D_0, Re D_1..D_H, Im D_1..D_H], each block harmonic-major over the contacts.
+    P is real-linear in D (the conjugates), so L acts on real and imaginary parts apart."""
+    n_c, n_h = coef.shape
+    size = n_h * n_c
+    out = np.zeros((n_c + 2 * size, n_c + 2 * size))
+
+    def re(h: int) -> slice:
+        return slice(n_c + (h - 1) * n_c, n_c + h * n_c)
+
+    def im(h: int) -> slice:
+        return slice(n_c + size + (h - 1) * n_c, n_c + size + h * n_c)
+
+    def put(h: int, j: int, factor: np.ndarray, conj: bool) -> None:
+        """P_h += factor * (D_j or conj(D_j)), factor (n_c,) complex: its 2 x 2 real blocks per contact."""
+        a, b = np.diag(factor.real), np.diag(factor.imag)
+        sign = -1.0 if conj else 1.0  # conj(D) = Re D - i Im D
+        out[re(h), re(j)] += a
+        out[re(h), im(j)] -= sign * b
+        out[im(h), re(j)] += b
+        out[im(h), im(j)] += sign * a
+
+    mean = slice(0, n_c)
+    for h in range(1, n_h + 1):
+        c = coef[:, h - 1]
+        out[mean, re(h)] += np.diag(0.5 * k_t * c.real)
+        out[mean, im(h)] += np.diag(0.5 * k_t * c.imag)
+        out[re(h), mean] += np.diag(k_t * c.real)
+        out[im(h), mean] += np.diag(k_t * c.imag)
+        for k in range(1, n_h + 1):
+            c = 0.5 * k_t * coef[:, k - 1]
+            if 1 <= h - k <= n_h:
+                put(h, h - k, c, False)
+            if 1 <= k - h <= n_h:
+                put(h, k - h, c, True)
+            if 1 <= h + k <= n_h:
+                put(h, h + k, np.conj(c), False)
+    return out
+
+
+def parametric_forces(op: Operating, harmonics: int | None = None) -> np.ndarray:
+    """The contacts' parametric forces P_h (H, n_c) [N] at one speed, harmonics 1..``harmonics`` (default all of
+    ``op.coef``): the harmonics of k_t (s - 1) delta~ in the coupled solution (:func:`_coupled`)."""
+    return _response(op, op.coef.shape[1] if harmonics is None else harmonics)[1]
+
+
+HILL_HARMONICS_FACTOR = 2
+"""The coupled solution carries this many times the harmonics asked, the extra ones as unknowns only (no
+excitation): the products of the stiffness's and the deflection's harmonics reach up to their sum, and a
+truncation at the harmonics asked would distort the highest of them."""
+
+
+def _response(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(X (H, n), P (H, n_c), F_0 C_h (n_c, H), omegas (H,) [rad/s]) at one speed, harmonics 1..``harmonics``
+    (:func:`_coupled` over :data:`HILL_HARMONICS_FACTOR` times as many)."""
+    import dataclasses
+
+    total = HILL_HARMONICS_FACTOR * harmonics
+    coef = np.zeros((op.coef.shape[0], total), complex)
+    coef[:, :min(harmonics, op.coef.shape[1])] = op.coef[:, :harmonics]
+    friction = None
+    if op.friction is not None:
+        friction = np.zeros((op.friction.shape[0], total), complex)
+        friction[:, :min(harmonics, op.friction.shape[1])] = op.friction[:, :harmonics]
+    x, p, excite, w = _coupled(dataclasses.replace(op, coef=coef, friction=friction), total)
+    return x[:harmonics], p[:harmonics], excite[:, :harmonics], w[:harmonics]
+
+
+def _coupled(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """(X (H, n), P (H, n_c), F_0 C_h (n_c, H), omegas (H,) [rad/s]) at one speed, harmonics 1..``harmonics``.
+
+    The stiffness variation acts twice: on the static deflection, the excitation F_0 C_h, and on the dynamic one, the
+    parametric force k_t (s - 1) delta~, which couples the harmonics and shifts the mean deflection (Hill's method,
+    :func:`parametric_matrix`). Both act through the contacts only, so the coupled problem is solved for the
+    contacts' deflections: D = D_1 - G P(D), G_h = g A_h^-1 g^T (n_c, n_c) each harmonic's contact compliance (the
+    static one, A_0 = K, for the mean), D_1 the response to the excitation alone; then every coordinate from the
+    forces F_0 C_h + P_h. A spur mesh varies its stiffness by tens of percent: without P the 1x and 2x mesh-force
+    harmonics came out 23 and 41 % low against time integration."""
     h = np.arange(1, harmonics + 1)
     w = h * op.omega_mesh
-    n = op.mass.shape[0]
+    w0 = np.concatenate([[0.0], w])  # the mean, then the harmonics
+    n, n_c = op.mass.shape[0], op.rows.shape[0]
     excite, f = excitation(op, harmonics)
+    friction = None if op.friction is None else op.friction[:, :harmonics]
+    # one factorisation per frequency: the excitation's response x1 and the unit contact forces' (unit, H + 1)
+    unit_forces = -np.broadcast_to(np.eye(n_c), (harmonics + 1, n_c, n_c)).astype(complex)
     if op.solver is not None:
-        c = -excite.T if op.friction is None else np.hstack([-excite.T, -op.friction[:, :harmonics].T])
-        x = op.solver(w, c)
+        first = (-excite.T if friction is None else np.hstack([-excite.T, -friction.T]))[..., None]
+        rest = unit_forces if friction is None else np.concatenate(
+            [unit_forces, np.zeros((harmonics + 1, friction.shape[0], n_c), complex)], axis=1)
+        both = op.solver(w, np.concatenate([first, rest[1:]], axis=2))  # (H, n, 1 + n_c)
+        x1, unit = both[..., 0], np.concatenate([op.solver(w0[:1], rest[:1]), both[..., 1:]])
     else:
-        a = (op.stiffness[None] - (w**2)[:, None, None] * op.mass[None]
-             + 1j * w[:, None, None] * op.damping[None])  # (H, n, n)
-        x = np.linalg.solve(a, f[..., None])[..., 0] if n else np.zeros((harmonics, 0), complex)
+        a = (op.stiffness[None] - (w0**2)[:, None, None] * op.mass[None]
+             + 1j * w0[:, None, None] * op.damping[None])  # (H + 1, n, n): the mean, then each harmonic
+        loads = op.rows.T @ unit_forces  # (H + 1, n, n_c)
+        rhs = np.concatenate([np.concatenate([np.zeros((1, n, 1)), f[..., None]]), loads], axis=2)
+        both = np.linalg.solve(a, rhs) if n else np.zeros((harmonics + 1, 0, 1 + n_c), complex)
+        x1, unit = both[1:, :, 0], both[..., 1:]
+    compliance = np.einsum("cn,hnk->hck", op.rows, unit)  # -G_h: contact deflections per unit contact force
+    d1 = x1 @ op.rows.T  # (H, n_c)
+    lmat = parametric_matrix(op.coef[:, :harmonics], op.k_t)
+    size = harmonics * n_c
+    gmat = np.zeros_like(lmat)
+    gmat[:n_c, :n_c] = compliance[0].real  # the mean: a real static compliance
+    for k in range(1, harmonics + 1):  # the complex product -G_h P_h as a real 2 x 2 block matrix
+        r = slice(n_c + (k - 1) * n_c, n_c + k * n_c)
+        i = slice(n_c + size + (k - 1) * n_c, n_c + size + k * n_c)
+        gmat[r, r], gmat[r, i] = compliance[k].real, -compliance[k].imag
+        gmat[i, r], gmat[i, i] = compliance[k].imag, compliance[k].real
+    rhs = np.concatenate([np.zeros(n_c), d1.real.ravel(), d1.imag.ravel()])
+    p_real = lmat @ np.linalg.solve(np.eye(lmat.shape[0]) - gmat @ lmat, rhs)
+    p = (p_real[n_c:n_c + size] + 1j * p_real[n_c + size:]).reshape(harmonics, n_c)  # (H, n_c); the mean left
+    x = x1 + np.einsum("hnk,hk->hn", unit[1:], p)  # unit holds the response to -g^T e_k: P acts as -g^T P
+    return x, p, excite, w
+
+
+def _solve(op: Operating, harmonics: int) -> dict[str, np.ndarray]:
+    """Complex amplitudes (H,) of every indicator at one speed (module docstring; :func:`_response`)."""
+    x, p, excite, w = _response(op, harmonics)
     delta = x @ op.rows.T  # (H, n_c)
-    contact = (op.k_t[None] + 1j * w[:, None] * op.c[None]) * delta + excite.T
+    contact = (op.k_t[None] + 1j * w[:, None] * op.c[None]) * delta + excite.T + p
     out: dict[str, np.ndarray] = {}
     for m, name in enumerate(op.mesh_names):
         out[name] = contact[:, op.mesh == m].sum(axis=1)

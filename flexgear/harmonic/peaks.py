@@ -13,13 +13,15 @@ mass-weighted MAC of their shapes psi (flexgear.modal.campbell_diagram.track) an
 f_mesh(n) by the same
 linear interpolation. Kinds: flexgear.lumped.modal.classify_mode on |psi|.
 
-Modal contributions. The steady response X at omega to a force F has the state s = (X, i omega X) with
-(i omega I - A) s = (0, M^-1 F); with eta = V^-1 s, X = sum_j psi_j eta_j exactly. An indicator y = r^T X + y_exc
-(flexgear.harmonic.base._solve: a mesh force r = (k_t + i omega c) g summed over the mesh's contacts and y_exc = F_0
-C_h, a bearing acceleration r = -omega^2 a, the transmission error r = te) has the contribution r^T psi_j eta_j of
-root j. A mode's contribution is the sum over the root and its conjugate, a multiplet's (modes of equal frequency
-within :data:`MULTIPLET_RTOL`: the degenerate pairs of cyclic symmetry, whose shapes are not unique) the sum over its
-modes. The mode that carries the response there is the multiplet with the largest |contribution|.
+Modal contributions. The steady response X at omega to a force F has the state s = (X, i omega X) with (i omega I -
+A) s = (0, M^-1 F); with eta = V^-1 s, X = sum_j psi_j eta_j exactly. F is the contacts' force variation -g^T (F_0
+C_h + P_h): the excitation and the parametric force of the coupled solution
+(flexgear.harmonic.base.parametric_forces). An indicator y = r^T X + y_exc (flexgear.harmonic.base._solve: a mesh
+force r = (k_t + i omega c) g summed over the mesh's contacts and y_exc = F_0 C_h + P_h, a bearing acceleration r =
+-omega^2 a, the transmission error r = te) has the contribution r^T psi_j eta_j of root j. A mode's contribution is
+the sum over the root and its conjugate, a multiplet's (modes of equal frequency within :data:`MULTIPLET_RTOL`: the
+degenerate pairs of cyclic symmetry, whose shapes are not unique) the sum over its modes. The mode that carries the
+response there is the multiplet with the largest |contribution|.
 
 Peaks. A peak of an indicator's harmonic h over the speed grid is a local maximum of its amplitude of at least
 :data:`PEAK_FRACTION` of the curve's highest, located between grid speeds by the vertex of the parabola through the
@@ -41,7 +43,14 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-from flexgear.harmonic.base import ACCEL_INDICATORS, DEFAULT_HARMONICS, Operating, Response, sweep_speeds
+from flexgear.harmonic.base import (
+    ACCEL_INDICATORS,
+    DEFAULT_HARMONICS,
+    Operating,
+    Response,
+    parametric_forces,
+    sweep_speeds,
+)
 from flexgear.harmonic.lumped import LumpedLinear, lumped_linear
 from flexgear.modal.campbell_diagram import MAC_MIN, MAX_DAMPING_RATIO, MESH_ORDERS, Campbell, order_crossings, track
 from flexgear.modal.eigenmodes import state_space_roots
@@ -120,7 +129,9 @@ def _contributions(op: Operating, roots: _Roots, indicator: str, harmonic: int) 
     r^T X) at harmonic ``harmonic`` (module docstring)."""
     n = op.mass.shape[0]
     omega = harmonic * op.omega_mesh
-    force = -(op.rows.T @ (op.f0 * op.coef[:, harmonic - 1]))  # generalised force -g F_0 C_h
+    # generalised force -g (F_0 C_h + P_h): the excitation and the parametric force of the coupled solution
+    # (flexgear.harmonic.base.parametric_forces), which the modes answer alike
+    force = -(op.rows.T @ (op.f0 * op.coef[:, harmonic - 1] + parametric_forces(op)[harmonic - 1]))
     if op.friction is not None:  # the tooth-friction excitation (flexgear.harmonic.base.excitation)
         force = force - op.friction_rows.T @ op.friction[:, harmonic - 1]
     a_dyn = op.stiffness - omega**2 * op.mass + 1j * omega * op.damping

@@ -177,10 +177,11 @@ class ModalSolver:
 
     def solve(self, spin: float, omegas: np.ndarray, coefficients: np.ndarray) -> np.ndarray:
         """x (H, n) at spin speed ``spin`` [rad/s] for the excitation frequencies ``omegas`` (H,) [rad/s] and forces
-        ``directions @ coefficients[h]`` (``coefficients`` (H, n_c))."""
+        ``directions @ coefficients[h]`` (``coefficients`` (H, n_c)); (H, n, k) for k force sets at once
+        (``coefficients`` (H, n_c, k))."""
         from threadpoolctl import threadpool_limits
 
-        out = np.empty((omegas.size, self.lam.size), complex)
+        out = np.empty((omegas.size, self.lam.size, *np.shape(coefficients)[2:]), complex)
         with threadpool_limits(limits=1, user_api="blas"):  # small dense solves: one thread is fastest
             for h, w in enumerate(omegas):
                 out[h] = self._one(spin, w, coefficients[h])

@@ -1,28 +1,31 @@
 """Steady harmonic response of the star gearbox to the transmission-error excitation, over a speed grid.
 
-Excitation (first order in the stiffness variation). Each mesh contact carries the time-varying stiffness of
+Excitation and the stiffness variation's coupling. Each mesh contact carries the time-varying stiffness of
 eq. 11-12, k(t) = k_mean s(phi(t)), s(phi) = 1 + sum_h c_h cos(2 pi h (phi - phi_0)), with the mesh phase phi in
 mesh cycles advancing at the mesh frequency f_mesh = z_sun (n_in - n_carrier) / 60 [Hz] and each planet's meshes
 phased by the planet's position (the models' own phases: flexgear.mbs.gearbox.mesh_contacts,
 flexgear.lumped.run.build_lumped_model). About the static operating point under the load torque (deflection
 delta_0, force F_0 = F(delta_0) of the contact law, the mean stiffness) the contact force is
 
-    F(t) = F(delta_0 + x_delta) s(phi)  ~  F_0 + k_t x_delta + c x_delta' + F_0 (s(phi) - 1),
+    F(t) = F(delta_0 + x_delta) s(phi)  ~  F_0 + k_t x_delta + c x_delta' + F_0 (s(phi) - 1) + k_t (s(phi) - 1) x_delta,
 
 k_t = dF/d delta at delta_0 the tangent stiffness (k_mean for the linear ISO 6336 law, 1.5 k delta_0^0.5 for the
-impact law), c the contact damping. The last term is the excitation: at harmonic h its complex amplitude is
+impact law), c the contact damping. The fourth term is the excitation: at harmonic h its complex amplitude is
 F_h = F_0 C_h = Delta k_h delta_0 (linear law) with C_h the complex Fourier coefficient of s at +h f_mesh, acting
-along the mesh's line of action (the generalised force -g F_h, g = d delta / dz). The products of the stiffness
-variation with the response (parametric terms, x_delta (s - 1)) are dropped: the result is exact to first order in
-the variation c_h and fails near the parametric instabilities (2 f_n / k = h f_mesh, combination resonances) and
-where the teeth lose contact (|F_dyn| comparable to F_0: the law's kink is not linearised). Tooth friction, as the
+along the mesh's line of action (the generalised force -g F_h, g = d delta / dz). The last, parametric term couples
+the harmonics of the response and shifts its mean deflection; it is kept (Hill's method, flexgear.harmonic.base:
+the coupled problem solved for the contacts' deflections over twice the harmonics asked): a spur mesh varies its
+stiffness by tens of percent, and the first-order response missed its 1x and 2x mesh-force harmonics by 23 and
+41 %. The response stays linear in the deflection: it fails near the parametric instabilities (2 f_n / k = h f_mesh,
+combination resonances), where its steady state does not exist, and where the teeth lose contact (|F_dyn|
+comparable to F_0: the law's kink is not linearised). Tooth friction, as the
 time model applies it (the spec's friction coefficient; none at mu = 0), adds its own first-order excitation: the
 Fourier series of its generalised force at the static mesh loads, -(a^T S_h + b^T L_h) on the contacts' sliding and
 relative-spin rows (flexgear.harmonic.friction); it does not enter the mesh forces' direct term.
 
 Response at each speed of the grid and each harmonic h = 1..H, omega = 2 pi h f_mesh(speed):
 
-    (-omega^2 M + i omega (D + G) + K) X_h = F_h
+    (-omega^2 M + i omega (D + G) + K) X_h = F_h - g^T P_h,    P_h the parametric force's harmonic
 
 with M, D, G, K the linearised model at that speed (multibody: flexgear.modal.linear.linearize at two speeds and
 the exact spin dependence G ~ Omega, K ~ Omega^2 between them, solved on a truncated modal basis with its
@@ -31,8 +34,8 @@ Outputs (complex amplitudes of x(t) = Re(X e^{i omega t}); ``amplitude`` = |X|, 
 origin at mesh phase 0):
 
 - ``outer_mesh_force_<i>_n``, ``inner_mesh_force_<i>_n`` [N]: each mesh's dynamic normal force, the sum over its
-  contacts (helix halves) of F_dyn,h = (k_t + i omega c) x_delta,h + F_0 C_h (the direct stiffness-variation term
-  included: it is what a force sensor in the mesh reads);
+  contacts (helix halves) of F_dyn,h = (k_t + i omega c) x_delta,h + F_0 C_h + P_h (the direct stiffness-variation
+  terms included: it is what a force sensor in the mesh reads);
 - ``outer_mesh_force_max_n``, ``inner_mesh_force_max_n`` [N]: the largest over the planets;
 - ``{input,output}_bearing_accel_{x,y}_m_per_s2`` [m/s^2]: -omega^2 X of the frame translation of the member
   carrying the input/output bearing (flexgear.results.signal_columns: the gear-centre frame node);

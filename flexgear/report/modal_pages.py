@@ -386,8 +386,8 @@ def _response_page(study: ModalStudy) -> Page:
         times = ", ".join(f"{k} {r.wall_time_s:.1f} s" for k, r in study.responses.items())
         text_block(fig.add_axes([0.07, 0.02, 0.9, 0.06]),
                    "Steady response to the transmission-error and tooth-friction excitation at the static loads, "
-                   "mesh harmonics 1-10, first order in the "
-                   "stiffness variation (flexgear.harmonic; fails near parametric instabilities and contact loss). "
+                   "mesh harmonics 1-10, with the stiffness variation's parametric coupling of the harmonics "
+                   "(flexgear.harmonic, Hill's method; fails near parametric instabilities and contact loss). "
                    "RMS of harmonics: sqrt(sum_h |X_h|²/2). K_v: 1 + the largest mesh's sum of harmonic amplitudes "
                    f"over its static load. Wall time of the sweeps: {times}. " + _notes_text(study, "response"),
                    width=200, fontsize=7)

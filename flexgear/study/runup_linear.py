@@ -11,10 +11,11 @@ friction coefficient is above zero, flexgear.harmonic.friction) is driven along 
 phi the run's mesh phase (flexgear.study.runup.mesh_phase) and s(t) the run's mean mesh force relative to the
 operating point's: the window-averaged sum of the recorded mesh forces divided by the sum of the static contact
 forces F_0 (flexgear.study.runup.mesh_excitation with that reference), so that F_0 s(t) C_h is the stiffness
-variation's force at the run's own load (first order in the variation, as flexgear.harmonic.response; friction,
-mu times the normal force, scales with the load alike; its sign of sliding is the operating point's). The
-output is a bearing acceleration y = a^T z'' (flexgear.harmonic.base.ACCEL_INDICATORS: the frame translation of the
-member carrying the bearing), the same signal the time run records.
+variation's force at the run's own load (first order in the variation: the parametric term of
+flexgear.harmonic.response is left out; friction, mu times the normal force, scales with the load alike; its sign of
+sliding is the operating point's). The output is a bearing acceleration y = a^T z''
+(flexgear.harmonic.base.ACCEL_INDICATORS: the frame translation of the member carrying the bearing), the same signal
+the time run records.
 
 Integration. In the mass-normalised undamped modes of (K_sym, M) (Phi^T M Phi = I, for conditioning) the state
 x = (p, p') obeys x' = A x + B u(t); with A = V diag(lambda) V^-1 each complex modal coordinate eta = V^-1 x obeys
