@@ -184,3 +184,20 @@ def test_spur_frequency_domain_matches_time_integration(example):
     timed = harmonic_amplitudes(run.signals[column].to_numpy()[-n:], dt, f_mesh, (1, 2))
     np.testing.assert_allclose(response.amplitudes(column).iloc[0].to_numpy()[:2], timed, rtol=0.02)
 
+
+
+def test_multibody_harmonic_response_equals_the_lumped_models(example):
+    """The linearised rigid planetary stage's harmonic response (the spin fit in the carrier's axes, its output the
+    carrier) against the lumped model's, at the example's 3000 rpm, no friction: the transmission error at the
+    carrier and planet 1's sun-planet mesh force at 1x-3x within 0.5 % (measured 0.02 % and 0.06 %). Before its
+    output was the ring's frame: held in this arrangement, a transmission error of zero."""
+    from flexgear.harmonic import harmonic_response, lumped_harmonic_response
+
+    rpm = example.gearbox.load_case.input_speed_rpm
+    spec = example.gearbox.with_fields("contact", friction_coefficient=0.0)
+    multibody = harmonic_response(dataclasses.replace(example, gearbox=spec), [rpm], 3)
+    lumped = lumped_harmonic_response(spec, [rpm], 3)
+    for indicator in ("transmission_error_m", "outer_mesh_force_1_n"):
+        got, ref = (r.amplitudes(indicator).iloc[0].to_numpy() for r in (multibody, lumped))
+        assert ref.min() > 0.0, indicator
+        np.testing.assert_allclose(got, ref, rtol=0.005, err_msg=indicator)

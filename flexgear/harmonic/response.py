@@ -288,7 +288,11 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
                 delta0[j] -= lm.static_residuals[nm]
         full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
         in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
-        out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
+        # the output member: the star's ring (its shaft where separate), the planetary stage's carrier
+        if "carrier" in full:
+            out_comp = ("carrier",)
+        else:
+            out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
         accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
         out_row = _frame_row(lm, out_comp, "phi_z")
         return law_rows, lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
