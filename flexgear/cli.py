@@ -330,7 +330,7 @@ def cmd_meshes(a: argparse.Namespace) -> int:
     if a.workers < 1:
         raise SystemExit(f"flexgear meshes: --workers must be >= 1, got {a.workers}")
     what = "meshes" if a.no_reduce else "meshes and reduced bodies"
-    items = build_items(not a.no_reduce)
+    items = build_items(not a.no_reduce, spec.gears.arrangement)
     with Progress(len(items), f"{what} ({a.level})", "parts", fmt="{:.0f}", plain_step=1 / len(items)) as bar:
         def done(c) -> None:
             modes = "" if c.n_modes is None else f", {c.n_modes} modes, first {c.first_frequency_hz:.0f} Hz"

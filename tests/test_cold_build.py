@@ -58,6 +58,7 @@ def test_cold_build_schedules_every_component_and_checks_its_workers(gearbox):
 
     assert sorted(COLD_BUILD_ORDER) == sorted(build_items()) == sorted((*GEOMETRY_COMPONENTS, TIED_PAIR))
     assert build_items(reduce=False) == GEOMETRY_COMPONENTS
+    assert build_items(arrangement="planetary") == GEOMETRY_COMPONENTS  # no tied ring and output shaft there
     with pytest.raises(ValueError, match="workers"):
         build_components(gearbox, "coarse", workers=0)
 

@@ -30,9 +30,11 @@ longest by far (it meshes both parts first), takes one worker; the other builds 
 the tied pair's task has made by then. Only the schedule depends on it; a task missing here starts last."""
 
 
-def build_items(reduce: bool = True) -> tuple[str, ...]:
-    """The tasks of :func:`build_components`: every component, and with ``reduce`` the tied ring and output shaft."""
-    return (*GEOMETRY_COMPONENTS, *((TIED_PAIR,) if reduce else ()))
+def build_items(reduce: bool = True, arrangement: str = "star") -> tuple[str, ...]:
+    """The tasks of :func:`build_components`: every component, and with ``reduce`` in the star arrangement the tied
+    ring and output shaft (the planetary stage holds its ring by the housing and joins its output shaft to the
+    carrier: no tied body)."""
+    return (*GEOMETRY_COMPONENTS, *((TIED_PAIR,) if reduce and arrangement == "star" else ()))
 
 
 @dataclass(frozen=True)
@@ -72,7 +74,7 @@ def build_components(spec: GearboxSpec, level: str, reduce: bool = True, workers
     if int(workers) != workers or workers < 1:
         raise ValueError(f"build_components: workers must be an integer >= 1, got {workers!r}")
     rank = {c: i for i, c in enumerate(COLD_BUILD_ORDER)}
-    items = build_items(reduce)
+    items = build_items(reduce, spec.gears.arrangement)
     order = sorted(items, key=lambda c: rank.get(c, len(rank)))
     done: dict[str, ComponentSummary] = {}
 
