@@ -213,7 +213,7 @@ def _part_runner(variant, t_end_s, progress=False, **_):
                       "loaded_sha256": __import__("hashlib").sha256(entry.source.read_bytes()).hexdigest()})
 
 
-def test_part_files_travel_with_the_task_and_land_in_the_run_folders_inputs(gearbox, tmp_path):
+def test_part_files_travel_with_the_task_and_land_in_the_run_folders_inputs(gearbox, tmp_path, monkeypatch):
     """A variant (in ``variants/``) of a gearbox (one folder up) whose sun comes from ``parts/sun.vtu``: its task
     carries the part, so it runs after the caller's folder is gone, as on a Dask worker that sees none of the
     caller's files: the worker loads the very same part (its SHA-256) from the task's own copy, laid out as the
@@ -221,6 +221,7 @@ def test_part_files_travel_with_the_task_and_land_in_the_run_folders_inputs(gear
     from flexgear.fe.mesh import component_mesh
     from flexgear.fe.mesh_io import write_vtu
     from flexgear.spec import load_variant
+    from flexgear.study import pool
     from flexgear.study.pool import make_task, run_task, save_task_result
 
     home = tmp_path / "study"
@@ -234,6 +235,15 @@ def test_part_files_travel_with_the_task_and_land_in_the_run_folders_inputs(gear
     path.write_text(path.read_text().replace('gearbox = "gearbox.toml"', 'gearbox = "../gearbox.toml"'))
     task = make_task(load_variant(path), 0.01)
     expected = load_variant(path).gearbox.components_geometry["sun"].sha256
+    assert make_task(load_variant(path), 0.01).parts[0][1] is task.parts[0][1]  # read once for every variant
+    changed = dataclasses.replace(load_variant(path), name="changed")
+    (home / "parts" / "sun.vtu").write_bytes((home / "parts" / "sun.vtu").read_bytes() + b" ")
+    assert make_task(changed, 0.01).parts == task.parts  # the content its cache keys name, read before
+    with monkeypatch.context() as m:  # not read before in this process: the changed file is refused
+        m.setattr(pool, "_PARTS", {})
+        with pytest.raises(ValueError, match="sun.vtu: the part file changed since its gearbox file was loaded"):
+            make_task(changed, 0.01)
+    (home / "parts" / "sun.vtu").write_bytes((home / "parts" / "sun.vtu").read_bytes()[:-1])
     shutil.move(home, tmp_path / "elsewhere")
     result = run_task(task, _part_runner)
     assert result.ok, result.meta.get("reason")

@@ -116,13 +116,32 @@ class RunTask:
         return variant
 
 
+_PARTS: dict[tuple[str, str], bytes] = {}
+"""Part files read for tasks, by (resolved path, SHA-256 at load): the variants of a matrix share one read."""
+
+
+def part_bytes(path: str | Path, sha256: str) -> bytes:
+    """The content of the part file ``path`` whose content had the SHA-256 ``sha256`` when its gearbox was loaded
+    (flexgear.schema_geometry.ComponentGeometry), read once per process; a file changed since then raises ValueError
+    in one line (the run would not be the one its cache keys name)."""
+    import hashlib
+
+    key = (str(Path(path).resolve()), sha256)
+    if key not in _PARTS:
+        data = Path(path).read_bytes()
+        if hashlib.sha256(data).hexdigest() != sha256:
+            raise ValueError(f"{path}: the part file changed since its gearbox file was loaded; load it again")
+        _PARTS[key] = data
+    return _PARTS[key]
+
+
 def make_task(variant: Variant, t_end_s: float | str | None, time_budget_s: float | None = None,
               error_window_s: float = 0.0, out_dir: str | Path = "") -> RunTask:
     """The task of a loaded variant: reads its two files once, on the caller's side; ``t_end_s`` in s, "settled"
     or None (the load case's end: ``end_time_s``, or "settled" with ``[load_case] end = "settled"``)."""
     lc = variant.gearbox.load_case
     t_end = t_end_s if t_end_s is not None else ("settled" if lc.end == "settled" else lc.end_time_s)
-    parts = {str(Path(e.source).resolve()): Path(e.source).read_bytes()
+    parts = {str(Path(e.source).resolve()): part_bytes(e.source, e.sha256)
              for e in variant.gearbox.components_geometry.values()}
     return RunTask(variant.name, str(Path(variant.source).resolve()), Path(variant.source).read_text(),
                    str(Path(variant.gearbox.source).resolve()), Path(variant.gearbox.source).read_text(), t_end_s,
