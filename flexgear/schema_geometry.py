@@ -29,6 +29,7 @@ The selectors are part of the entry, so they enter the spec hash and the compone
 
 from __future__ import annotations
 
+import dataclasses
 import hashlib
 import math
 from dataclasses import dataclass
@@ -37,8 +38,8 @@ from typing import Any
 
 from flexgear.schema_fields import SpecError
 
-__all__ = ["ComponentGeometry", "GEOMETRY_FORMATS", "LENGTH_UNITS", "RegionSelector", "SELECTABLE_REGIONS",
-           "SELECTOR_KINDS", "components_geometry_table"]
+__all__ = ["CONTACT_BAND", "ComponentGeometry", "GEOMETRY_FORMATS", "LENGTH_UNITS", "RegionSelector",
+           "SELECTABLE_REGIONS", "SELECTOR_KINDS", "components_geometry_table"]
 
 GEOMETRY_FORMATS = {".step": "step", ".stp": "step", ".brep": "brep", ".brp": "brep", ".vtu": "mesh",
                     ".msh": "mesh", ".inp": "mesh"}
@@ -46,13 +47,20 @@ GEOMETRY_FORMATS = {".step": "step", ".stp": "step", ".brep": "brep", ".brp": "b
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 """Length unit of a file's coordinates -> metres per unit."""
 _COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft")
-SELECTABLE_REGIONS = {"sun": ("bore", "flanks"), "planet": ("bore", "flanks"),
-                      "ring": ("flanks", "bolt_holes", "bolt_hole_<k>", "bolt_discs"),
+SELECTABLE_REGIONS = {"sun": ("bore", "flanks", "contact_band"), "planet": ("bore", "flanks", "contact_band"),
+                      "ring": ("flanks", "bolt_holes", "bolt_hole_<k>", "bolt_discs", "contact_band"),
                       "input_shaft": ("bearing_seat", "gear_seat"),
                       "output_shaft": ("bearing_seat", "bolt_holes", "bolt_hole_<k>", "bolt_discs")}
 """Component -> the mesh regions its reduction's interfaces and contact bands stand on (``bolt_hole_<k>``: the
 k-th bolt hole alone, k = 0, 1, ...; ``bolt_discs``: the bolts' clamped discs on the flange or web face, one
-patch per bolt, in place of the discs the bolt circle and ``bolt_clamp_diameter_mm`` give, flexgear.fe.bolted)."""
+patch per bolt, in place of the discs the bolt circle and ``bolt_clamp_diameter_mm`` give, flexgear.fe.bolted;
+``contact_band``: a gear's contact band, a cylinder only: ``radius`` the circle the mesh loads act on and its
+modes are sensed at, ``tolerance`` the band's radial half-width (default: the gear data's, one normal module),
+``z`` its axial range (each helix half's band is cut to it; default: the gear data's halves), in place of the
+operating pitch circle and the helix halves, flexgear.fe.reduced.contact_band_override)."""
+CONTACT_BAND = "contact_band"
+"""The selectable region that is a gear's contact band (a circle band for the reduction's loads and the contacts'
+mode sensing), not a set of boundary nodes."""
 SELECTOR_KINDS = ("cylinder", "points", "physical_group")
 """The kinds of a region selector (module docstring)."""
 _GROUP_SUFFIXES = (".msh", ".inp")
@@ -154,7 +162,13 @@ def _selectors(path: Path, field: str, component: str, unit: str, file: Path, ra
             kinds = " | ".join(f"{k} = ..." for k in SELECTOR_KINDS)
             raise SpecError(path, where, f"expected one selector: {{ {kinds} }}", table)
         ((kind, value),) = table.items()
-        out.append(_selector(path, f"{where}.{kind}", region, kind, value, unit, file))
+        if region == CONTACT_BAND and kind != "cylinder":
+            raise SpecError(path, where, f"expected a cylinder: {{ cylinder = {{ radius_{unit} = ..., "
+                            f"tolerance_{unit} = ..., z_{unit} = [...] }} }} (a contact band is a circle band)", table)
+        selector = _selector(path, f"{where}.{kind}", region, kind, value, unit, file)
+        if region == CONTACT_BAND and f"tolerance_{unit}" not in value:  # the gear data's band
+            selector = dataclasses.replace(selector, tolerance=0.0)
+        out.append(selector)
     names = {s.region for s in out}
     if "bolt_holes" in names and any(n.startswith("bolt_hole_") for n in names):
         raise SpecError(path, field, "give bolt_holes (its holes are bolt_hole_<k>) or bolt_hole_<k>, not both")

@@ -15,6 +15,7 @@ built-in meshes written as files and imported again:
 - the selectors enter the spec hash and the component's cache keys.
 """
 
+import dataclasses
 from pathlib import Path
 
 import meshio
@@ -286,3 +287,71 @@ def _held_lowest_hz(body) -> float:
     basis = la.null_space(joint_rows(body, "bolt_patches", body.interface("bolt_patches").point))
     return float(np.sqrt(la.eigh(basis.T @ stiffness @ basis, basis.T @ mass @ basis, eigvals_only=True)[0])
                  / (2 * np.pi))
+
+
+# --------------------------------------------------------------------------- the contact band
+def test_a_contact_band_selector_places_the_loads_and_the_sensing(gearbox, parts, tmp_path):
+    """``regions.contact_band`` of an imported gear: a cylinder at the gear data's band (operating pitch radius,
+    one normal module, the helix halves) gives the gear data's load circles and contact sensing exactly; moved half
+    a module towards the root it loads and senses the teeth there, which yield less (the static compliance under
+    the contact kernel's loads, bore held, is smaller on every contact); a band that misses the mesh, or that is not a
+    cylinder, is refused in one line."""
+    import flexgear as fg
+    from flexgear.fe.reduced import component_contacts, component_load_circles, component_reduced_body
+    from flexgear.mbs.train import contact_sensing_rows
+
+    d = as_design(gearbox)
+    r_p = d.meshes["outer"].mesh.operating_pitch_radii[0]
+    m = gearbox.gears.normal_module_m
+    order = gearbox.reduction_assumed.contact_fourier_order
+    file = _copy(parts, tmp_path, "sun.vtu")
+    specs = {}
+    for label, radius in (("data", r_p), ("root", r_p - 0.5 * m)):
+        folder = tmp_path / label
+        folder.mkdir()
+        _copy(parts, folder, "sun.vtu")
+        specs[label] = load_gearbox(_gearbox(folder, "sun", file, "m", f"contact_band = {{ cylinder = {{ "
+                                                                       f"radius_m = {radius!r} }} }}"))
+    plain = component_load_circles(gearbox, "sun", order)
+    same = component_load_circles(specs["data"], "sun", order)
+    assert [(c.radius_m, c.z_min_m, c.z_max_m, c.radial_band_m) for c in same] == [
+        (c.radius_m, c.z_min_m, c.z_max_m, c.radial_band_m) for c in plain]
+    root = component_load_circles(specs["root"], "sun", order)
+    assert all(abs(c.radius_m - (r_p - 0.5 * m)) < 1e-12 for c in root)
+    bodies = {label: component_reduced_body(spec, "sun", "coarse") for label, spec in specs.items()}
+    contacts = fg.mesh_contacts(gearbox)
+    for label, spec in specs.items():  # the sensing follows the band the reduction loads
+        band = next(s for s in spec.components_geometry["sun"].regions if s.region == "contact_band")
+        rows = contact_sensing_rows(bodies[label], "sun", np.zeros(3), contacts, order, m, band)
+        plain_rows = contact_sensing_rows(bodies[label], "sun", np.zeros(3), contacts, order, m)
+        same_span = np.linalg.svd(rows @ plain_rows.T, compute_uv=False).min() > 1 - 1e-9
+        assert same_span == (label == "data"), label
+    compliance = {}
+    for label, spec in specs.items():
+        points, normals = component_contacts(spec, "sun")
+        compliance[label] = np.diag(fg.static_compliance(bodies[label], points, normals, "bore",
+                                                         kernel=component_load_circles(spec, "sun", order)))
+    assert np.all(compliance["root"] < compliance["data"]), (compliance["root"], compliance["data"])
+    # the multibody model's flexible sun takes the band: its contact columns are those of the moved band
+    import exudyn as exu
+
+    from flexgear.mbs.assemble import build_gearbox
+    from flexgear.spec import load_variant
+
+    base = load_variant(ROOT / "model_variants" / "model1.toml")
+    columns = {}
+    for label, spec in specs.items():
+        variant = dataclasses.replace(base, gearbox=spec, rigid_mass_properties="exact",
+                                      components={**base.components, "sun": "flexible"})
+        sc = exu.SystemContainer()
+        model = build_gearbox(sc.AddSystem(), variant)
+        assert model.bodies["sun"].contact_band.region == "contact_band"
+        kin = model.kinematics
+        columns[label] = kin.tables[[b == "sun" for b in kin.bodies]]
+        sc.Reset()
+    assert not np.allclose(columns["root"], columns["data"])
+    _refused(tmp_path, "sun", file, "m", "contact_band = { cylinder = { radius_m = 0.5 } }", "contact_band",
+             "finds no node")
+    with pytest.raises(SpecError) as err:
+        load_gearbox(_gearbox(tmp_path, "sun", file, "m", "contact_band = { points = { at_m = [[0.05, 0.0, 0.0]] } }"))
+    assert err.value.field == "components_geometry.sun.regions.contact_band" and "cylinder" in str(err.value)

@@ -49,7 +49,7 @@ from flexgear.fe.mesh_io import MeshFileError, boundary_faces, netgen_mesh, read
 from flexgear.fe.parts import cached_brep, register_file_parts
 from flexgear.fe.selectors import SelectorError, group_points, selected_regions, whole_faces
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
-from flexgear.schema_geometry import SELECTABLE_REGIONS, ComponentGeometry
+from flexgear.schema_geometry import CONTACT_BAND, SELECTABLE_REGIONS, ComponentGeometry
 from flexgear.spec import GearboxSpec
 
 __all__ = ["GeometryFileError", "ImportedMesh", "imported_brep", "imported_mesh", "check_imported_mesh",
@@ -221,8 +221,24 @@ def _select(d: Design, component: str, entry: ComponentGeometry, mesh: Component
         raise GeometryFileError(component, entry, f"selector {exc}") from None
 
 
-_REGIONS = {c: tuple(n for n in names if "<" not in n) for c, names in SELECTABLE_REGIONS.items()}
+_REGIONS = {c: tuple(n for n in names if "<" not in n and n != CONTACT_BAND) for c, names in SELECTABLE_REGIONS.items()}
 """The mesh regions of each component that its reduction's interfaces and contact bands stand on."""
+
+
+def _check_contact_band(d: Design, component: str, entry: ComponentGeometry, band, nodes: np.ndarray) -> None:
+    """Refuse a ``contact_band`` selector whose band (its radius +- its radial half-width, the gear data's one normal
+    module when it gives none, over its axial range) holds no node of the part's mesh."""
+    if band.axis != (0.0, 0.0):
+        raise GeometryFileError(component, entry, f"selector {band.describe()}: a contact band lies about the gear's "
+                                "axis (axis_<unit> = [0, 0])")
+    half = band.tolerance or d.spec.gears.normal_module_m
+    r, z = np.hypot(nodes[:, 0] - band.axis[0], nodes[:, 1] - band.axis[1]), nodes[:, 2]
+    inside = np.abs(r - band.radius) <= half
+    if band.z_range is not None:
+        inside &= (z >= band.z_range[0]) & (z <= band.z_range[1])
+    if not inside.any():
+        raise GeometryFileError(component, entry, f"selector {band.describe()} finds no node of its mesh within "
+                                f"{half * 1e3:g} mm of that circle")
 
 
 def check_imported_mesh(d: Design, component: str, mesh: ComponentMesh, entry: ComponentGeometry) -> None:
@@ -230,6 +246,9 @@ def check_imported_mesh(d: Design, component: str, mesh: ComponentMesh, entry: C
     that hold no whole boundary face: no surface), or whose teeth do not match the gear data
     (:func:`_check_teeth`); the bolts' clamped discs must each hold nodes (flexgear.fe.bolted)."""
     selected = {s.region for s in entry.regions}
+    band = next((s for s in entry.regions if s.region == CONTACT_BAND), None)
+    if band is not None:
+        _check_contact_band(d, component, entry, band, mesh.nodes)
     for name in _REGIONS[component]:
         if name == "bolt_discs" and name not in selected:
             continue  # the built-in discs: checked below

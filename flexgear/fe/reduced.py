@@ -40,9 +40,11 @@ from flexgear.geometry.contact_lines import MeshContactGeometry
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
+from flexgear.schema_geometry import CONTACT_BAND
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
-__all__ = ["component_interfaces", "component_load_circles", "component_contacts", "component_reduced_body",
+__all__ = ["contact_band_selector", "contact_fit_window", "component_interfaces", "component_load_circles",
+           "component_contacts", "component_reduced_body",
            "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
            "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles",
            "read_cached"]
@@ -145,7 +147,44 @@ def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarr
     out = []
     for contact, drive, first, angles in meshes:
         out += [(circle, angles) for circle in band_circles(contact, drive, first, spec.gears.normal_module_m)]
-    return out
+    selector = contact_band_selector(d, component)
+    if selector is None:
+        return out
+    moved = []
+    for circle, angles in out:  # the circle at the selector's radius, its band cut to the selector's (one window)
+        z = 0.5 * (circle.z_min_m + circle.z_max_m)
+        point, half, radial = contact_fit_window(selector, np.array([circle.radius_m, 0.0, z]),
+                                                 0.5 * (circle.z_max_m - circle.z_min_m), circle.radial_band_m)
+        moved.append((dataclasses.replace(circle, radius_m=float(point[0]), z_min_m=float(point[2] - half),
+                                          z_max_m=float(point[2] + half), radial_band_m=radial), angles))
+    return moved
+
+
+def contact_band_selector(spec: GearboxSpec | Design, component: str):
+    """The ``[components_geometry] <component>.regions.contact_band`` selector of an imported gear
+    (flexgear.schema_geometry.RegionSelector), None for a built-in component or one without it."""
+    entry = (getattr(as_design(spec).spec, "components_geometry", None) or {}).get(component)
+    return next((s for s in entry.regions if s.region == CONTACT_BAND), None) if entry is not None else None
+
+
+def contact_fit_window(band, point: np.ndarray, half_width: float, radial_band: float
+                       ) -> tuple[np.ndarray, float, float]:
+    """The contact band's (point [m], axial half-width [m], radial half-width [m]) of a contact at ``point`` with
+    the gear data's ``half_width`` and ``radial_band``, moved by a ``contact_band`` selector ``band`` (None: as
+    given): the point's radius the selector's, its axial range cut to the selector's, the radial half-width the
+    selector's tolerance where it gives one. An axial range that misses the contact's raises ValueError."""
+    if band is None:
+        return np.asarray(point, float), float(half_width), float(radial_band)
+    p = np.asarray(point, float)
+    r = math.hypot(p[0], p[1])
+    z0, z1 = p[2] - half_width, p[2] + half_width
+    if band.z_range is not None:
+        z0, z1 = max(z0, band.z_range[0]), min(z1, band.z_range[1])
+        if z1 < z0:
+            raise ValueError(f"{band.describe()} misses the contact's axial range "
+                             f"{1e3 * (p[2] - half_width):g}..{1e3 * (p[2] + half_width):g} mm")
+    moved = np.array([p[0] * band.radius / r, p[1] * band.radius / r, 0.5 * (z0 + z1)])
+    return moved, 0.5 * (z1 - z0), float(band.tolerance or radial_band)
 
 
 def band_circles(contact: MeshContactGeometry, drive: int, first: bool, band: float) -> list[LoadCircle]:

@@ -35,7 +35,7 @@ from pathlib import Path
 
 import numpy as np
 
-from flexgear.schema_geometry import RegionSelector
+from flexgear.schema_geometry import CONTACT_BAND, RegionSelector
 
 __all__ = ["SelectorError", "FEATURE_ANGLE_DEG", "group_points", "picked_nodes", "whole_faces", "check_surface",
            "named_selector", "patches_by_angle", "selected_discs", "selected_regions"]
@@ -228,6 +228,8 @@ def selected_regions(selectors: tuple[RegionSelector, ...], builtin: dict[str, n
     another element order than the FE model's, whose nodes are not checked)."""
     out = dict(builtin)
     for s in selectors:
+        if s.region == CONTACT_BAND:  # not boundary nodes: the reduction's and the contacts' band (fe.reduced)
+            continue
         picked = picked_nodes(s, nodes, surface, groups, strict)
         expected = (n_holes if s.region in ("bolt_holes", "bolt_discs")
                     else 1 if s.region in _SINGLE or "_hole_" in s.region else None)

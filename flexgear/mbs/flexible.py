@@ -47,6 +47,8 @@ class FlexibleBody(Body):
     modal_sizes: tuple[int, ...] = ()
     basis: np.ndarray | None = None
     contact_nodes: tuple[int, ...] = ()  # the nodes of q~ that the gear contacts sense (all, without a basis)
+    # an imported gear's contact_band selector (flexgear.fe.reduced.contact_fit_window), None: the gear data's band
+    contact_band: object | None = None
 
     def node_columns(self, nodes: tuple[int, ...] | list[int]) -> np.ndarray:
         """Indices in q~ of the coordinates of ``nodes`` (some of ``modal_nodes``), in order."""

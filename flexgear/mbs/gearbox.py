@@ -21,7 +21,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.fe.reduced import component_mass_properties
+from flexgear.fe.reduced import component_mass_properties, contact_band_selector
 from flexgear.fe.ring_shaft import TIED_PAIR
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.involute import GearSetGeometry
@@ -272,11 +272,12 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
     keep = dynamic_modes(geometry, full.frequencies_hz, cutoff_hz)
     kept = full.truncated(keep) if keep < full.n_modes else full
     sensing = None
+    band = contact_band_selector(spec, geometry) if geometry in GEARS else None  # an imported gear's own band
     if coordinates and geometry in GEARS and kept.n_modes > 6 * len(coordinates):  # room beside the interfaces
         from flexgear.mbs.train import contact_sensing_rows
 
         sensing = contact_sensing_rows(kept, name, position, list(contacts),
-                                       spec.reduction_assumed.contact_fourier_order, spec.gears.normal_module_m)
+                                       spec.reduction_assumed.contact_fourier_order, spec.gears.normal_module_m, band)
     body = add_flexible_body(mbs, name, kept, position,
                              stiffness_damping_s=spec.reduction_assumed.modal_stiffness_damping_s,
                              interface_markers=joints or [], point_markers=points,
@@ -284,6 +285,8 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
                              nominal_spin_rad_s=spin_rad_s, superelement=superelement or reference,
                              interface_coordinates=tuple(dict.fromkeys(coordinates)), sensing_rows=sensing,
                              linear_frame_tolerance=frame_tol)
+    if band is not None:
+        body = replace(body, contact_band=band)
     if keep == full.n_modes:
         return body
     from flexgear.mbs.residual import dropped_modes

@@ -63,6 +63,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.fe.reduced import contact_fit_window
 from flexgear.laws.compiled import bound_entry, ramp_state
 from flexgear.mbs.bodies import matrix_container, motion_at_point, normal_lever, resting_node, zero_user_jacobian
 from flexgear.mbs.contact_kinematics import modal_contact_coefficients
@@ -169,8 +170,9 @@ def residual_compliance(contacts, bodies: dict, dropped: dict[str, DroppedModes]
                 if body_name != name:
                     continue
                 rel = np.asarray(c.point) - body.position
-                table = modal_contact_coefficients(body.reduced.nodes, d.modes, rel, c.normal,
-                                                   0.5 * c.half_width, radial_band, order)
+                point, half, width = contact_fit_window(getattr(body, "contact_band", None), rel, 0.5 * c.half_width,
+                                                        radial_band)
+                table = modal_contact_coefficients(body.reduced.nodes, d.modes, point, c.normal, half, width, order)
                 rows.append(i)
                 parts.append((table, sign, spin, rel, np.asarray(c.normal, float)))
         if not rows:

@@ -63,6 +63,7 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
     ``carrier_spin``: the carrier's nominal spin per drive angle. The contact points turn with the carrier, so the
     material angle of a contact on a gear is alpha = psi - (spin - carrier_spin) theta (theta the drive angle), for
     the central gears and for the planets, whose contact points sit still in the carrier's frame."""
+    from flexgear.fe.reduced import contact_fit_window
     from flexgear.mbs.contact_kinematics import ModalColumn, modal_contact_coefficients
 
     columns = []
@@ -72,25 +73,30 @@ def modal_columns(contacts: list[GearContact], bodies: dict[str, Body], order: i
             if not body.flexible:
                 continue
             rel = np.asarray(c.point) - body.position
-            values = body.to_coordinates(modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, rel,
-                                                                    c.normal, 0.5 * c.half_width, radial_band, order))
+            point, half, band = contact_fit_window(getattr(body, "contact_band", None), rel, 0.5 * c.half_width,
+                                                   radial_band)
+            values = body.to_coordinates(modal_contact_coefficients(body.reduced.nodes, body.reduced.modes, point,
+                                                                    c.normal, half, band, order))
             columns.append(ModalColumn(row, name, sign, float(np.arctan2(rel[1], rel[0])), spin - carrier_spin,
                                        values))
     return columns
 
 
 def contact_sensing_rows(reduced, name: str, position: np.ndarray, contacts: list[GearContact], order: int,
-                         radial_band: float) -> np.ndarray:
+                         radial_band: float, band: object | None = None) -> np.ndarray:
     """Orthonormal rows (r, m) spanning the Fourier coefficients (flexgear.mbs.contact_kinematics.
     modal_contact_fourier) of every contact of body ``name`` (a flexgear.fe.cms.ReducedBody at ``position``
     [m]): each contact's deflection c(alpha) . q is then a combination of these r sensed coordinates only
     (flexgear.mbs.flexible.interface_basis). r <= 2 (2 order + 1) per distinct band and normal (the planets'
-    contacts on a ring are turned copies). Singular values below 1e-9 of the largest are round-off."""
+    contacts on a ring are turned copies). Singular values below 1e-9 of the largest are round-off. ``band``: the
+    gear's ``contact_band`` selector (flexgear.fe.reduced.contact_fit_window), None for the gear data's band."""
+    from flexgear.fe.reduced import contact_fit_window
     from flexgear.mbs.contact_kinematics import modal_contact_fourier
 
-    coefs = [modal_contact_fourier(reduced.nodes, reduced.modes, np.asarray(c.point) - position, c.normal,
-                                   0.5 * c.half_width, radial_band, order)
-             for c in contacts if name in (c.body1, c.body2)]
+    coefs = [modal_contact_fourier(reduced.nodes, reduced.modes, point, c.normal, half, width, order)
+             for c in contacts if name in (c.body1, c.body2)
+             for point, half, width in [contact_fit_window(band, np.asarray(c.point) - position, 0.5 * c.half_width,
+                                                           radial_band)]]
     if not coefs:
         return np.zeros((0, reduced.n_modes))
     _, sv, vt = np.linalg.svd(np.vstack(coefs), full_matrices=False)
