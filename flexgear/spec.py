@@ -382,10 +382,6 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
             raise SpecError(path, f"components.{name}", "missing; expected 'rigid' or 'flexible'")
         components[name] = _check_value(path, f"components.{name}", comps[name], str,
                                         {"choices": ("rigid", "flexible")})
-    if gearbox.gears.arrangement == "planetary":
-        if components["output_shaft"] == "flexible":
-            raise SpecError(path, "components.output_shaft", "expected 'rigid': in the planetary arrangement "
-                            "(gears.arrangement) the output shaft and the carrier are one rigid body", "flexible")
 
     level = raw.get("mesh_level", "default")
     if level not in gearbox.meshing_assumed:

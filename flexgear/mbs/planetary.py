@@ -7,12 +7,14 @@ shaft, which takes the output bearing and the load torque. Each contact's geomet
 (flexgear.mbs.carrier.CarrierKinematics); the planets' frames are absolute, so their orbit's Coriolis and
 centripetal terms come from the rigid-body equations themselves.
 
-Components. The output shaft and the carrier are one rigid body: the carrier is not a component of the gearbox file,
-its mass and polar inertia are ``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped
-model's, eq. 1-13; derived from the gear set when the file leaves them out, flexgear.sizing), its transverse inertia
-half the polar (a disc). The input shaft, the sun, the planets and the ring are each rigid or a reduced flexible body
-of the production formulation, as in the star (flexgear.mbs.gearbox.add_component):
+Components. The carrier is not a component of the gearbox file: a rigid body whose mass and polar inertia are
+``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped model's, eq. 1-13; derived from the
+gear set when the file leaves them out, flexgear.sizing), its transverse inertia half the polar (a disc). Every
+component of the file is rigid or a reduced flexible body, as in the star (flexgear.mbs.gearbox.add_component):
 
+- the output shaft: rigid, one rigid body with the carrier; flexible, bolted to the carrier at its bolts' clamped
+  discs (a fixed joint where the star bolts the ring's flange to it), the output bearing at its seat and the load
+  torque there;
 - the sun and the input shaft: one rigid body when both are rigid, else two bodies and the linear fixed joint of
   the star (flexgear.mbs.joints.LinearInterfaceJoint); the input bearing at the shaft's seat;
 - a flexible planet: its bore's motion on a seat node, the bearing a pin bearing on the carrier
@@ -80,14 +82,11 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     flexgear.mbs.gearbox.GearboxModel (output body: the carrier). ``mass_source`` (spec, component) ->
     MassProperties overrides the variant's rigid mass properties, ``reduced_source`` (spec, component, level) its
     reduced bodies, as in flexgear.mbs.assemble.build_gearbox."""
-    from flexgear.fe.reduced import gear_shaft_joints
+    from flexgear.fe.reduced import BOLT_PATCHES, gear_shaft_joints, joint_point
 
     d = as_design(variant.gearbox if design is None else design)
     spec, th, geo = d.spec, d.theory, d.gears
     form = variant.components
-    if form["output_shaft"] != "rigid":
-        raise ValueError(f"{variant.source}: field 'components.output_shaft': expected 'rigid': in the planetary "
-                         "arrangement the output shaft and the carrier are one rigid body")
     reference = spec.solver_assumed.reference
     props, reduced = component_sources(variant, d, mass_source, reduced_source)
     lc, level = spec.load_case, variant.mesh_level
@@ -127,8 +126,25 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
                 body_axes.append("sun")
     ring_joints = [FixedJointElement("ring", gi, "housing", si, p) for gi, si, p in gear_shaft_joints(d, "ring")]
     ring = component("ring", "ring", np.zeros(3), 0.0, joints={j.interface: j.point for j in ring_joints})
-    carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
-                                                                     props(spec, "output_shaft")), np.zeros(3))
+    if form["output_shaft"] == "rigid":  # one rigid body with the carrier
+        carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
+                                                                         props(spec, "output_shaft")), np.zeros(3))
+        output_end = carrier
+    else:  # bolted to the carrier at its bolts' clamped discs (where the star bolts the ring's flange to it)
+        carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(spec), np.zeros(3))
+        point = joint_point(d, "ring")
+        joint = FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", "carrier", point)
+        output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
+                               joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
+        shafts.append(output_end)
+        if reference:
+            joints["output_shaft"] = [(add_interface_joint(mbs, output_end, carrier, joint,
+                                                           "joint_output_shaft_carrier"), point)]
+        else:
+            made = LinearInterfaceJoint(mbs, output_end, carrier, joint, ratio, "joint_output_shaft_carrier")
+            turning += made.turning()
+            joints["output_shaft"] = [(made.obj, point)]
+            linear_gears.append("output_shaft")
     planets = []
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -166,7 +182,11 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         turning += seat.turning()
     else:
         add_support(mbs, input_end, supports["input_shaft"].on(input_end.name))
-    add_support(mbs, carrier, supports["output_shaft"].on("carrier"))
+    if output_end.flexible and not reference:
+        seat = LinearSeat(mbs, output_end, supports["output_shaft"].on(output_end.name), ratio)
+        turning += seat.turning()
+    else:
+        add_support(mbs, output_end, supports["output_shaft"].on(output_end.name))
     extra = []
     if turning:
         extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
@@ -179,9 +199,9 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
                            extra_pre_steps=extra, contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
                            radial_band=spec.gears.normal_module_m)
     spin_in = interface_spin_marker(mbs, input_end, "bearing_seat" if input_end.flexible else None)
-    spin_out = interface_spin_marker(mbs, carrier, None)
+    spin_out = interface_spin_marker(mbs, output_end, "bearing_seat" if output_end.flexible else None)
     drive = add_speed_drive(mbs, input_end, lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
-    load = add_load_torque(mbs, carrier, -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s,
+    load = add_load_torque(mbs, output_end, -math.copysign(lc.load_torque_nm, th.output_speed), lc.ramp_time_s,
                            spin_out[0])
     springs = train.springs
     halves = len(helix_halves(geo))
@@ -189,6 +209,6 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
     inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
     return GearboxModel(d, {b.name: b for b in [*bodies, *shafts]}, outer, inner, drive, load, contacts,
-                        train.friction, train.kinematics, tuple(train.aux_nodes), input_end.name, "carrier", joints,
-                        spin_out[1:], linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
+                        train.friction, train.kinematics, tuple(train.aux_nodes), input_end.name, output_end.name,
+                        joints, spin_out[1:], linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
                         carrier_seat_nodes=seat_nodes)
