@@ -79,3 +79,20 @@ def test_spur_planetary_example_against_hand_theory_and_the_lumped_model(tmp_pat
         means[name] = late[[f"{m}_mesh_force_{i}_n" for m in ("outer", "inner") for i in (1, 2, 3)]].mean()
         np.testing.assert_allclose(means[name], force, rtol=0.01, err_msg=name)
     np.testing.assert_allclose(means["rigid"].to_numpy(), means["lumped"].to_numpy(), rtol=0.01)
+
+
+def test_recorded_states_name_the_planetary_stages_geometries(tmp_path):
+    """The bodies' geometries for the animation (flexgear.mbs.states.state_bodies): the ring held by the housing is
+    the ring alone (never the star's tied ring and output shaft), the carrier carries its merged output shaft, the
+    sun its merged input shaft."""
+    import exudyn as exu
+
+    from flexgear.mbs.assemble import build_gearbox
+    from flexgear.mbs.states import state_bodies
+
+    sc = exu.SystemContainer()
+    model = build_gearbox(sc.AddSystem(), load_variant(_planetary(tmp_path)))
+    bodies = state_bodies(model)
+    assert bodies["ring"]["geometries"] == ["ring"] and bodies["carrier"]["geometries"] == ["output_shaft"]
+    assert bodies["sun"]["geometries"] == ["sun", "input_shaft"] and bodies["planet1"]["geometries"] == ["planet"]
+    sc.Reset()

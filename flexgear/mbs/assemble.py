@@ -16,8 +16,9 @@ def build_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
                   design: Design | None = None) -> GearboxModel:
     """Assemble the gearbox of ``variant`` into ``mbs`` in its ``[gears] arrangement``: the star
     (flexgear.mbs.gearbox.build_star_gearbox, every rigid/flexible combination) or the planetary stage
-    (flexgear.mbs.planetary.build_planetary_gearbox, rigid components). Call ``mbs.Assemble()`` afterwards."""
+    (flexgear.mbs.planetary.build_planetary_gearbox, likewise). Call ``mbs.Assemble()`` afterwards."""
     d = as_design(variant.gearbox if design is None else design)
     if d.spec.gears.arrangement == "planetary":
-        return build_planetary_gearbox(mbs, variant, mass_source, design=d)
+        return build_planetary_gearbox(mbs, variant, mass_source, design=d, reduced_source=reduced_source,
+                                       superelements=superelements)
     return build_star_gearbox(mbs, variant, mass_source, reduced_source, superelements, design=d)

@@ -77,11 +77,12 @@ def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
 
 
 def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Design | None = None,
-                            reduced_source=None) -> GearboxModel:
+                            reduced_source=None, superelements: bool = False) -> GearboxModel:
     """Assemble the planetary gearbox of ``variant`` into ``mbs`` (module docstring); returns its
-    flexgear.mbs.gearbox.GearboxModel (output body: the carrier). ``mass_source`` (spec, component) ->
-    MassProperties overrides the variant's rigid mass properties, ``reduced_source`` (spec, component, level) its
-    reduced bodies, as in flexgear.mbs.assemble.build_gearbox."""
+    flexgear.mbs.gearbox.GearboxModel (output body: the carrier, or a flexible output shaft). ``mass_source``
+    (spec, component) -> MassProperties overrides the variant's rigid mass properties, ``reduced_source`` (spec,
+    component, level) its reduced bodies, ``superelements`` whether every flexible body keeps its
+    ``ObjectFFRFreducedOrder`` (for recorded states), as in flexgear.mbs.assemble.build_gearbox."""
     from flexgear.fe.reduced import BOLT_PATCHES, gear_shaft_joints, joint_point
 
     d = as_design(variant.gearbox if design is None else design)
@@ -99,7 +100,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         if form["planets" if geometry == "planet" else geometry] == "rigid":
             return add_rigid_body(mbs, name, props(spec, geometry), position)
         return add_component(mbs, name, "flexible", geometry, position, spec, level, props, reduced, spin_rad_s=spin,
-                             contacts=contacts, **kw)
+                             contacts=contacts, superelement=superelements, **kw)
 
     turning, joints, linear_gears, body_axes = [], {}, [], []
     if form["sun"] == "rigid" and form["input_shaft"] == "rigid":

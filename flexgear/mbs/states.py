@@ -29,12 +29,17 @@ _MERGED = {"sun": "input_shaft", "ring": "output_shaft"}
 
 def state_bodies(model: GearboxModel) -> dict[str, dict]:
     """Per body: the component geometries it carries (a rigid gear merged with its rigid shaft carries
-    both; the flexible ring and output shaft, tied, the tied pair's body), whether it is flexible, its mode
-    count and probe node."""
+    both; the flexible ring and output shaft, tied, the tied pair's body; a planetary stage's carrier its merged
+    output shaft's, or none), whether it is flexible, its mode count and probe node."""
     out = {}
+    planetary = model.design.spec.gears.arrangement == "planetary"
     for name, body in model.bodies.items():
         if name.startswith("planet"):
             geometries = ["planet"]
+        elif name == "carrier":  # not a component: it carries the output shaft's geometry where merged with it
+            geometries = ["output_shaft"] if "output_shaft" not in model.bodies else []
+        elif planetary and name == "ring":  # held by the housing: never merged or tied with the output shaft
+            geometries = ["ring"]
         elif name in _MERGED and _MERGED[name] not in model.bodies:  # merged rigid, or tied flexible
             geometries = [TIED_PAIR] if body.flexible else [name, _MERGED[name]]
         else:

@@ -63,6 +63,8 @@ def body_meshes(result: RunResult, reduced_source=None) -> list[BodyMesh]:
         from flexgear.fe.ring_shaft import reduced_body as reduced_source
     out = []
     for name, info in bodies.items():
+        if not info["geometries"]:  # a body without a component's geometry (a planetary stage's own carrier)
+            continue
         parts, tris, rows, probe, count = [], [], [], -1, 0
         for geometry in info["geometries"]:
             red = reduced_source(variant.gearbox, geometry, variant.mesh_level)
