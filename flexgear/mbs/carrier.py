@@ -71,8 +71,7 @@ class CarrierKinematics:
         self.ramp_time, self.drive_speed = ramp_time, drive_speed
         self.n_frames = 6 * len(bodies)
         self.rows0 = np.asarray(rows, float)[:, :self.n_frames].copy()
-        self.n_columns = np.asarray(rows).shape[1]
-        self.modal = self.n_columns > self.n_frames  # flexible gears: their modal columns are not written here
+        self.modal = np.shape(rows)[1] > self.n_frames  # flexible gears: their modal columns are not written here
         names = [b.name for b in bodies]
         if carrier.body not in names:
             raise KeyError(f"carrier body {carrier.body!r} is not among the bodies {names}")
@@ -105,11 +104,11 @@ class CarrierKinematics:
         return np.hstack([pos, np.zeros_like(pos)]).ravel()
 
     def matrix_and_offset(self, t: float) -> tuple[np.ndarray, np.ndarray]:
-        """Constraint scaling matrix and offset at time t (aux = G q - offset); the modal columns zero."""
+        """Constraint scaling matrix over the frame coordinates and offset at time t (aux = G q - offset; the modal
+        columns, where there are any, are flexgear.mbs.contact_kinematics.ContactKinematics')."""
         theta = self.theta(t)
-        g = np.zeros((len(self.rows0), self.n_columns))
-        g[:, :self.n_frames] = self.turned(self.rows0, theta)
-        return g, g[:, :self.n_frames] @ self.reference(theta) + self.spin_sum * theta
+        g = self.turned(self.rows0, theta)
+        return g, g @ self.reference(theta) + self.spin_sum * theta
 
     def __call__(self, mbs, t: float) -> bool:
         g, offset = self.matrix_and_offset(t)

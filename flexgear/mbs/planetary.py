@@ -103,6 +103,24 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
                              contacts=contacts, superelement=superelements, **kw)
 
     turning, joints, linear_gears, body_axes = [], {}, [], []
+
+    def join(lead: Body, other: Body, found: list[FixedJointElement], spin: float, label: str) -> None:
+        """The fixed joints ``found`` of ``lead`` and ``other`` (their common spin per drive angle ``spin``):
+        Exudyn's generic joints in the reference formulation, else linear joints (flexgear.mbs.joints, in body
+        axes where ``other`` is flexible) whose turning blocks join the others; recorded under ``lead``."""
+        labels = [label + (f"_{k}" if k else "") for k in range(len(found))]
+        if reference:
+            joints[lead.name] = [(add_interface_joint(mbs, lead, other, j, name), np.array(j.point))
+                                 for j, name in zip(found, labels, strict=True)]
+            return
+        axes = joint_axes(other)
+        made = [LinearInterfaceJoint(mbs, lead, other, j, spin, name, axes=axes)
+                for j, name in zip(found, labels, strict=True)]
+        turning.extend(e for j in made for e in j.turning())
+        joints[lead.name] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
+        linear_gears.append(lead.name)
+        if axes == "body":
+            body_axes.append(lead.name)
     if form["sun"] == "rigid" and form["input_shaft"] == "rigid":
         sun = add_rigid_body(mbs, "sun", combine_mass_properties(props(spec, "sun"), props(spec, "input_shaft")),
                              np.zeros(3))
@@ -113,18 +131,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         input_end = component("input_shaft", "input_shaft", np.zeros(3), th.input_speed,
                               joints={j.other_interface: j.point for j in found}, support=supports["input_shaft"])
         shafts = [input_end]
-        labels = ["joint_sun_input_shaft" + (f"_{k}" if k else "") for k in range(len(found))]
-        if reference:
-            joints["sun"] = [(add_interface_joint(mbs, sun, input_end, j, label), np.array(j.point))
-                             for j, label in zip(found, labels, strict=True)]
-        else:
-            made = [LinearInterfaceJoint(mbs, sun, input_end, j, 1.0, label, axes=joint_axes(input_end))
-                    for j, label in zip(found, labels, strict=True)]
-            turning += [e for j in made for e in j.turning()]
-            joints["sun"] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
-            linear_gears.append("sun")
-            if joint_axes(input_end) == "body":
-                body_axes.append("sun")
+        join(sun, input_end, found, 1.0, "joint_sun_input_shaft")
     ring_joints = [FixedJointElement("ring", gi, "housing", si, p) for gi, si, p in gear_shaft_joints(d, "ring")]
     ring = component("ring", "ring", np.zeros(3), 0.0, joints={j.interface: j.point for j in ring_joints})
     if form["output_shaft"] == "rigid":  # one rigid body with the carrier
@@ -138,14 +145,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
                                joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
         shafts.append(output_end)
-        if reference:
-            joints["output_shaft"] = [(add_interface_joint(mbs, output_end, carrier, joint,
-                                                           "joint_output_shaft_carrier"), point)]
-        else:
-            made = LinearInterfaceJoint(mbs, output_end, carrier, joint, ratio, "joint_output_shaft_carrier")
-            turning += made.turning()
-            joints["output_shaft"] = [(made.obj, point)]
-            linear_gears.append("output_shaft")
+        join(output_end, carrier, [joint], ratio, "joint_output_shaft_carrier")
     planets = []
     for i, psi in enumerate(geo.planet_angles):
         pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -154,16 +154,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     if ring.flexible:  # held at its bolts' clamped discs by the housing
         housing = add_rigid_body(mbs, "housing", props(spec, "ring"), np.zeros(3))
         add_fixed_joint(mbs, housing, name="housing_ground")
-        labels = ["joint_ring_housing" + (f"_{k}" if k else "") for k in range(len(ring_joints))]
-        if reference:
-            joints["ring"] = [(add_interface_joint(mbs, ring, housing, j, label), np.array(j.point))
-                              for j, label in zip(ring_joints, labels, strict=True)]
-        else:
-            made = [LinearInterfaceJoint(mbs, ring, housing, j, 0.0, label)
-                    for j, label in zip(ring_joints, labels, strict=True)]
-            turning += [e for j in made for e in j.turning()]
-            joints["ring"] = [(j.obj, np.array(e.point)) for j, e in zip(made, ring_joints, strict=True)]
-            linear_gears.append("ring")
+        join(ring, housing, ring_joints, 0.0, "joint_ring_housing")
     else:
         add_fixed_joint(mbs, ring, name="ring_housing")
     seat_nodes = {}
@@ -178,16 +169,11 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         else:
             add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
                                                                                  other="carrier"))
-    if input_end.flexible and not reference:
-        seat = LinearSeat(mbs, input_end, supports["input_shaft"].on(input_end.name), 1.0)
-        turning += seat.turning()
-    else:
-        add_support(mbs, input_end, supports["input_shaft"].on(input_end.name))
-    if output_end.flexible and not reference:
-        seat = LinearSeat(mbs, output_end, supports["output_shaft"].on(output_end.name), ratio)
-        turning += seat.turning()
-    else:
-        add_support(mbs, output_end, supports["output_shaft"].on(output_end.name))
+    for end, key, spin in ((input_end, "input_shaft", 1.0), (output_end, "output_shaft", ratio)):  # shafts' seats
+        if end.flexible and not reference:
+            turning += LinearSeat(mbs, end, supports[key].on(end.name), spin).turning()
+        else:
+            add_support(mbs, end, supports[key].on(end.name))
     extra = []
     if turning:
         extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
