@@ -7,7 +7,7 @@ from __future__ import annotations
 import math
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
@@ -215,8 +215,6 @@ truncation at the harmonics asked would distort the highest of them."""
 def _response(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """(X (H, n), P (H, n_c), F_0 C_h (n_c, H), omegas (H,) [rad/s]) at one speed, harmonics 1..``harmonics``
     (:func:`_coupled` over :data:`HILL_HARMONICS_FACTOR` times as many)."""
-    import dataclasses
-
     total = HILL_HARMONICS_FACTOR * harmonics
     coef = np.zeros((op.coef.shape[0], total), complex)
     coef[:, :min(harmonics, op.coef.shape[1])] = op.coef[:, :harmonics]
@@ -224,7 +222,7 @@ def _response(op: Operating, harmonics: int) -> tuple[np.ndarray, np.ndarray, np
     if op.friction is not None:
         friction = np.zeros((op.friction.shape[0], total), complex)
         friction[:, :min(harmonics, op.friction.shape[1])] = op.friction[:, :harmonics]
-    x, p, excite, w = _coupled(dataclasses.replace(op, coef=coef, friction=friction), total)
+    x, p, excite, w = _coupled(replace(op, coef=coef, friction=friction), total)
     return x[:harmonics], p[:harmonics], excite[:, :harmonics], w[:harmonics]
 
 
