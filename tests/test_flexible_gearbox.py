@@ -123,3 +123,22 @@ def test_rigid_twins_read_the_cached_bodies_mass_properties():
     assert np.abs(planet.props.inertia - whole.inertia).max() <= 1e-12 * np.abs(whole.inertia).max()
 
 
+
+
+def test_a_rigid_twin_without_its_body_takes_the_fe_meshs_mass_properties(tmp_path, monkeypatch):
+    """Without a cached reduced body a rigid component's mass properties come from its FE model's mass matrix
+    alone (no reduction is run, no body file written): the very numbers the body carries once it is built, and
+    within the mesh's geometric error (1e-3) of the exact section integrals."""
+    from flexgear.fe.reduced import component_mass_properties, component_reduced_body, reduced_cache_path
+    from flexgear.geometry.layout import exact_mass_properties
+
+    monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path))
+    g = load_variant(VARIANTS / "model1.toml").gearbox
+    alone = component_mass_properties(g, "input_shaft", "coarse")
+    assert not list(tmp_path.glob(reduced_cache_path("*").name)) and list(tmp_path.glob("massprops-mesh-*.npz"))
+    assert alone.mass == pytest.approx(exact_mass_properties(g, "input_shaft").mass, rel=1e-3)
+    whole = component_reduced_body(g, "input_shaft", "coarse").props
+    assert alone.mass == pytest.approx(whole.mass, rel=1e-12)
+    assert np.abs(alone.com - whole.com).max() < 1e-12
+    assert np.abs(alone.inertia - whole.inertia).max() <= 1e-12 * np.abs(whole.inertia).max()
+    assert component_mass_properties(g, "input_shaft", "coarse").mass == whole.mass  # the body's, once built

@@ -30,7 +30,8 @@ import scipy.sparse.linalg as sla
 from flexgear.geometry.massprops import MassProperties
 from flexgear.spec import Material
 
-__all__ = ["FEModel", "fe_model", "rigid_body_modes", "lame_parameters", "surface_faces", "kron3_operator"]
+__all__ = ["FEModel", "fe_model", "mesh_mass_properties", "rigid_body_modes", "lame_parameters", "surface_faces",
+           "kron3_operator"]
 
 
 def lame_parameters(material: Material) -> tuple[float, float]:
@@ -86,12 +87,7 @@ class FEModel:
 
         m = 1^T M_s 1, m c = X^T M_s 1, Q = X^T M_s X - m c c^T, J_c = tr(Q) I - Q.
         """
-        x = self.nodes
-        ms1 = self.mass_scalar @ np.ones(self.n_nodes)
-        mass = float(ms1.sum())
-        com = x.T @ ms1 / mass
-        q = x.T @ (self.mass_scalar @ x) - mass * np.outer(com, com)
-        return MassProperties(mass, com, np.trace(q) * np.eye(3) - q)
+        return _mass_properties(self.nodes, self.mass_scalar)
 
     def region(self, name: str) -> np.ndarray:
         """Node indices of the named boundary region (KeyError lists the names there are)."""
@@ -148,14 +144,8 @@ def _to_scipy(mat, n: int, position: np.ndarray | None = None) -> sp.csr_matrix:
     return out
 
 
-def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None = None) -> FEModel:
-    """Assemble the FE model of ``mesh`` (ngsolve.Mesh or netgen mesh) with nodal elements of ``order``: a
-    first-order mesh is raised to second order (edge nodes on its geometry's surfaces), a mesh of second-order
-    elements (flexgear.fe.mesh_io.netgen_mesh of an imported file) is taken with its edge nodes as they are.
-
-    ``regions``: boundary names to turn into node sets (default: every named boundary except
-    "default"). Raises ValueError for an order other than 1 or 2.
-    """
+def _nodal_space(mesh, order: int):
+    """(netgen mesh of ``order``, ngsolve.Mesh, scalar nodal space) of ``mesh`` as :func:`fe_model` takes it."""
     import ngsolve as ngs
 
     if order not in (1, 2):
@@ -166,9 +156,52 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
         ngmesh.SecondOrder()
     m = ngs.Mesh(ngmesh)
     scalar = ngs.NodalFESpace(m, order=order)
+    if scalar.ndof != len(ngmesh.Points()):
+        raise RuntimeError(f"fe_model: {scalar.ndof} nodal dofs but {len(ngmesh.Points())} mesh points")
+    return ngmesh, m, scalar
+
+
+def _mass_scalar(scalar, material: Material) -> sp.csr_matrix:
+    """The scalar consistent mass matrix M_s = int rho N^T N dV [kg] on the nodal space ``scalar``."""
+    import ngsolve as ngs
+
+    us, vs = scalar.TnT()
+    m_form = ngs.BilinearForm(scalar, symmetric=False)
+    m_form += material.density_kg_m3 * us * vs * ngs.dx
+    with ngs.TaskManager():
+        m_form.Assemble()
+    return _to_scipy(m_form.mat, scalar.ndof)
+
+
+def mesh_mass_properties(mesh, material: Material, order: int = 2) -> MassProperties:
+    """Mass properties of the FE model :func:`fe_model` would assemble on ``mesh`` (:meth:`FEModel.mass_properties`,
+    the same numbers), from its mass matrix alone: what a rigid twin of a flexible body needs, without K."""
+    ngmesh, _, scalar = _nodal_space(mesh, order)
+    return _mass_properties(np.array(ngmesh.Coordinates(), float), _mass_scalar(scalar, material))
+
+
+def _mass_properties(x: np.ndarray, mass_scalar: sp.csr_matrix) -> MassProperties:
+    """Mass, centre of mass and inertia about it of nodes ``x`` (n, 3) [m] with scalar mass matrix [kg]:
+    m = 1^T M_s 1, m c = X^T M_s 1, Q = X^T M_s X - m c c^T, J_c = tr(Q) I - Q."""
+    ms1 = mass_scalar @ np.ones(len(x))
+    mass = float(ms1.sum())
+    com = x.T @ ms1 / mass
+    q = x.T @ (mass_scalar @ x) - mass * np.outer(com, com)
+    return MassProperties(mass, com, np.trace(q) * np.eye(3) - q)
+
+
+def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None = None) -> FEModel:
+    """Assemble the FE model of ``mesh`` (ngsolve.Mesh or netgen mesh) with nodal elements of ``order``: a
+    first-order mesh is raised to second order (edge nodes on its geometry's surfaces), a mesh of second-order
+    elements (flexgear.fe.mesh_io.netgen_mesh of an imported file) is taken with its edge nodes as they are.
+
+    ``regions``: boundary names to turn into node sets (default: every named boundary except
+    "default"). Raises ValueError for an order other than 1 or 2.
+    """
+    import ngsolve as ngs
+
+    ngmesh, m, scalar = _nodal_space(mesh, order)
     n = scalar.ndof
-    if n != len(ngmesh.Points()):
-        raise RuntimeError(f"fe_model: {n} nodal dofs but {len(ngmesh.Points())} mesh points")
     vector = scalar**3
     mu, lam = lame_parameters(material)
     u, v = vector.TnT()
@@ -176,20 +209,15 @@ def fe_model(mesh, material: Material, order: int = 2, regions: list[str] | None
     k_form = ngs.BilinearForm(vector, symmetric=False)
     k_form += (2.0 * mu * ngs.InnerProduct(eps_u, eps_v) + lam * ngs.Trace(eps_u) * ngs.Trace(eps_v)) * ngs.dx
     us, vs = scalar.TnT()
-    m_form = ngs.BilinearForm(scalar, symmetric=False)
-    m_form += material.density_kg_m3 * us * vs * ngs.dx
     with ngs.TaskManager():
         k_form.Assemble()
-        m_form.Assemble()
     block = np.arange(3 * n)  # NGSolve order: all x, all y, all z -> interleaved position 3 i + c
     k_inter = _to_scipy(k_form.mat, 3 * n, 3 * (block % n) + block // n)
     del k_form
     k_inter = (k_inter + k_inter.T).tocsr()  # remove round-off asymmetry: (K + K^T) / 2, halved in place
     k_inter.data *= 0.5
-    mass_scalar = _to_scipy(m_form.mat, n)
-    del m_form
-
-    # node coordinates: NGSolve's point order equals the nodal dof order (checked above: same count)
+    mass_scalar = _mass_scalar(scalar, material)
+    # node coordinates: NGSolve's point order equals the nodal dof order (checked: same count)
     nodes = np.array(ngmesh.Coordinates(), float)
 
     names = [b for b in dict.fromkeys(m.GetBoundaries()) if b != "default"] if regions is None else regions

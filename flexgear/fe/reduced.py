@@ -282,11 +282,41 @@ def component_reduced_body(spec: GearboxSpec | Design, component: str, level: st
 
 def component_mass_properties(spec: GearboxSpec | Design, component: str, level: str = "coarse",
                               progress: bool = False) -> MassProperties:
-    """The mass properties of :func:`component_reduced_body` (those of its FE mesh), read alone from the cache
-    when the body is there (a rigid twin needs no modes), else from the body built and cached."""
+    """The mass properties of :func:`component_reduced_body` (those of its FE mesh), which a rigid twin needs
+    without modes: read alone from the cache when the body is there (a damaged body file is named and rebuilt),
+    else those of the FE model's mass matrix alone (flexgear.fe.fem.mesh_mass_properties: the numbers the body
+    will carry, without its reduction), cached beside it."""
     key, build = _component_reduction(spec, component, level, progress)
-    props = read_cached(key, _load_mass_properties)
-    return props if props is not None else cached_reduced_body(key, build).props
+    if reduced_cache_path(key).exists():
+        props = read_cached(key, _load_mass_properties)
+        return props if props is not None else cached_reduced_body(key, build).props
+    return _mesh_mass_properties(as_design(spec), component, level, key, progress)
+
+
+def _mesh_mass_properties(d: Design, component: str, level: str, key: str, progress: bool) -> MassProperties:
+    """:func:`component_mass_properties` of a component whose body is not built: its FE mesh's, cached as
+    ``massprops-mesh-<body key>.npz``."""
+    from flexgear.fe.fem import mesh_mass_properties
+    from flexgear.fe.mesh import component_mesh
+
+    path = cache_dir() / f"massprops-mesh-{key}.npz"
+
+    def load() -> MassProperties | None:
+        return read_entry(path, _load_mass_properties) if path.exists() else None
+
+    def build() -> MassProperties:
+        import io
+
+        name = COMPONENT_GEOMETRY[component]
+        mesh = component_mesh(d, name, level, order=1, progress=progress)
+        props = mesh_mass_properties(mesh.ngsolve_mesh(), d.spec.material_assumed,
+                                     d.spec.meshing_assumed[level].element_order)
+        buf = io.BytesIO()
+        np.savez(buf, mass=props.mass, com=props.com, inertia=props.inertia)
+        atomic_write_bytes(path, buf.getvalue())
+        return props
+
+    return load_or_build(path, load, build)
 
 
 def cached_component_frequencies(spec: GearboxSpec | Design, component: str,
