@@ -199,15 +199,15 @@ def pytest_addoption(parser):
 def _prebuild(spec, task: str) -> None:
     """Build (or find cached) one entry of :data:`PREBUILD_CHAINS`; a cached body is not loaded."""
     from flexgear.fe.mesh import component_mesh
-    from flexgear.fe.reduced import component_mass_properties
+    from flexgear.fe.reduced import cached_component_frequencies, component_reduced_body
     from flexgear.fe.ring_shaft import tied_pair_mass_properties
 
     if task == "tied":  # the tied build's FE models are coarse_fe's
         tied_pair_mass_properties(spec, "coarse", fe_source=_coarse_fe_model)
     elif task.startswith("mesh:"):
         component_mesh(spec, task.removeprefix("mesh:"), "coarse")
-    else:
-        component_mass_properties(spec, task, "coarse")
+    elif cached_component_frequencies(spec, task, "coarse") is None:
+        component_reduced_body(spec, task, "coarse")
 
 
 @pytest.fixture(scope="session", autouse=True)
