@@ -27,7 +27,6 @@ TEST_WORKERS ?= 2
 .PHONY: quick install venv test test-heavy lint meshes matrix readings report lpm bench api-docs clean distclean
 
 quick: install
-	$(PY) -m flexgear.cli meshes model_variants/quick/model7.toml --level coarse
 	$(PY) -m flexgear.cli matrix $(QUICK_VARIANTS) $(QUICK_ISO_VARIANTS) --out '$(RESULTS)/{folder}' --reference model7 \
 		--speeds-rpm $(SPEEDS_RPM)
 	$(PY) -m flexgear.cli lpm model_variants/quick/model1.toml --out $(RESULTS)/quick

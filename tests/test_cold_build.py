@@ -78,3 +78,25 @@ def test_cholesky_solves_a_block_of_columns_in_one_call():
     block = chol.solve(loads)
     for j in range(loads.shape[1]):
         np.testing.assert_allclose(block[:, j], chol.solve(loads[:, j]), rtol=0, atol=1e-12 * np.abs(block).max())
+
+
+def test_a_cold_matrix_builds_the_longest_body_first_and_runs_what_needs_it_last(tmp_path, monkeypatch):
+    """With an empty cache the matrix pool gets every body its runs need as a job ahead of the runs, the tied ring
+    and output shaft first (the longest build), and only the runs that need that body wait at the end: model 7's;
+    model 1 (rigid) needs no body, model 4 the sun's and the ring's alone."""
+    from conftest import VARIANTS
+
+    from flexgear.fe.build import variant_build_items
+    from flexgear.fe.ring_shaft import TIED_PAIR
+    from flexgear.spec import load_variant
+    from flexgear.study.matrix import _cold_build
+
+    monkeypatch.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path))
+    variants = {name: load_variant(VARIANTS / "quick" / f"{name}.toml") for name in ("model1", "model4", "model7")}
+    items = {name: variant_build_items(v.gearbox, v.components) for name, v in variants.items()}
+    assert items == {"model1": (), "model4": ("sun", "ring"),
+                     "model7": ("input_shaft", "sun", "planet", TIED_PAIR)}
+    jobs, waits = _cold_build(variants)
+    built = [args[1] for _, _, args in jobs]
+    assert built[0] == TIED_PAIR and sorted(built) == sorted({*items["model4"], *items["model7"]})
+    assert waits == {"model7"}

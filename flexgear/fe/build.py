@@ -20,9 +20,10 @@ from dataclasses import dataclass
 
 from flexgear.fe.ring_shaft import PAIR, TIED_PAIR
 from flexgear.heap import lean_heap
-from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.spec import COMPONENT_GEOMETRY, GEOMETRY_COMPONENTS, GearboxSpec
 
-__all__ = ["ComponentSummary", "build_components", "build_items", "COLD_BUILD_ORDER"]
+__all__ = ["ComponentSummary", "build_components", "build_items", "COLD_BUILD_ORDER", "variant_build_items",
+           "build_key", "is_built", "build_body"]
 
 COLD_BUILD_ORDER = (TIED_PAIR, "planet", "sun", "input_shaft", "output_shaft", "ring")
 """Tasks in the order they start (coarse level, benchmarks/RESULTS.md): the tied ring and output shaft, the
@@ -37,6 +38,32 @@ def build_items(reduce: bool = True, arrangement: str = "star") -> tuple[str, ..
     return (*GEOMETRY_COMPONENTS, *((TIED_PAIR,) if reduce and arrangement == "star" else ()))
 
 
+def variant_build_items(spec: GearboxSpec, components: dict[str, str]) -> tuple[str, ...]:
+    """The tasks of :func:`build_component` whose bodies a variant with Table 3 ``components`` (component -> "rigid"
+    | "flexible") uses: each flexible component's geometry, and in the star arrangement the tied ring and output
+    shaft in place of the two when both are flexible (as flexgear.mbs.gearbox builds them)."""
+    flexible = [COMPONENT_GEOMETRY[c] for c, form in components.items() if form == "flexible"]
+    if spec.gears.arrangement == "star" and set(PAIR) <= set(flexible):
+        return (*(g for g in flexible if g not in PAIR), TIED_PAIR)
+    return tuple(flexible)
+
+
+def build_key(spec: GearboxSpec, item: str, level: str) -> str:
+    """The cache key of the reduced body of build task ``item`` (a geometry or
+    :data:`~flexgear.fe.ring_shaft.TIED_PAIR`) at mesh ``level``."""
+    from flexgear.fe.reduced import component_cache_key
+    from flexgear.fe.ring_shaft import tied_pair_key
+
+    return tied_pair_key(spec, level) if item == TIED_PAIR else component_cache_key(spec, item, level)
+
+
+def is_built(spec: GearboxSpec, item: str, level: str) -> bool:
+    """Whether the reduced body of build task ``item`` is in the cache (its file is there; nothing is read)."""
+    from flexgear.fe.reduced import reduced_cache_path
+
+    return reduced_cache_path(build_key(spec, item, level)).exists()
+
+
 @dataclass(frozen=True)
 class ComponentSummary:
     """What a worker reports of one component: its mesh and, if reduced, its flexible modes."""
@@ -46,6 +73,16 @@ class ComponentSummary:
     element_order: int
     n_modes: int | None = None
     first_frequency_hz: float | None = None
+
+
+def build_body(spec: GearboxSpec, item: str, level: str) -> int:
+    """Build (or find in the cache) the reduced body of build task ``item`` at mesh ``level`` alone (not the meshes
+    of :func:`build_component`); returns its mode count (a worker process sends nothing larger back)."""
+    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.fe.ring_shaft import tied_pair_body
+
+    body = tied_pair_body(spec, level) if item == TIED_PAIR else component_reduced_body(spec, item, level)
+    return body.n_modes
 
 
 def build_component(spec: GearboxSpec, component: str, level: str, reduce: bool = True) -> ComponentSummary:

@@ -45,7 +45,8 @@ from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
 
 __all__ = ["contact_band_selector", "contact_fit_window", "component_interfaces", "component_load_circles",
            "component_contacts", "component_reduced_body",
-           "component_mass_properties", "cached_component_frequencies", "COMPONENT_GEOMETRY", "joint_point",
+           "component_mass_properties", "cached_component_frequencies", "component_cache_key", "COMPONENT_GEOMETRY",
+           "joint_point",
            "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles",
            "read_cached"]
 
@@ -317,6 +318,11 @@ def _mesh_mass_properties(d: Design, component: str, level: str, key: str, progr
         return props
 
     return load_or_build(path, load, build)
+
+
+def component_cache_key(spec: GearboxSpec | Design, component: str, level: str = "coarse") -> str:
+    """The cache key of :func:`component_reduced_body` (flexgear.fe.reduced.reduced_cache_path names its file)."""
+    return _component_reduction(spec, component, level, False)[0]
 
 
 def cached_component_frequencies(spec: GearboxSpec | Design, component: str,

@@ -49,7 +49,7 @@ from flexgear.progress import say
 from flexgear.spec import GearboxSpec
 
 __all__ = ["PAIR", "TIED_PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
-           "tied_pair_body", "tied_pair_mass_properties", "reduced_body", "tied_part_matrices"]
+           "tied_pair_body", "tied_pair_key", "tied_pair_mass_properties", "reduced_body", "tied_part_matrices"]
 
 PAIR = ("ring", "output_shaft")
 """The bolted pair's parts, in the order of the tied model (the ring first: its nodes keep their indices)."""
@@ -95,6 +95,11 @@ def tied_pair_interfaces(tied: TiedFE, shaft: FEModel, spec: GearboxSpec) -> lis
     indices mapped into the tied model."""
     seat = next(i for i in component_interfaces(shaft, spec, "output_shaft") if i.name == "bearing_seat")
     return [tied.interface("output_shaft", seat)]
+
+
+def tied_pair_key(spec: GearboxSpec, level: str = "coarse") -> str:
+    """The cache key of :func:`tied_pair_body` (flexgear.fe.reduced.reduced_cache_path names its file)."""
+    return _tied_key(spec, level)
 
 
 def _tied_key(spec: GearboxSpec, level: str) -> str:

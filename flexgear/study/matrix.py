@@ -189,6 +189,28 @@ def _run_order(variants: dict[Any, Variant]) -> list[Any]:
     return sorted(variants, key=lambda name: -costs[name])
 
 
+def _cold_build(variants: dict[Any, Variant]) -> tuple[list[tuple[Any, Callable, tuple]], set[Any]]:
+    """The bodies the ``variants``' runs need that are not in the cache, as pool jobs submitted before the runs, the
+    longest first (flexgear.fe.build.COLD_BUILD_ORDER: the tied ring and output shaft of the star's all-flexible
+    variants), and the keys of the runs that need the longest, which go last: one worker builds that body while the
+    others build the rest and run the variants that do not need it, instead of workers waiting for one body.
+    ([], set()) when every body is there."""
+    from flexgear.fe.build import COLD_BUILD_ORDER, build_body, build_key, variant_build_items
+    from flexgear.fe.reduced import reduced_cache_path
+
+    rank = {item: k for k, item in enumerate(COLD_BUILD_ORDER)}
+    cold: dict[str, tuple[str, Variant, set[Any]]] = {}  # body key -> (item, a variant that needs it, run keys)
+    for key, v in variants.items():
+        for item in variant_build_items(v.gearbox, v.components):
+            body = build_key(v.gearbox, item, v.mesh_level)
+            if not reduced_cache_path(body).exists():
+                cold.setdefault(body, (item, v, set()))[2].add(key)
+    entries = sorted(cold.values(), key=lambda entry: rank.get(entry[0], len(rank)))
+    jobs = [(("build", item, v.mesh_level, k), build_body, (v.gearbox, item, v.mesh_level))
+            for k, (item, v, _) in enumerate(entries)]
+    return jobs, (entries[0][2] if entries else set())
+
+
 @dataclasses.dataclass
 class _Folder:
     """One results folder of a matrix: its variants, the runs to do and the ones kept."""
@@ -310,10 +332,11 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     folders = [_prepare(Path(d), paths, t_end_s, time_budget_s, reference, progress)
                for d, paths in _folders(variant_paths, out_dir).items()]
     pending = {(str(f.out_dir), name): v for f in folders for name, v in f.pending.items()}
+    first, waits = _cold_build(pending) if runner is None and scheduler is None and workers > 1 else ([], set())
     order = {key: k for k, key in enumerate(_run_order(pending))}
-    tasks = sorted((t for f in folders for t in f.tasks), key=lambda t: order[t.key])
+    tasks = sorted((t for f in folders for t in f.tasks), key=lambda t: (t.key in waits, order[t.key]))
     jobs = [j for f in folders for j in _jobs(f, speeds_rpm, modal and runner is None)] if runner is None else []
-    metas, done = execute(tasks, workers, scheduler, runner, progress, jobs)
+    metas, done = execute(tasks, workers, scheduler, runner, progress, jobs, first)
     tables = [_finish(f, metas, done, progress, reference) for f in folders]
     if len(tables) == 1:
         return tables[0]

@@ -190,14 +190,16 @@ def say_progress(progress: bool, text: str) -> None:
 
 
 def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, progress: bool, bar: Progress,
-              jobs: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, list[RunTask], dict]:
-    """Submit the runs, then the ``jobs`` (key, function, arguments): work that needs no run (the modal and speed
-    screenings), taken by a worker when the runs leave one free. Each run's result is saved in its folder as it
-    arrives. Returns the runs' metas by :attr:`RunTask.key`, the runs whose worker died, the jobs' results by key
-    (an exception raised by a job is its result)."""
+              jobs: Sequence[tuple[Any, Callable, tuple]] = (),
+              first: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, list[RunTask], dict]:
+    """Submit the ``first`` jobs (key, function, arguments: a cold body that runs wait for), the runs, then the
+    ``jobs``: work that needs no run (the modal and speed screenings), taken by a worker when the runs leave one
+    free. Each run's result is saved in its folder as it arrives. Returns the runs' metas by :attr:`RunTask.key`,
+    the runs whose worker died, the jobs' results by key (an exception raised by a job is its result)."""
     several = len({t.out_dir for t in tasks}) > 1
+    side = {submit(fn, *args): key for key, fn, args in first}
     futures = {submit(run_task, t, runner): t for t in tasks}
-    side = {submit(fn, *args): key for key, fn, args in jobs}
+    side.update({submit(fn, *args): key for key, fn, args in jobs})
     started = last_beat = time.perf_counter()
     metas: dict[tuple[str, str], dict] = {}
     done: dict[Any, Any] = {}
@@ -241,9 +243,10 @@ def _label(task: RunTask, several: bool) -> str:
 
 
 def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: Runner | None,
-             progress: bool, jobs: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, dict]:
-    """Run ``tasks`` and ``jobs`` in one pool (module docstring); returns the runs' metas by key and the jobs'
-    results by key."""
+            progress: bool, jobs: Sequence[tuple[Any, Callable, tuple]] = (),
+            first: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, dict]:
+    """Run ``first`` (local pools only), ``tasks`` and ``jobs`` in one pool (module docstring, :func:`_run_pool`);
+    returns the runs' metas by key and the jobs' results by key."""
     if not tasks and not jobs:
         return {}, {}
     # on a terminal a bar; in a log the per-run lines of _say are the progress
@@ -264,7 +267,7 @@ def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: R
              + f" on {workers} local worker process(es)")
         ctx = get_context("spawn")
         with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
-            metas, died, done = _run_pool(tasks, pool.submit, runner, progress, bar, jobs)
+            metas, died, done = _run_pool(tasks, pool.submit, runner, progress, bar, jobs, first)
         # A dead worker breaks the whole pool: rerun each affected task alone to find the culprit.
         retry, died = died, []
         for task in retry:
