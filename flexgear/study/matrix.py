@@ -7,7 +7,9 @@ variant from that content, builds (or finds in its own cache, ``FLEXGEAR_CACHE_D
 meshes and reduced bodies, runs it and sends the :class:`~flexgear.results.RunResult` back; the caller
 writes it with :func:`flexgear.results.save_result` under ``out_dir/<variant name>/`` together with
 copies of its input files (``inputs/``), as each run finishes (flexgear.study.pool). The runs with the most
-flexible bodies start first (the longest first, so that the last ones overlap); the screenings that need no run
+flexible bodies start first (the longest first, so that the last ones overlap); on a local pool with a cold cache
+the bodies the runs need are built first, as jobs of the same pool, the longest alone on one worker while the
+others build the rest and run the variants that do not need it (those that do go last); the screenings that need no run
 (the modal screening of an all-flexible reference, the speed screening) take a worker the runs leave free. One
 pool may serve several results folders (``out_dir`` with ``{folder}``: each variant file's folder name), the
 longest runs of all of them first. Then it writes, per folder,
