@@ -4,7 +4,8 @@ The public API (``__all__``) builds any gearbox in a few lines: gear geometry (`
 bodies (``add_rigid_body``, ``add_flexible_body`` from a mesh via ``fe_model`` and ``reduce``; parts bolted or
 bonded together tied into one body first, ``reduce([fe_a, fe_b], ..., ties=[Tie(...)])``; any gear as a toothed
 body built as the study's gears, ``GearBody`` -> ``toothed_body`` (flexible, its high modes as residual
-compliance through ``dropped_modes``) or ``toothed_mass_properties`` (rigid)), bearings
+compliance through ``dropped_modes``) or ``toothed_mass_properties`` (rigid); a planetary stage's carrier,
+``carrier_sizes`` -> ``carrier_body`` or ``carrier_mass_properties``), bearings
 (``BearingElement``: a 6x6 stiffness and damping about a point on an axis, on a body frame or an interface,
 ``add_planet_bearing``), fixed joints (``FixedJointElement``, ``add_fixed_joint``, ``add_interface_joint``), gear
 contacts for external and internal meshes (``pair_contacts``, assembled by ``add_gear_train``, optionally
@@ -41,6 +42,9 @@ _LAZY = {
     "GearBody": "geometry.gear_body", "Engagement": "geometry.gear_body",
     "toothed_body": "fe.toothed", "toothed_mass_properties": "fe.toothed", "toothed_fe_model": "fe.toothed",
     "toothed_contacts": "fe.toothed", "toothed_load_circles": "fe.toothed",
+    # a planetary stage's carrier: its sizes, solid, exact mass properties, FE model and reduced body
+    "CarrierSizes": "geometry.carrier", "carrier_sizes": "geometry.carrier", "carrier_solid": "geometry.carrier",
+    "carrier_mass_properties": "geometry.carrier", "carrier_fe_model": "fe.carrier", "carrier_body": "fe.carrier",
     # laws
     "ContactLaw": "laws.contact", "drive_angle": "laws.ramps",
     # multibody: bodies, elements, contacts

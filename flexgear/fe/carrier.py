@@ -1,0 +1,109 @@
+"""The planet carrier as an FE model and a reduced flexible body (flexgear.geometry.carrier).
+
+The carrier's solid is meshed by Netgen at a mesh level of ``[meshing_assumed]``: the level's body size, its tooth
+size on the pin bores (where the planets' bearing loads enter). Named faces become the FE model's regions:
+
+- ``pin_<k>``: the two pin bores of planet k (one in each plate), the interface where the planet's pin, and through
+  it the planet's bearing, acts: RBE3, its point the pin's centre on the mid-plane;
+- ``seat``: the output-side plate's bore, on the output shaft: a rigid interface (the shaft's spline holds it).
+
+The reduced body is the Craig-Bampton reduction of flexgear.fe.cms with those interfaces and every fixed-interface
+mode below :data:`CUTOFF_FACTOR` times the gearbox's ``[reduction_assumed] fixed_interface_cutoff_hz``, cached by its
+inputs' hash.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from flexgear.fe.cms import ReducedBody, interface, reduce
+from flexgear.fe.fem import FEModel, fe_model
+from flexgear.fe.reduced import cached_reduced_body
+from flexgear.geometry.carrier import CarrierSizes, carrier_sizes, carrier_solid
+from flexgear.progress import say
+from flexgear.spec import GearboxSpec, spec_hash
+
+__all__ = ["carrier_fe_model", "carrier_body", "carrier_interfaces", "SEAT", "CUTOFF_FACTOR"]
+
+CUTOFF_FACTOR = 3.0
+"""The carrier's fixed-interface modes reach this multiple of the gearbox's cutoff (3.5 mesh orders). The gears carry
+attachment modes of their contact loads; the carrier has none, and its pins' static modes alone leave its modes
+in the band (3 mesh orders) up to 17 % stiff. The spur planetary example's carrier, seat held, modes to 3 mesh
+orders against full FE: cutoff x1 (no fixed-interface mode) 17 %, x2 (6) 1.05 %, x3 (15) 0.14 %, x4 (21) 0.11 %
+(benchmarks/RESULTS.md)."""
+SEAT = "seat"
+"""The carrier's interface on the output shaft."""
+_VERSION = 1
+"""Bump when the carrier's mesh or reduction changes without an input changing (enters the cache key)."""
+_FACE_TOL = 1e-6
+"""Distance [m] within which a face's centre lies on an axis or at a height."""
+
+
+def _named_solid(sizes: CarrierSizes, pin_size: float):
+    """The carrier's solid with its pin bores named ``pin_<k>`` (mesh size ``pin_size`` [m]) and the output-side
+    plate's bore named ``seat``."""
+    solid = carrier_solid(sizes)
+    half = sizes.gap / 2
+    pins = sizes.pin_centres()[:, :2]
+    for face in solid.faces:  # a full cylindrical face's centre lies on its axis
+        c = face.center
+        off = np.hypot(pins[:, 0] - c.x, pins[:, 1] - c.y)
+        k = int(np.argmin(off))
+        if off[k] < _FACE_TOL and abs(c.z) > half:
+            face.name, face.maxh = f"pin_{k}", pin_size
+        elif np.hypot(c.x, c.y) < _FACE_TOL and c.z > half and abs(_radius(face) - sizes.bore_radius) < _FACE_TOL:
+            face.name = SEAT
+    return solid
+
+
+def _radius(face) -> float:
+    """Radius [m] of a cylindrical face about the z axis: the largest distance of its vertices from it."""
+    return max(float(np.hypot(v.p.x, v.p.y)) for v in face.vertices)
+
+
+def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None) -> FEModel:
+    """The carrier's FE model (module docstring) at mesh ``level``, the level's element order; ``sizes`` default
+    :func:`flexgear.geometry.carrier.carrier_sizes`."""
+    import netgen.meshing as nm
+    from netgen.occ import OCCGeometry
+
+    sizes = sizes or carrier_sizes(spec)
+    settings = spec.meshing_assumed[level]
+    geo = OCCGeometry(_named_solid(sizes, settings.tooth_size_mm * 1e-3))
+    mp = nm.MeshingParameters(maxh=settings.body_size_mm * 1e-3, curvaturesafety=settings.elements_per_curvature_radius,
+                              segmentsperedge=0.0, optsteps2d=settings.optimisation_steps,
+                              optsteps3d=settings.optimisation_steps)
+    mesh = geo.GenerateMesh(mp=mp)
+    fe = fe_model(mesh, spec.material_assumed, settings.element_order)
+    missing = [f"pin_{k}" for k in range(sizes.planet_count) if f"pin_{k}" not in fe.regions] + (
+        [SEAT] if SEAT not in fe.regions else [])
+    if missing:
+        raise RuntimeError(f"carrier: the meshed solid lacks the faces {missing}")
+    return fe
+
+
+def carrier_interfaces(fe: FEModel, sizes: CarrierSizes) -> list:
+    """The seat and the pins' interfaces (module docstring), the pins' points their centres on the mid-plane."""
+    seat = interface(fe, SEAT)
+    pins = [interface(fe, f"pin_{k}") for k in range(sizes.planet_count)]
+    pins = [type(p)(p.name, p.nodes, p.weights, centre) for p, centre in zip(pins, sizes.pin_centres(), strict=True)]
+    return [seat, *pins]
+
+
+def carrier_body(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None,
+                 progress: bool = False, fe: FEModel | None = None) -> ReducedBody:
+    """The carrier's reduced flexible body (module docstring), cached; ``sizes`` default
+    :func:`flexgear.geometry.carrier.carrier_sizes`; ``fe``: its FE model when the body must be built, exactly as
+    :func:`carrier_fe_model` builds it for ``spec``, ``level`` and ``sizes`` (e.g. one the caller holds already)."""
+    sizes = sizes or carrier_sizes(spec)
+    red = spec.reduction_assumed
+    max_hz = CUTOFF_FACTOR * red.fixed_interface_cutoff_hz
+    key = spec_hash(sizes, spec.meshing_assumed[level], spec.material_assumed, max_hz, _VERSION)
+
+    def build() -> ReducedBody:
+        if progress:
+            say(f"  carrier ({level}): building the reduced body")
+        model = fe if fe is not None else carrier_fe_model(spec, level, sizes)
+        return reduce(model, carrier_interfaces(model, sizes), n_compare=0, rigid=(SEAT,), max_hz=max_hz)
+
+    return cached_reduced_body(f"carrier-{level}-{key}", build)
