@@ -28,8 +28,12 @@ With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`f
 - load case: step 1/24 of the mesh period (9.5 vs 10 us);
 - screening: settled-window blocks of z_ring / settle_final_blocks mesh cycles, rounded (17, as the study's);
   a fixed window from the ramps' end to the load case's end;
-- lumped model's carrier (turning in the planetary arrangement only): as heavy as its planets together (solid
-  discs over the root circle, the whole face width), its inertia that of a disc of radius a_w.
+- the carrier's mass and polar inertia (``[lumped_assumed]``: the lumped and the multibody model's rigid carrier,
+  turning in the planetary arrangement only): in the planetary arrangement those of the carrier's solid with its
+  default sizes (flexgear.geometry.carrier: two plates and the posts between the planets, exact section
+  integrals); where no posts fit between the planets, and in the star arrangement (the carrier held), as heavy as
+  its planets together (solid discs over the root circle, the whole face width), the inertia that of a disc of
+  radius a_w.
 """
 
 from __future__ import annotations
@@ -37,8 +41,9 @@ from __future__ import annotations
 import math
 from typing import Any
 
+from flexgear.geometry.carrier import carrier_mass_properties, carrier_sizes_of
 from flexgear.geometry.involute import gear_set_geometry_of
-from flexgear.schema import GearSet, GearSetAssumed, LoadCase, Material
+from flexgear.schema import ComponentsAssumed, GearSet, GearSetAssumed, LoadCase, Material
 from flexgear.spec import register_derived_defaults
 from flexgear.theory import mesh_frequency_hz
 
@@ -126,8 +131,15 @@ def _component_sizes(g: GearSet, a: GearSetAssumed, given: dict[str, Any]) -> di
     }
 
 
-def _carrier(g: GearSet, a: GearSetAssumed, material: Material) -> dict[str, float]:
-    """[lumped_assumed] carrier mass [kg] and inertia [kg m^2] (module docstring)."""
+def _carrier(g: GearSet, a: GearSetAssumed, material: Material, c: ComponentsAssumed) -> dict[str, float]:
+    """[lumped_assumed] carrier mass [kg] and polar inertia [kg m^2] (module docstring)."""
+    if g.arrangement == "planetary":
+        try:
+            props = carrier_mass_properties(carrier_sizes_of(g, a, c), material.density_kg_m3)
+        except ValueError:  # no room for posts between the planets: the estimate below
+            pass
+        else:
+            return {"carrier_mass_kg": props.mass, "carrier_inertia_kg_m2": float(props.inertia[2, 2])}
     df_planet = _root_diameters_mm(g, a)[1] * _MM
     width = a.face_width_m * (2 if a.helix_layout == "double" else 1)
     mass = g.planet_count * material.density_kg_m3 * math.pi * (df_planet / 2) ** 2 * width
@@ -166,7 +178,7 @@ def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -
                 "ring_body_size_mm": max(ring_tooth_mm, min(body_mm, rim)),
                 "elements_per_curvature_radius": curvature, "optimisation_steps": passes}
     if table == "lumped_assumed":
-        return _carrier(g, a, built["material_assumed"])
+        return _carrier(g, a, built["material_assumed"], built["components_assumed"])
     if table == "load_case":
         speed = given.get("input_speed_rpm")
         if not isinstance(speed, (int, float)) or isinstance(speed, bool) or not speed:

@@ -93,3 +93,20 @@ def test_sizes_without_posts_are_refused_in_one_line():
     assert "\n" not in str(err.value)
     with pytest.raises(ValueError, match="unknown sizes"):
         carrier_sizes(gearbox, plate_diameter=0.1)
+
+
+def test_the_planetary_stages_rigid_carrier_carries_the_solids_mass_properties(tmp_path):
+    """The derived ``[lumped_assumed] carrier_mass_kg`` / ``carrier_inertia_kg_m2`` of a planetary stage are the
+    carrier solid's mass and polar inertia (the multibody and the lumped model's rigid carrier); a file that gives
+    them keeps its values; the star's carrier (held) keeps the planets' estimate."""
+    gearbox = fg.load_gearbox(EXAMPLE)
+    exact = carrier_mass_properties(carrier_sizes(gearbox), gearbox.material_assumed.density_kg_m3)
+    la = gearbox.lumped_assumed
+    assert la.carrier_mass_kg == pytest.approx(exact.mass, rel=1e-12)
+    assert la.carrier_inertia_kg_m2 == pytest.approx(exact.inertia[2, 2], rel=1e-12)
+    given = tmp_path / "gearbox.toml"
+    given.write_text(EXAMPLE.read_text() + "\n[lumped_assumed]\ncarrier_mass_kg = 7.5\ncarrier_inertia_kg_m2 = 0.05\n")
+    assert fg.load_gearbox(given).lumped_assumed.carrier_mass_kg == 7.5
+    star = tmp_path / "star.toml"
+    star.write_text(EXAMPLE.read_text().replace('arrangement = "planetary"', 'arrangement = "star"'))
+    assert fg.load_gearbox(star).lumped_assumed.carrier_mass_kg < 0.5 * exact.mass  # the planets' estimate

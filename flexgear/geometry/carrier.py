@@ -28,12 +28,13 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from flexgear.geometry.involute import gear_set_geometry
+from flexgear.geometry.involute import gear_set_geometry_of
 from flexgear.geometry.massprops import MassProperties
+from flexgear.schema import ComponentsAssumed, GearSet, GearSetAssumed
 from flexgear.spec import GearboxSpec
 
-__all__ = ["CarrierSizes", "carrier_sizes", "carrier_solid", "carrier_mass_properties", "PIN_PER_PLANET_BORE",
-           "PLATE_THICKNESS_PER_FACE_WIDTH", "CLEARANCE_PER_MODULE", "PLATE_LIGAMENT_PER_PIN"]
+__all__ = ["CarrierSizes", "carrier_sizes", "carrier_sizes_of", "carrier_solid", "carrier_mass_properties",
+           "PIN_PER_PLANET_BORE", "PLATE_THICKNESS_PER_FACE_WIDTH", "CLEARANCE_PER_MODULE", "PLATE_LIGAMENT_PER_PIN"]
 
 PIN_PER_PLANET_BORE = 0.6
 """Pin diameter over the planet's bore diameter (the planet bearing's rings and rolling elements in between)."""
@@ -95,9 +96,14 @@ class CarrierSizes:
 def carrier_sizes(spec: GearboxSpec, **given: float) -> CarrierSizes:
     """The carrier of ``spec``'s gear set with the default sizes (module constants), any of them ``given`` [m] by
     its :class:`CarrierSizes` name; checked (ValueError naming the dimension)."""
-    gs = gear_set_geometry(spec)
-    c, a = spec.components_assumed, spec.gears_assumed
-    module = spec.gears.normal_module_mm * 1e-3
+    return carrier_sizes_of(spec.gears, spec.gears_assumed, spec.components_assumed, **given)
+
+
+def carrier_sizes_of(gears: GearSet, a: GearSetAssumed, c: ComponentsAssumed, **given: float) -> CarrierSizes:
+    """:func:`carrier_sizes` from the tables ``[gears]``, ``[gears_assumed]`` and ``[components_assumed]`` alone
+    (e.g. while the rest of a gearbox file is loaded, flexgear.sizing)."""
+    gs = gear_set_geometry_of(gears, a)
+    module = gears.normal_module_mm * 1e-3
     clearance = CLEARANCE_PER_MODULE * module
     length = a.face_width_m + (a.half_gap_m if a.helix_layout == "double" else 0.0)
     face = a.face_width_m * (2 if a.helix_layout == "double" else 1)
