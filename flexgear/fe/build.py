@@ -23,7 +23,7 @@ from flexgear.heap import lean_heap
 from flexgear.spec import COMPONENT_GEOMETRY, GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = ["ComponentSummary", "build_components", "build_items", "COLD_BUILD_ORDER", "variant_build_items",
-           "build_key", "is_built", "build_body"]
+           "build_key", "build_body"]
 
 COLD_BUILD_ORDER = (TIED_PAIR, "planet", "sun", "input_shaft", "output_shaft", "ring")
 """Tasks in the order they start (coarse level, benchmarks/RESULTS.md): the tied ring and output shaft, the
@@ -55,13 +55,6 @@ def build_key(spec: GearboxSpec, item: str, level: str) -> str:
     from flexgear.fe.ring_shaft import tied_pair_key
 
     return tied_pair_key(spec, level) if item == TIED_PAIR else component_cache_key(spec, item, level)
-
-
-def is_built(spec: GearboxSpec, item: str, level: str) -> bool:
-    """Whether the reduced body of build task ``item`` is in the cache (its file is there; nothing is read)."""
-    from flexgear.fe.reduced import reduced_cache_path
-
-    return reduced_cache_path(build_key(spec, item, level)).exists()
 
 
 @dataclass(frozen=True)

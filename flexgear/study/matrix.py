@@ -203,8 +203,12 @@ def _cold_build(variants: dict[Any, Variant]) -> tuple[list[tuple[Any, Callable,
     rank = {item: k for k, item in enumerate(COLD_BUILD_ORDER)}
     cold: dict[str, tuple[str, Variant, set[Any]]] = {}  # body key -> (item, a variant that needs it, run keys)
     for key, v in variants.items():
-        for item in variant_build_items(v.gearbox, v.components):
-            body = build_key(v.gearbox, item, v.mesh_level)
+        try:
+            needed = {build_key(v.gearbox, item, v.mesh_level): item
+                      for item in variant_build_items(v.gearbox, v.components)}
+        except Exception:  # noqa: BLE001  the run itself then fails and is recorded with its reason
+            continue
+        for body, item in needed.items():
             if not reduced_cache_path(body).exists():
                 cold.setdefault(body, (item, v, set()))[2].add(key)
     entries = sorted(cold.values(), key=lambda entry: rank.get(entry[0], len(rank)))
