@@ -132,3 +132,19 @@ def test_documented_assumptions_lists_only_what_the_study_does_not_give():
     assert "TEa" in table.loc["allowable_total_error_pct", "note"]
     for study_value in ("sun_teeth", "helix_angle_deg", "load_torque_nm", "stiffness"):
         assert study_value not in table.index
+
+
+def test_documented_assumptions_list_the_values_derived_from_the_gear_set():
+    """A gearbox file that gives only its gear data, bearings and load case (the spur planetary example) has its
+    every other value derived: the appendix lists each with its value as loaded, e.g. the carrier's mass from its
+    solid; the study's file, which gives every value, lists none as derived."""
+    from flexgear.report.data import DERIVED_NOTE
+    from flexgear.spec import load_gearbox
+
+    example = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary" / "gearbox.toml"
+    table = documented_assumptions(example)
+    spec = load_gearbox(example)
+    assert len(table) == len(spec.derived) and (table.note == DERIVED_NOTE).all()
+    row = table.set_index(["table", "key"]).loc[("lumped_assumed", "carrier_mass_kg")]
+    assert float(row.value) == pytest.approx(spec.lumped_assumed.carrier_mass_kg, rel=1e-5)
+    assert not (documented_assumptions(Path(GEARBOX)).note == DERIVED_NOTE).any()

@@ -248,12 +248,37 @@ def _split_comment(line: str) -> tuple[str, str]:
     return line.strip(), ""
 
 
+DERIVED_NOTE = "derived from the gear set: not in the file (flexgear.sizing, docs/configuration.md)"
+"""The note of an assumption the gearbox file leaves to its derived default."""
+
+
 def documented_assumptions(path: Path) -> pd.DataFrame:
     """Every value of a gearbox file that the study does not give, with its documenting comment.
 
     That is every key of the ``*_assumed`` and ``screening`` tables, plus any key of a study table
-    whose comment says "assumed"; comment lines just above a key (or a table header) are its note.
+    whose comment says "assumed"; comment lines just above a key (or a table header) are its note. Then every
+    value the file leaves to a default derived from its gear set (:data:`DERIVED_NOTE`), as the loaded gearbox
+    holds it.
     """
+    rows = _file_assumptions(path)
+    try:
+        spec = load_gearbox(path)
+    except SpecError:  # a file the report cannot load: what it says itself
+        return rows
+    given = set(zip(rows.table, rows.key, strict=True))
+    derived = []
+    for name in spec.derived:
+        table, key = name.rsplit(".", 1)
+        if (table, key) in given:
+            continue
+        top, _, level = table.partition(".")
+        holder = spec.meshing_assumed[level] if top == "meshing_assumed" and level else getattr(spec, top)
+        derived.append({"table": table, "key": key, "value": fmt(getattr(holder, key), 6), "note": DERIVED_NOTE})
+    return pd.concat([rows, pd.DataFrame(derived, columns=rows.columns)], ignore_index=True) if derived else rows
+
+
+def _file_assumptions(path: Path) -> pd.DataFrame:
+    """The file's own assumptions of :func:`documented_assumptions`, with their comments."""
     text = Path(path).read_text()
     data = tomllib.loads(text)
     rows, pending, table, table_note = [], [], "", ""
