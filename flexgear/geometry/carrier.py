@@ -39,7 +39,8 @@ __all__ = ["CarrierSizes", "carrier_sizes", "carrier_sizes_of", "carrier_solid",
 PIN_PER_PLANET_BORE = 0.6
 """Pin diameter over the planet's bore diameter (the planet bearing's rings and rolling elements in between)."""
 PLATE_THICKNESS_PER_FACE_WIDTH = 0.5
-"""Side plate thickness over the gears' face width (both helices of a double-helical gear)."""
+"""Side plate thickness over the gears' face width (the toothed width, both helices of a double-helical gear
+together, as flexgear.geometry.layout lays the teeth out)."""
 CLEARANCE_PER_MODULE = 1.0
 """Radial clearance of the posts to the sun's and the planets' tip circles, and axial clearance of the plates to
 the gears' faces, in normal modules."""
@@ -106,14 +107,13 @@ def carrier_sizes_of(gears: GearSet, a: GearSetAssumed, c: ComponentsAssumed, **
     module = gears.normal_module_mm * 1e-3
     clearance = CLEARANCE_PER_MODULE * module
     length = a.face_width_m + (a.half_gap_m if a.helix_layout == "double" else 0.0)
-    face = a.face_width_m * (2 if a.helix_layout == "double" else 1)
     pin = PIN_PER_PLANET_BORE * c.planet_bore_diameter_mm * 1e-3 / 2
     sizes = CarrierSizes(
         pin_circle_radius=gs.centre_distance, planet_angles=tuple(float(p) for p in gs.planet_angles),
         pin_radius=pin, bore_radius=c.input_shaft_outer_diameter_mm * 1e-3 / 2 + clearance,
         plate_outer_radius=min(gs.centre_distance + (1.0 + PLATE_LIGAMENT_PER_PIN) * pin,
                                gs.ring.tip_radius - clearance),
-        plate_thickness=PLATE_THICKNESS_PER_FACE_WIDTH * face, gap=length + 2.0 * clearance,
+        plate_thickness=PLATE_THICKNESS_PER_FACE_WIDTH * a.face_width_m, gap=length + 2.0 * clearance,
         post_inner_radius=gs.sun.tip_radius + clearance, window_radius=gs.planet.tip_radius + clearance)
     unknown = set(given) - set(CarrierSizes.__dataclass_fields__)
     if unknown:
