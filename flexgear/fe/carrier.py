@@ -14,6 +14,8 @@ inputs' hash.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from flexgear.fe.cms import ReducedBody, interface, reduce
@@ -85,9 +87,7 @@ def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSiz
 def carrier_interfaces(fe: FEModel, sizes: CarrierSizes) -> list:
     """The seat and the pins' interfaces (module docstring), the pins' points their centres on the mid-plane."""
     seat = interface(fe, SEAT)
-    pins = [interface(fe, f"pin_{k}") for k in range(sizes.planet_count)]
-    pins = [type(p)(p.name, p.nodes, p.weights, centre) for p, centre in zip(pins, sizes.pin_centres(), strict=True)]
-    return [seat, *pins]
+    return [seat, *(replace(interface(fe, f"pin_{k}"), point=centre) for k, centre in enumerate(sizes.pin_centres()))]
 
 
 def carrier_body(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None,

@@ -29,6 +29,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from flexgear.geometry.involute import gear_set_geometry_of
+from flexgear.geometry.layout import stacked_prism_mass_properties
 from flexgear.geometry.massprops import MassProperties
 from flexgear.schema import ComponentsAssumed, GearSet, GearSetAssumed
 from flexgear.spec import GearboxSpec
@@ -177,13 +178,6 @@ def carrier_mass_properties(sizes: CarrierSizes, density: float) -> MassProperti
     post_area = math.pi * (s.plate_outer_radius**2 - s.post_inner_radius**2) - n * win_area
     post_polar = math.pi * (s.plate_outer_radius**4 - s.post_inner_radius**4) / 2 - n * win_polar
     half = s.gap / 2
-    prisms = [(plate_area, plate_polar, -half - s.plate_thickness, -half), (post_area, post_polar, -half, half),
-              (plate_area, plate_polar, half, half + s.plate_thickness)]
-    mass = first = i_zz = i_xx = 0.0
-    for area, polar, z0, z1 in prisms:
-        mass += density * area * (z1 - z0)
-        first += density * area * (z1**2 - z0**2) / 2
-        i_zz += density * polar * (z1 - z0)
-        i_xx += density * (polar * (z1 - z0) / 2 + area * (z1**3 - z0**3) / 3)
-    zc = first / mass
-    return MassProperties(mass, np.array([0.0, 0.0, zc]), np.diag([i_xx - mass * zc**2, i_xx - mass * zc**2, i_zz]))
+    return stacked_prism_mass_properties([(plate_area, plate_polar, -half - s.plate_thickness, -half),
+                                          (post_area, post_polar, -half, half),
+                                          (plate_area, plate_polar, half, half + s.plate_thickness)], density)

@@ -61,6 +61,7 @@ __all__ = [
     "exact_mass_properties",
     "layout_mass_properties",
     "component_mass_properties",
+    "stacked_prism_mass_properties",
     "cached_mass_properties",
     "geometry_hash",
     "HelixSweep",
@@ -349,13 +350,20 @@ def layout_mass_properties(layout: ComponentLayout, profiles: dict[str, ToothPro
                            rho: float) -> MassProperties:
     """Mass properties of a component ``layout`` of density ``rho`` [kg/m^3] from the exact section integrals
     (module docstring), the gear sections' outlines from ``profiles``."""
+    return stacked_prism_mass_properties(
+        [(*section_integrals(p.section, profiles), p.z0, p.z1) for p in layout.prisms], rho)
+
+
+def stacked_prism_mass_properties(prisms: list[tuple[float, float, float, float]], rho: float) -> MassProperties:
+    """Mass properties of prisms along the z axis, each (area A [m^2], polar moment J = int r^2 dA [m^4], z0, z1 [m])
+    of a section with n-fold symmetry (n >= 3: the transverse inertia is axisymmetric), density ``rho`` [kg/m^3]:
+    m = rho sum A L, I_zz = rho sum J L, I_xx = rho sum (J L / 2 + A (z1^3 - z0^3) / 3) - m z_c^2."""
     mass = first = i_zz = i_xx = 0.0
-    for p in layout.prisms:
-        area, polar = section_integrals(p.section, profiles)
-        mass += rho * area * p.length
-        first += rho * area * (p.z1**2 - p.z0**2) / 2
-        i_zz += rho * polar * p.length
-        i_xx += rho * (polar * p.length / 2 + area * (p.z1**3 - p.z0**3) / 3)
+    for area, polar, z0, z1 in prisms:
+        mass += rho * area * (z1 - z0)
+        first += rho * area * (z1**2 - z0**2) / 2
+        i_zz += rho * polar * (z1 - z0)
+        i_xx += rho * (polar * (z1 - z0) / 2 + area * (z1**3 - z0**3) / 3)
     zc = first / mass
     inertia = np.diag([i_xx - mass * zc**2, i_xx - mass * zc**2, i_zz])
     return MassProperties(mass, np.array([0.0, 0.0, zc]), inertia)

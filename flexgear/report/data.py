@@ -252,17 +252,17 @@ DERIVED_NOTE = "derived from the gear set: not in the file (flexgear.sizing, doc
 """The note of an assumption the gearbox file leaves to its derived default."""
 
 
-def documented_assumptions(path: Path) -> pd.DataFrame:
+def documented_assumptions(path: Path, spec: GearboxSpec | None = None) -> pd.DataFrame:
     """Every value of a gearbox file that the study does not give, with its documenting comment.
 
     That is every key of the ``*_assumed`` and ``screening`` tables, plus any key of a study table
     whose comment says "assumed"; comment lines just above a key (or a table header) are its note. Then every
     value the file leaves to a default derived from its gear set (:data:`DERIVED_NOTE`), as the loaded gearbox
-    holds it.
+    holds it (``spec``: the gearbox of ``path`` when the caller has loaded it already).
     """
     rows = _file_assumptions(path)
     try:
-        spec = load_gearbox(path)
+        spec = spec or load_gearbox(path)
     except SpecError:  # a file the report cannot load: what it says itself
         return rows
     given = set(zip(rows.table, rows.key, strict=True))

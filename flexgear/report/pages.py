@@ -247,7 +247,7 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
     others = [o for o in (gather(x) for x in also if not results_folder_problem(x)) if o.runs]
     output = Path(output)
     created = _dt.datetime.now(_dt.UTC).strftime("%Y-%m-%d %H:%M UTC")
-    assumptions = documented_assumptions(d.gearbox_file)
+    assumptions = documented_assumptions(d.gearbox_file, d.gearbox)
     body: list[Page] = [rp.run_time_page(d), *rp.diagram_pages(d), *rp.screening_pages(d)]
     if rp.shown_runs(d):
         body += [*rp.overlay_pages(d), *rp.spectrum_pages(d), *rp.tables_6_7_pages(d),
