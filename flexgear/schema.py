@@ -31,7 +31,7 @@ __all__ = [
     "ReductionSettings", "IndicatorWeights", "IndicatorTolerance", "LoadTolerance",
     "LevelTolerance", "ReferenceIndicators", "ScreeningSettings",
     "LumpedAssumed", "GearboxSpec", "Variant", "COMPONENTS", "GEAR_COMPONENTS", "SHAFT_COMPONENTS",
-    "GEOMETRY_COMPONENTS", "COMPONENT_GEOMETRY",
+    "GEOMETRY_COMPONENTS", "COMPONENT_GEOMETRY", "CARRIER", "OPTIONAL_COMPONENTS",
 ]
 COMPONENTS = ("input_shaft", "sun", "planets", "ring", "output_shaft")
 """Component names of Table 3, in its column order (a variant sets each rigid or flexible)."""
@@ -41,7 +41,13 @@ SHAFT_COMPONENTS = ("input_shaft", "output_shaft")
 GEOMETRY_COMPONENTS = GEAR_COMPONENTS + SHAFT_COMPONENTS
 """Distinct component geometries (one planet geometry serves every planet)."""
 
-COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"}
+CARRIER = "carrier"
+"""The planet carrier: a component of the planetary arrangement (rigid by default, flexible when a variant says so,
+flexgear.fe.carrier); the star holds it."""
+OPTIONAL_COMPONENTS = (CARRIER,)
+"""Components a variant may leave out of ``[components]`` (then rigid)."""
+
+COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet", CARRIER: CARRIER}
 """Table 3 component (or geometry) name -> its geometry name."""
 
 

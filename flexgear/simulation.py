@@ -20,7 +20,16 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
-from flexgear.spec import COMPONENTS, GearboxSpec, SpecError, Variant, load_gearbox, load_variant
+from flexgear.spec import (
+    CARRIER,
+    COMPONENTS,
+    OPTIONAL_COMPONENTS,
+    GearboxSpec,
+    SpecError,
+    Variant,
+    load_gearbox,
+    load_variant,
+)
 from flexgear.theory import Theory, theory
 
 __all__ = ["Simulation"]
@@ -41,20 +50,27 @@ class Simulation:
     def from_gearbox(cls, gearbox: str | Path | GearboxSpec, flexible: Iterable[str] = (), *, name: str = "",
                      mesh_level: str = "coarse", rigid_mass_properties: str = "mesh") -> Simulation:
         """From a gearbox file (or a loaded spec): the components named in ``flexible`` flexible (any of
-        flexgear.spec.COMPONENTS), the others rigid. ``rigid_mass_properties``: "mesh" (the reduced bodies',
-        rigid and flexible twins identical) or "exact" (the exact geometry's: no meshing for a rigid variant)."""
+        flexgear.spec.COMPONENTS, and the planetary stage's ``carrier``), the others rigid.
+        ``rigid_mass_properties``: "mesh" (the reduced bodies', rigid and flexible twins identical) or "exact" (the
+        exact geometry's: no meshing for a rigid variant)."""
         spec = gearbox if isinstance(gearbox, GearboxSpec) else load_gearbox(gearbox)
         flexible = tuple(flexible)
+        known = COMPONENTS + OPTIONAL_COMPONENTS
         for component in flexible:
-            if component not in COMPONENTS:
+            if component not in known:
                 raise SpecError(spec.source, f"components.{component}", f"unknown component; allowed: "
-                                f"{', '.join(COMPONENTS)}")
+                                f"{', '.join(known)}")
+        if CARRIER in flexible and spec.gears.arrangement != "planetary":
+            raise SpecError(spec.source, f"components.{CARRIER}", "a flexible carrier needs [gears] arrangement = "
+                            f"'planetary' (the {spec.gears.arrangement} arrangement holds it); expected 'rigid'")
         if mesh_level not in spec.meshing_assumed:
             raise SpecError(spec.source, "mesh_level", f"expected one of {sorted(spec.meshing_assumed)}", mesh_level)
         if rigid_mass_properties not in ("mesh", "exact"):
             raise SpecError(spec.source, "rigid_mass_properties", "expected one of 'mesh', 'exact'",
                             rigid_mass_properties)
         components = {c: ("flexible" if c in flexible else "rigid") for c in COMPONENTS}
+        if CARRIER in flexible:
+            components[CARRIER] = "flexible"
         label = name or ("rigid" if not flexible else "flexible_" + "_".join(flexible))
         return cls(Variant(spec.source, label, spec, components, mesh_level, rigid_mass_properties))
 

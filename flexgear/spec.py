@@ -23,10 +23,12 @@ from typing import Any, get_type_hints
 
 from flexgear.derived import FIRST_TABLES, REQUIRED_TABLES, rederive, register_derived_defaults, with_derived
 from flexgear.schema import (
+    CARRIER,
     COMPONENT_GEOMETRY,
     COMPONENTS,
     GEAR_COMPONENTS,
     GEOMETRY_COMPONENTS,
+    OPTIONAL_COMPONENTS,
     REMOVED_FIELDS,
     SHAFT_COMPONENTS,
     Bearing,
@@ -78,6 +80,8 @@ __all__ = [
     "GearboxSpec",
     "Variant",
     "COMPONENTS",
+    "OPTIONAL_COMPONENTS",
+    "CARRIER",
     "GEAR_COMPONENTS",
     "SHAFT_COMPONENTS",
     "GEOMETRY_COMPONENTS",
@@ -373,15 +377,21 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
     comps = raw["components"]
     if not isinstance(comps, dict):
         raise SpecError(path, "components", "expected a table")
+    known = COMPONENTS + OPTIONAL_COMPONENTS
     for name in comps:
-        if name not in COMPONENTS:
-            raise SpecError(path, f"components.{name}", f"unknown component; allowed: {', '.join(COMPONENTS)}")
+        if name not in known:
+            raise SpecError(path, f"components.{name}", f"unknown component; allowed: {', '.join(known)}")
     components = {}
-    for name in COMPONENTS:
+    for name in known:
         if name not in comps:
+            if name in OPTIONAL_COMPONENTS:
+                continue
             raise SpecError(path, f"components.{name}", "missing; expected 'rigid' or 'flexible'")
         components[name] = _check_value(path, f"components.{name}", comps[name], str,
                                         {"choices": ("rigid", "flexible")})
+    if components.get(CARRIER) == "flexible" and gearbox.gears.arrangement != "planetary":
+        raise SpecError(path, f"components.{CARRIER}", f"a flexible carrier needs [gears] arrangement = 'planetary' "
+                        f"(the {gearbox.gears.arrangement} arrangement holds it); expected 'rigid'", "flexible")
 
     level = raw.get("mesh_level", "default")
     if level not in gearbox.meshing_assumed:

@@ -20,7 +20,7 @@ from dataclasses import dataclass
 
 from flexgear.fe.ring_shaft import PAIR, TIED_PAIR
 from flexgear.heap import lean_heap
-from flexgear.spec import COMPONENT_GEOMETRY, GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.spec import CARRIER, COMPONENT_GEOMETRY, GEOMETRY_COMPONENTS, GearboxSpec
 
 __all__ = ["ComponentSummary", "build_components", "build_items", "COLD_BUILD_ORDER", "variant_build_items",
            "build_key", "build_body"]
@@ -51,9 +51,12 @@ def variant_build_items(spec: GearboxSpec, components: dict[str, str]) -> tuple[
 def build_key(spec: GearboxSpec, item: str, level: str) -> str:
     """The cache key of the reduced body of build task ``item`` (a geometry or
     :data:`~flexgear.fe.ring_shaft.TIED_PAIR`) at mesh ``level``."""
+    from flexgear.fe.carrier import carrier_body_key
     from flexgear.fe.reduced import component_cache_key
     from flexgear.fe.ring_shaft import tied_pair_key
 
+    if item == CARRIER:
+        return carrier_body_key(spec, level)
     return tied_pair_key(spec, level) if item == TIED_PAIR else component_cache_key(spec, item, level)
 
 
@@ -71,11 +74,9 @@ class ComponentSummary:
 def build_body(spec: GearboxSpec, item: str, level: str) -> int:
     """Build (or find in the cache) the reduced body of build task ``item`` at mesh ``level`` alone (not the meshes
     of :func:`build_component`); returns its mode count (a worker process sends nothing larger back)."""
-    from flexgear.fe.reduced import component_reduced_body
-    from flexgear.fe.ring_shaft import tied_pair_body
+    from flexgear.fe.ring_shaft import reduced_body
 
-    body = tied_pair_body(spec, level) if item == TIED_PAIR else component_reduced_body(spec, item, level)
-    return body.n_modes
+    return reduced_body(spec, item, level).n_modes
 
 
 def build_component(spec: GearboxSpec, component: str, level: str, reduce: bool = True) -> ComponentSummary:

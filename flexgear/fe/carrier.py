@@ -25,7 +25,8 @@ from flexgear.geometry.carrier import CarrierSizes, carrier_sizes, carrier_solid
 from flexgear.progress import say
 from flexgear.spec import GearboxSpec, spec_hash
 
-__all__ = ["carrier_fe_model", "carrier_body", "carrier_interfaces", "SEAT", "CUTOFF_FACTOR"]
+__all__ = ["carrier_fe_model", "carrier_body", "carrier_body_key", "carrier_interfaces", "pin_interface", "SEAT",
+           "CUTOFF_FACTOR"]
 
 CUTOFF_FACTOR = 3.0
 """The carrier's fixed-interface modes reach this multiple of the gearbox's cutoff (3.5 mesh orders). The gears carry
@@ -35,6 +36,11 @@ orders against full FE: cutoff x1 (no fixed-interface mode) 17 %, x2 (6) 1.05 %,
 (benchmarks/RESULTS.md)."""
 SEAT = "seat"
 """The carrier's interface on the output shaft."""
+
+
+def pin_interface(k: int) -> str:
+    """The name of the interface of planet ``k``'s pin (0-based, in the order of the planets' angles)."""
+    return f"pin_{k}"
 _VERSION = 1
 """Bump when the carrier's mesh or reduction changes without an input changing (enters the cache key)."""
 _FACE_TOL = 1e-6
@@ -52,7 +58,7 @@ def _named_solid(sizes: CarrierSizes, pin_size: float):
         off = np.hypot(pins[:, 0] - c.x, pins[:, 1] - c.y)
         k = int(np.argmin(off))
         if off[k] < _FACE_TOL and abs(c.z) > half:
-            face.name, face.maxh = f"pin_{k}", pin_size
+            face.name, face.maxh = pin_interface(k), pin_size
         elif np.hypot(c.x, c.y) < _FACE_TOL and c.z > half and abs(_radius(face) - sizes.bore_radius) < _FACE_TOL:
             face.name = SEAT
     return solid
@@ -77,7 +83,7 @@ def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSiz
                               optsteps3d=settings.optimisation_steps)
     mesh = geo.GenerateMesh(mp=mp)
     fe = fe_model(mesh, spec.material_assumed, settings.element_order)
-    missing = [f"pin_{k}" for k in range(sizes.planet_count) if f"pin_{k}" not in fe.regions] + (
+    missing = [pin_interface(k) for k in range(sizes.planet_count) if pin_interface(k) not in fe.regions] + (
         [SEAT] if SEAT not in fe.regions else [])
     if missing:
         raise RuntimeError(f"carrier: the meshed solid lacks the faces {missing}")
@@ -87,7 +93,8 @@ def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSiz
 def carrier_interfaces(fe: FEModel, sizes: CarrierSizes) -> list:
     """The seat and the pins' interfaces (module docstring), the pins' points their centres on the mid-plane."""
     seat = interface(fe, SEAT)
-    return [seat, *(replace(interface(fe, f"pin_{k}"), point=centre) for k, centre in enumerate(sizes.pin_centres()))]
+    pins = [replace(interface(fe, pin_interface(k)), point=centre) for k, centre in enumerate(sizes.pin_centres())]
+    return [seat, *pins]
 
 
 def carrier_body(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None,
@@ -96,14 +103,25 @@ def carrier_body(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes |
     :func:`flexgear.geometry.carrier.carrier_sizes`; ``fe``: its FE model when the body must be built, exactly as
     :func:`carrier_fe_model` builds it for ``spec``, ``level`` and ``sizes`` (e.g. one the caller holds already)."""
     sizes = sizes or carrier_sizes(spec)
-    red = spec.reduction_assumed
-    max_hz = CUTOFF_FACTOR * red.fixed_interface_cutoff_hz
-    key = spec_hash(sizes, spec.meshing_assumed[level], spec.material_assumed, max_hz, _VERSION)
 
     def build() -> ReducedBody:
         if progress:
             say(f"  carrier ({level}): building the reduced body")
         model = fe if fe is not None else carrier_fe_model(spec, level, sizes)
-        return reduce(model, carrier_interfaces(model, sizes), n_compare=0, rigid=(SEAT,), max_hz=max_hz)
+        return reduce(model, carrier_interfaces(model, sizes), n_compare=0, rigid=(SEAT,),
+                      max_hz=_max_hz(spec))
 
-    return cached_reduced_body(f"carrier-{level}-{key}", build)
+    return cached_reduced_body(carrier_body_key(spec, level, sizes), build)
+
+
+def _max_hz(spec: GearboxSpec) -> float:
+    """The carrier's fixed-interface cutoff [Hz]: :data:`CUTOFF_FACTOR` times the gearbox's."""
+    return CUTOFF_FACTOR * spec.reduction_assumed.fixed_interface_cutoff_hz
+
+
+def carrier_body_key(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None) -> str:
+    """The cache key of :func:`carrier_body` (flexgear.fe.reduced.reduced_cache_path names its file): every input
+    of the carrier's mesh and reduction hashed."""
+    sizes = sizes or carrier_sizes(spec)
+    key = spec_hash(sizes, spec.meshing_assumed[level], spec.material_assumed, _max_hz(spec), _VERSION)
+    return f"carrier-{level}-{key}"

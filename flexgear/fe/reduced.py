@@ -48,7 +48,7 @@ __all__ = ["contact_band_selector", "contact_fit_window", "component_interfaces"
            "component_mass_properties", "cached_component_frequencies", "component_cache_key", "COMPONENT_GEOMETRY",
            "joint_point",
            "gear_shaft_joints", "gear_seat", "is_tied", "patch_union", "BOLT_PATCHES", "RING_SEAT", "band_circles",
-           "read_cached"]
+           "read_cached", "cached_frequencies"]
 
 BOLT_PATCHES = "bolt_patches"
 """Name of the ring's and the output shaft's rigid interface over the clamped discs of all bolts."""
@@ -329,7 +329,13 @@ def cached_component_frequencies(spec: GearboxSpec | Design, component: str,
                                  level: str = "coarse") -> np.ndarray | None:
     """Free-free frequencies [Hz] of :func:`component_reduced_body`, read alone from the cache; None when the
     body is not cached yet (nothing is built)."""
-    return read_cached(_component_reduction(spec, component, level, False)[0], _load_frequencies)
+    return cached_frequencies(_component_reduction(spec, component, level, False)[0])
+
+
+def cached_frequencies(key: str) -> np.ndarray | None:
+    """Free-free frequencies [Hz] of the reduced body cached under ``key``, read alone; None when it is not
+    cached (or cannot be read)."""
+    return read_cached(key, _load_frequencies)
 
 
 def _load_mass_properties(path: Path) -> MassProperties:

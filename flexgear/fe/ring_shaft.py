@@ -46,7 +46,7 @@ from flexgear.fe.tied import Tie, TiedFE, reduce, tie_parts
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
 from flexgear.progress import say
-from flexgear.spec import GearboxSpec
+from flexgear.spec import CARRIER, GearboxSpec
 
 __all__ = ["PAIR", "TIED_PAIR", "part_fe_model", "pair_fe_models", "tied_pair", "tied_pair_interfaces", "ring_seat",
            "tied_pair_body", "tied_pair_key", "tied_pair_mass_properties", "reduced_body", "tied_part_matrices"]
@@ -196,7 +196,12 @@ def tied_part_matrices(spec: GearboxSpec, level: str = "coarse", progress: bool 
 
 def reduced_body(spec: GearboxSpec, component: str, level: str = "coarse", progress: bool = False) -> ReducedBody:
     """The reduced body of ``component`` (flexgear.fe.reduced.component_reduced_body), or of the tied ring and
-    output shaft for :data:`TIED_PAIR` (:func:`tied_pair_body`); cached."""
+    output shaft for :data:`TIED_PAIR` (:func:`tied_pair_body`), or the planetary stage's carrier
+    (flexgear.fe.carrier.carrier_body); cached."""
     if component == TIED_PAIR:
         return tied_pair_body(spec, level, progress)
+    if component == CARRIER:
+        from flexgear.fe.carrier import carrier_body
+
+        return carrier_body(spec, level, progress=progress)
     return component_reduced_body(spec, component, level, progress)

@@ -58,7 +58,8 @@ class CarrierKinematics:
 
     ``rows`` (n_contacts, 6 n_bodies + n_modal): the contacts' gradient rows at carrier angle 0 (one kinematic
     row of every contact, over the frame coordinates in the order of ``bodies``, then the flexible gears' modal
-    coordinates, zero here). Bodies off the carrier axis (other than the carrier) orbit with it. ``extra_rows``
+    coordinates, zero here). Bodies off the carrier axis (other than the carrier) orbit with it. The carrier's frame
+    (rigid, or a flexible carrier's mean axes) carries no contact: only its position, the axis, enters. ``extra_rows``
     are further row sets over the frame coordinates to turn in place (the friction's sliding rows), given as
     arrays to overwrite. With flexible gears (modal columns) the update writes only the frame columns and the
     offset: flexgear.mbs.contact_kinematics.ContactKinematics writes the modal ones, at the material angle of
@@ -75,8 +76,6 @@ class CarrierKinematics:
         names = [b.name for b in bodies]
         if carrier.body not in names:
             raise KeyError(f"carrier body {carrier.body!r} is not among the bodies {names}")
-        if next(b for b in bodies if b.name == carrier.body).flexible:
-            raise ValueError(f"carrier body {carrier.body!r} must be rigid")
         axis = next(b.position for b in bodies if b.name == carrier.body)
         self.axis = np.asarray(axis, float)
         self.positions = np.array([b.position for b in bodies], float)
@@ -131,11 +130,12 @@ def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: BearingElement
                            name or f"bearing_{planet.name}")
 
 
-def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: BearingElement, name: str
-                    ) -> list[int]:
+def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: BearingElement, name: str,
+                    pin_node: int | None = None) -> list[int]:
     """A bearing between the rigid node ``node`` (a planet's frame, or a flexible planet's seat node,
     flexgear.mbs.joints.LinearSeat) whose reference position is ``point`` [m, ground] and the pin of ``carrier``
-    there, the spin free.
+    there, the spin free. ``pin_node``: the pin's own rigid-body node, whose coordinates are the pin's motion (a
+    flexible carrier's, flexgear.mbs.joints.CarrierPins), in place of the point fixed in the rigid ``carrier``.
 
     ``bearing`` about ``point`` must be diag(k_r, k_r, k_a, k_t, k_t, 0) (ValueError otherwise). Translation: an
     ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries
@@ -153,15 +153,19 @@ def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: B
 
     k_r, k_a, k_t = bearing.axisymmetric_entries()
     d_r, d_a, d_t = bearing.axisymmetric_entries(bearing.damping)
-    pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
-                                           localPosition=list(np.asarray(point, float) - carrier.position)))
+    if pin_node is None:
+        pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
+                                               localPosition=list(np.asarray(point, float) - carrier.position)))
+    else:
+        pin = mbs.AddMarker(MarkerNodePosition(nodeNumber=pin_node))
+    tilted = carrier.node if pin_node is None else pin_node
     out = [mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         name=name, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],
         stiffness=[k_r, k_r, k_a], damping=[d_r, d_r, d_a]))]
     for axis in (3, 4):
         out.append(mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=f"{name}_tilt{axis - 2}",
-            markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=carrier.node, coordinate=axis)),
+            markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=tilted, coordinate=axis)),
                            mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))],
             stiffness=k_t, damping=d_t)))
     return out

@@ -63,7 +63,8 @@ def add_linear_elements(mbs, bodies: list[Body], elements: list[BearingElement],
     return obj, marker
 
 
-def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = None) -> list[int]:
+def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = None,
+                other_interface: str | None = None) -> list[int]:
     """The bearing ``bearing`` (acting on ``body``, ground on the other side) where it is.
 
     Rigid body on a linear frame (flexgear.mbs.bodies.add_linear_frame): the 6 x 6 bearing on its frame
@@ -74,7 +75,9 @@ def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = N
     body-fixed marker of a rigid body. Points on the axis: the spin does not move them, so the bearing leaves the
     spin free and damps only translation and tilt. ``other``: the rigid body on the bearing's other side
     (``bearing.other``; a planet's pin on a turning carrier), whose points at the same places replace ground (the
-    springs are isotropic about the axis: the carrier's turning does not change them). Returns the connectors.
+    springs are isotropic about the axis: the carrier's turning does not change them); a flexible ``other`` (a
+    flexible carrier) gives its point markers on ``other_interface`` (its pin), placed at the same points. Returns
+    the connectors.
     """
     from exudyn.itemInterface import (
         MarkerBodyPosition,
@@ -86,9 +89,9 @@ def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = N
 
     if other is None:
         bearing.check_to_ground(body.name)
-    elif (bearing.body, bearing.other) != (body.name, other.name) or other.flexible:
+    elif (bearing.body, bearing.other) != (body.name, other.name) or (other.flexible and other_interface is None):
         raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed on {body.name!r} and "
-                         f"{other.name!r} (a rigid body)")
+                         f"{other.name!r}{' (flexible: name its interface)' if other.flexible else ''}")
     if body.frame is not None and not body.flexible and other is None:  # a linear frame: one linear bearing
         from flexgear.mbs.joints import add_frame_bearing
 
@@ -102,12 +105,20 @@ def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = N
     else:
         markers = [mbs.AddMarker(MarkerBodyPosition(bodyNumber=body.obj, localPosition=[float(v) for v in sp.point]))
                    for sp in springs]
+    bases = []
+    if other is not None and other.flexible:
+        bases = other.point_markers.get(other_interface, [])
+        if len(bases) != len(springs):
+            raise KeyError(f"flexible body {other.name!r} needs {len(springs)} point markers on interface "
+                           f"{other_interface!r} (add_flexible_body point_markers); has {len(bases)}")
     out = []
     for k, (spring, marker) in enumerate(zip(springs, markers, strict=True)):
         place = body.position + spring.point
         if other is None:
             base = mbs.AddMarker(MarkerNodePosition(nodeNumber=mbs.AddNode(NodePointGround(
                 referenceCoordinates=list(map(float, place))))))
+        elif bases:
+            base = bases[k]
         else:
             base = mbs.AddMarker(MarkerBodyPosition(bodyNumber=other.obj,
                                                     localPosition=[float(v) for v in place - other.position]))

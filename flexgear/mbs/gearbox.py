@@ -39,7 +39,7 @@ from flexgear.mbs.elements import (
     support_points,
 )
 from flexgear.mbs.train import add_gear_train
-from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
+from flexgear.spec import CARRIER, COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
@@ -74,6 +74,8 @@ class GearboxModel:
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
     # planet -> the rigid-body node of its seat on a turning carrier (flexgear.mbs.joints.LinearSeat): it orbits
     carrier_seat_nodes: dict[str, int] = field(default_factory=dict)
+    # pin interface -> the rigid-body node of a flexible carrier's pin (flexgear.mbs.joints.CarrierPins): it orbits
+    carrier_pin_nodes: dict[str, int] = field(default_factory=dict)
 
     @property
     def spec(self) -> GearboxSpec:
@@ -191,7 +193,8 @@ def run_cost(variant: Variant) -> float | None:
     """An estimate of a variant's run time in arbitrary units, to order the runs of a matrix longest first: the sum
     over its flexible bodies of (dynamic modes)^2 (each body's dense modal matrices and the constraint columns it
     feeds grow with it), from the cached reduced bodies' frequencies; None if one of them is not cached yet."""
-    from flexgear.fe.reduced import cached_component_frequencies
+    from flexgear.fe.carrier import carrier_body_key
+    from flexgear.fe.reduced import cached_component_frequencies, cached_frequencies
 
     d = as_design(variant.gearbox)
     spec = d.spec
@@ -200,7 +203,8 @@ def run_cost(variant: Variant) -> float | None:
     for component, form in variant.components.items():
         if form != "flexible":
             continue
-        frequencies = cached_component_frequencies(d, component, variant.mesh_level)
+        frequencies = (cached_frequencies(carrier_body_key(spec, variant.mesh_level)) if component == CARRIER else
+                       cached_component_frequencies(d, component, variant.mesh_level))
         if frequencies is None:
             return None
         geometry = COMPONENT_GEOMETRY[component]
@@ -240,7 +244,8 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
                    level: str, props: MassSource, reduced: ReducedSource,
                    joints: dict[str, np.ndarray] | None = None, support: BearingElement | None = None,
                    cutoff_hz: float = 0.0, dropped: dict | None = None, spin_rad_s: float = 0.0,
-                   superelement: bool = True, contacts: list[GearContact] = (), source: str | None = None) -> Body:
+                   superelement: bool = True, contacts: list[GearContact] = (), source: str | None = None,
+                   bearing_points: dict[str, list[np.ndarray]] | None = None) -> Body:
     """One component as a rigid body or a reduced flexible body of the same geometry.
 
     ``joints`` {interface name: point [m]}: a flexible body gets those interfaces' markers at those points;
@@ -252,6 +257,9 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
     flexible body gets its ``ObjectFFRFreducedOrder`` (markers, mesh-node sensors; flexgear.mbs.flexible);
     ``contacts``: the gear contacts, whose sensed coordinates a gear on interface coordinates gets as a node;
     ``source``: the reduced body to load when it is not ``geometry``'s own (the tied ring and output shaft).
+    ``bearing_points`` {interface: points [m, body frame]}: further interfaces where bearings of other bodies act (a
+    flexible carrier's pins): in the production formulation each interface's own coordinates, in the reference
+    formulation point markers at those points (flexgear.mbs.elements.add_support with ``other``).
     """
     frame_tol = linear_frame_tolerance(spec)
     reference = spec.solver_assumed.reference
@@ -264,9 +272,12 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
     # production: linear joints and seats (flexgear.mbs.joints) on their interfaces' own coordinates, no markers;
     # reference: Exudyn's generic joints on interface markers, seat springs on point markers
     points = {support.interface: support_points(support)} if support is not None and reference else None
+    if reference and bearing_points:
+        points = {**(points or {}), **bearing_points}
     coordinates = []
     if not reference:
-        coordinates = list(joints or {}) + ([support.interface] if support is not None else [])
+        coordinates = (list(joints or {}) + ([support.interface] if support is not None else [])
+                       + list(bearing_points or {}))
         joints = {}
     full = reduced(spec, source or geometry, level)
     keep = dynamic_modes(geometry, full.frequencies_hz, cutoff_hz)

@@ -49,12 +49,14 @@ from numba import njit
 
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.compiled import bound_entry, ramp_state, turn_columns
+from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
 _ON_AXIS_M = 1e-9
 """A joint point within this distance [m] of the spin axis lies on it (the exact geometry places it there)."""
 
-__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks", "add_frame_bearing", "body_axes_form", "frame_form",
+__all__ = ["CarrierPins", "LinearInterfaceJoint", "LinearSeat", "TurningBlocks",
+           "add_frame_bearing", "body_axes_form", "frame_form",
            "interface_rows", "linear_bearing", "turning_form"]
 
 
@@ -218,11 +220,12 @@ class LinearSeat:
     ``carrier``: the rigid body on the bearing's other side (``bearing.other``; a planet on its pin of a turning
     carrier) instead of ground: the seat coordinates are then those of a rigid-body node at the bearing centre
     (displacement from its reference place and rotation, the same six numbers) and the bearing a pin bearing on the
-    carrier (flexgear.mbs.carrier.add_pin_bearing); no residual then.
+    carrier (flexgear.mbs.carrier.add_pin_bearing); no residual then. ``pin_node``: with ``carrier`` flexible, the
+    node of the pin's motion (:class:`CarrierPins`) the bearing acts on.
     """
 
     def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False,
-                 carrier: Body | None = None):
+                 carrier: Body | None = None, pin_node: int | None = None):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
@@ -248,7 +251,8 @@ class LinearSeat:
 
             seat_ref[:3] = body.position + centre
             self.node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{body.name}_seat", referenceCoordinates=seat_ref))
-            add_pin_bearing(mbs, carrier, self.node, body.position + centre, bearing, f"bearing_{body.name}")
+            add_pin_bearing(mbs, carrier, self.node, body.position + centre, bearing, f"bearing_{body.name}",
+                            pin_node=pin_node)
         else:
             self.node = resting_node(mbs, f"{body.name}_seat", 6)
             if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
@@ -323,4 +327,104 @@ class TurningBlocks:
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:
             set_parameter(obj, param, matrix)
+        return True
+
+
+class CarrierPins:
+    """The pins of a flexible planet carrier, each on a rigid-body node whose coordinates are the pin's motion: the
+    planets' bearings act on them (flexgear.mbs.carrier.add_pin_bearing with ``pin_node``).
+
+    The carrier (flexible ``carrier``, its frame on the axis at c_0) turns at ``spin_per_drive_angle`` times the
+    prescribed drive angle; theta is its angle at the end of each step, predicted from its spin coordinate and rate
+    at the step's start (:meth:`angle`). Pin k's RBE3 interface ``interfaces[k]`` has its point p_k
+    [m, carrier frame] off the axis, so, to first order in the frame's translation u, its small rotation
+    (phi - theta e_z) and the modal coordinates q (module docstring), with r = R_z(theta) p_k,
+
+        s_t = c_0 + u + r + (phi - theta e_z) x r + R_theta Psi_t q,     s_r = phi + R_theta Psi_r q
+
+    (s_t the pin's position [m], s_r its rotation coordinates: ground tilts, the carrier's spin angle; Psi the
+    interface's RBE3 motion per modal coordinate). One ``ObjectConnectorCoordinateVector`` per pin ties the node
+    to the carrier: s = F(r) (c_0 + u, phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the
+    turned pin) and o = -(r + theta r x e_z, 0). Its frame columns, its modal columns and its offset all turn
+    with theta; the pre-step call rewrites them each step (the offset grows with theta: its theta r x e_z
+    cancels the carrier's spin coordinate's own lever, phi_z r x e_z, to round-off). The multipliers are the
+    pin's reaction on the carrier, force [N] and moment [N m] in ground axes.
+
+    Why the actual angle, not the nominal one: the tie's lever r is frozen over a step, so its moment about the
+    axis, (r x F)_z, is off by (phi_z - theta) a F_r for a pin force F with a radial part F_r (the planets'
+    centripetal force) at the pin radius a: the nominal angle would leave the carrier's wind-up behind it (its pins'
+    own deflection, the shafts' torsion) as a first-order error of the torque the pins pass on; the predicted angle
+    leaves the change of that wind-up within one step.
+    """
+
+    def __init__(self, mbs, carrier: Body, interfaces: list[str], spin_per_drive_angle: float, ramp_time: float,
+                 drive_speed: float):
+        from exudyn.itemInterface import (
+            MarkerNodeCoordinates,
+            MarkerObjectODE2Coordinates,
+            NodeRigidBodyRxyz,
+            ObjectConnectorCoordinateVector,
+            ObjectGenericODE2,
+        )
+
+        if not carrier.flexible:
+            raise ValueError(f"CarrierPins: carrier {carrier.name!r} is rigid (its pins are points of the body)")
+        self.spin, self.ramp_time, self.drive_speed = float(spin_per_drive_angle), float(ramp_time), float(drive_speed)
+        self.carrier_node, self._last = carrier.node, None
+        self.points, self.forms, self.nodes, self.ties = [], [], [], []
+        for name in interfaces:
+            p = np.array(carrier.reduced.interface(name).point, float)
+            modal_nodes, rows = carrier.span(interface_rows(carrier, name, p))
+            node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
+                                                 referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
+            span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_span", nodeNumbers=[node, carrier.node],
+                                                   jacobianUserFunction=zero_user_jacobian(12)))
+            modal = (MarkerNodeCoordinates(nodeNumber=modal_nodes[0]) if len(modal_nodes) == 1 else
+                     MarkerObjectODE2Coordinates(objectNumber=mbs.AddObject(ObjectGenericODE2(
+                         name=f"{carrier.name}_{name}_modes", nodeNumbers=modal_nodes,
+                         jacobianUserFunction=zero_user_jacobian(rows.shape[1])))))
+            self.points.append(p)
+            self.forms.append(turning_form(rows))
+            self.nodes.append(node)
+            scaling0, scaling1, offset = self.coefficients(len(self.points) - 1, 0.0)
+            self.ties.append(mbs.AddObject(ObjectConnectorCoordinateVector(
+                name=f"{carrier.name}_{name}_tie",
+                markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
+                scalingMarker0=scaling0, scalingMarker1=scaling1, offset=offset)))
+
+    def theta(self, t: float) -> float:
+        """Nominal carrier angle [rad] at time ``t`` [s]."""
+        return self.spin * float(drive_angle(t, self.ramp_time, self.drive_speed))
+
+    def angle(self, mbs, t: float) -> float:
+        """The carrier's angle [rad] at the end of the step to time ``t`` [s], predicted from its state at the step's
+        start (its spin coordinate and rate, the previous call's time; the nominal angle before any state)."""
+        import exudyn as exu
+
+        if self._last is None:
+            self._last = t
+            return self.theta(t)
+        q = mbs.GetNodeOutput(self.carrier_node, exu.OutputVariableType.Coordinates)
+        v = mbs.GetNodeOutput(self.carrier_node, exu.OutputVariableType.Coordinates_t)
+        h, self._last = t - self._last, t
+        return float(q[5] + v[5] * h)
+
+    def coefficients(self, k: int, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(scaling of (s, carrier frame), scaling of the modal coordinates, offset) of pin ``k``'s tie at the
+        carrier angle ``theta`` [rad] (class docstring; Exudyn's equation: scaling1 q - scaling0 (s, frame) -
+        offset = 0, both markers measuring reference plus displacement)."""
+        c, s = np.cos(theta), np.sin(theta)
+        r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ self.points[k]
+        const, cos_part, sin_part = self.forms[k]
+        offset = -np.concatenate([r + theta * np.array([r[1], -r[0], 0.0]), np.zeros(3)])
+        return np.hstack([np.eye(6), -frame_rows(r)]), const + c * cos_part + s * sin_part, offset
+
+    def __call__(self, mbs, t: float) -> bool:
+        theta = self.angle(mbs, t)
+        set_parameter = mbs.SetObjectParameter
+        for k, tie in enumerate(self.ties):
+            scaling0, scaling1, offset = self.coefficients(k, theta)
+            set_parameter(tie, "scalingMarker0", scaling0)
+            set_parameter(tie, "scalingMarker1", scaling1)
+            set_parameter(tie, "offset", offset)
         return True

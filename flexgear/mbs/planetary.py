@@ -44,7 +44,7 @@ from flexgear.design import Design, as_design
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
-from flexgear.mbs.carrier import Carrier, add_planet_bearing
+from flexgear.mbs.carrier import Carrier, add_pin_bearing, add_planet_bearing
 from flexgear.mbs.elements import (
     add_fixed_joint,
     add_interface_joint,
@@ -61,10 +61,10 @@ from flexgear.mbs.gearbox import (
     joint_axes,
     mesh_contacts,
 )
-from flexgear.mbs.joints import LinearInterfaceJoint, LinearSeat, TurningBlocks
+from flexgear.mbs.joints import CarrierPins, LinearInterfaceJoint, LinearSeat, TurningBlocks
 from flexgear.mbs.spin import SpinSchedule
 from flexgear.mbs.train import add_gear_train
-from flexgear.spec import GearboxSpec, Variant
+from flexgear.spec import CARRIER, GearboxSpec, Variant
 
 __all__ = ["build_planetary_gearbox", "carrier_mass_properties"]
 
@@ -83,6 +83,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     (spec, component) -> MassProperties overrides the variant's rigid mass properties, ``reduced_source`` (spec,
     component, level) its reduced bodies, ``superelements`` whether every flexible body keeps its
     ``ObjectFFRFreducedOrder`` (for recorded states), as in flexgear.mbs.assemble.build_gearbox."""
+    from flexgear.fe.carrier import SEAT, pin_interface
     from flexgear.fe.reduced import BOLT_PATCHES, gear_shaft_joints, joint_point
 
     d = as_design(variant.gearbox if design is None else design)
@@ -134,22 +135,38 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         join(sun, input_end, found, 1.0, "joint_sun_input_shaft")
     ring_joints = [FixedJointElement("ring", gi, "housing", si, p) for gi, si, p in gear_shaft_joints(d, "ring")]
     ring = component("ring", "ring", np.zeros(3), 0.0, joints={j.interface: j.point for j in ring_joints})
-    if form["output_shaft"] == "rigid":  # one rigid body with the carrier
+    places = [geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0]) for psi in geo.planet_angles]
+    names = [f"planet{i + 1}" for i in range(len(places))]
+    bearings = [replace(supports["planet"].on(name), other="carrier") for name in names]
+    pins = [pin_interface(i) for i in range(len(places))]
+    point = joint_point(d, "ring")  # the output shaft's flange: where the star bolts the ring to it
+    if form.get(CARRIER, "rigid") == "flexible":  # its seat on the output shaft, the planets' bearings on its pins
+        carrier = add_component(
+            mbs, "carrier", "flexible", CARRIER, np.zeros(3), spec, level, props, reduced, joints={SEAT: point},
+            spin_rad_s=th.output_speed, superelement=superelements,
+            bearing_points={pin: [place + sp.point for sp in b.axis_springs()]
+                            for pin, place, b in zip(pins, places, bearings, strict=True)})
+        if form["output_shaft"] == "rigid":
+            output_end = add_rigid_body(mbs, "output_shaft", props(spec, "output_shaft"), np.zeros(3))
+        else:
+            output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
+                                   joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
+        shafts.append(output_end)
+        join(output_end, carrier, [FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", SEAT, point)], ratio,
+             "joint_output_shaft_carrier")
+    elif form["output_shaft"] == "rigid":  # one rigid body with the carrier
         carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
                                                                          props(spec, "output_shaft")), np.zeros(3))
         output_end = carrier
     else:  # bolted to the carrier at its bolts' clamped discs (where the star bolts the ring's flange to it)
         carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(spec), np.zeros(3))
-        point = joint_point(d, "ring")
         joint = FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", "carrier", point)
         output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
                                joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
         shafts.append(output_end)
         join(output_end, carrier, [joint], ratio, "joint_output_shaft_carrier")
-    planets = []
-    for i, psi in enumerate(geo.planet_angles):
-        pos = geo.centre_distance * np.array([math.cos(psi), math.sin(psi), 0.0])
-        planets.append(component(f"planet{i + 1}", "planet", pos, th.planet_speed, support=supports["planet"]))
+    planets = [component(name, "planet", place, th.planet_speed, support=supports["planet"])
+               for name, place in zip(names, places, strict=True)]
     bodies: list[Body] = [sun, ring, carrier, *planets]
     if ring.flexible:  # held at its bolts' clamped discs by the housing
         housing = add_rigid_body(mbs, "housing", props(spec, "ring"), np.zeros(3))
@@ -157,15 +174,23 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         join(ring, housing, ring_joints, 0.0, "joint_ring_housing")
     else:
         add_fixed_joint(mbs, ring, name="ring_housing")
-    seat_nodes = {}
-    for planet in planets:
-        bearing = replace(supports["planet"].on(planet.name), other="carrier")
-        if planet.flexible and reference:  # springs on the bore's point markers, the pins' points on the carrier
-            add_support(mbs, planet, bearing, other=carrier)
+    seat_nodes, pin_nodes = {}, {}
+    extra = []
+    if carrier.flexible and not reference:  # each pin's motion on a node of its own
+        carrier_pins = CarrierPins(mbs, carrier, pins, ratio, lc.ramp_time_s, lc.input_speed_rad_s)
+        pin_nodes = dict(zip(pins, carrier_pins.nodes, strict=True))
+        extra.append(carrier_pins)
+    for planet, bearing, pin in zip(planets, bearings, pins, strict=True):
+        if reference and (planet.flexible or carrier.flexible):  # springs on the bore's and the pin's points
+            add_support(mbs, planet, bearing, other=carrier, other_interface=pin if carrier.flexible else None)
         elif planet.flexible:
-            seat = LinearSeat(mbs, planet, bearing, th.planet_speed / th.input_speed, carrier=carrier)
+            seat = LinearSeat(mbs, planet, bearing, th.planet_speed / th.input_speed, carrier=carrier,
+                              pin_node=pin_nodes.get(pin))
             turning += seat.turning()
             seat_nodes[planet.name] = seat.node
+        elif pin in pin_nodes:
+            add_pin_bearing(mbs, carrier, planet.node, planet.position, bearing.at(np.zeros(3)),
+                            f"bearing_{planet.name}", pin_node=pin_nodes[pin])
         else:
             add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
                                                                                  other="carrier"))
@@ -174,7 +199,6 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
             turning += LinearSeat(mbs, end, supports[key].on(end.name), spin).turning()
         else:
             add_support(mbs, end, supports[key].on(end.name))
-    extra = []
     if turning:
         extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
     linear = [b for b in [*bodies, *shafts] if getattr(b, "spin", None) is not None]
@@ -198,4 +222,4 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     return GearboxModel(d, {b.name: b for b in [*bodies, *shafts]}, outer, inner, drive, load, contacts,
                         train.friction, train.kinematics, tuple(train.aux_nodes), input_end.name, output_end.name,
                         joints, spin_out[1:], linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
-                        carrier_seat_nodes=seat_nodes)
+                        carrier_seat_nodes=seat_nodes, carrier_pin_nodes=pin_nodes)

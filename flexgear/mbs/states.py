@@ -36,7 +36,9 @@ def state_bodies(model: GearboxModel) -> dict[str, dict]:
     for name, body in model.bodies.items():
         if name.startswith("planet"):
             geometries = ["planet"]
-        elif name == "carrier":  # not a component: it carries the output shaft's geometry where merged with it
+        elif name == "carrier" and body.flexible:
+            geometries = ["carrier"]
+        elif name == "carrier":  # rigid: it carries the output shaft's geometry where merged with it
             geometries = ["output_shaft"] if "output_shaft" not in model.bodies else []
         elif planetary and name == "ring":  # held by the housing: never merged or tied with the output shaft
             geometries = ["ring"]

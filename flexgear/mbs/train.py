@@ -113,9 +113,9 @@ def add_gear_train(mbs, bodies: list[Body], elements: list, contacts: list[GearC
 
     ``ramp_time`` [s] and ``drive_speed`` [rad/s]: the prescribed STEP speed ramp whose angle
     (flexgear.mbs.contacts.drive_angle) drives the mesh phase. ``friction``: add tooth friction for
-    contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; the carrier body rigid): the contacts'
-    geometry turns with it (flexgear.mbs.carrier), and the flexible gears' material angles under the contacts follow
-    their spin relative to it (:func:`modal_columns`).
+    contacts with mu > 0. ``carrier``: a rotating carrier (planetary stage; the carrier rigid or flexible): the
+    contacts' geometry turns with it (flexgear.mbs.carrier), and the flexible gears' material angles under the
+    contacts follow their spin relative to it (:func:`modal_columns`).
     Flexible gears: ``contact_fourier_order`` harmonics fit their mode shapes round the contact circle,
     from mesh nodes within ``radial_band`` [m] of it (required then; about one normal module, half the
     tooth height). ``extra_pre_steps``: further pre-step callables (mbs, t) -> bool, run first.
