@@ -94,8 +94,8 @@ def test_bad_variant(tmp_path):
     bad = good.replace('sun = "rigid"', 'sun = "elastic"')
     with pytest.raises(SpecError, match=r"'components.sun': expected one of 'rigid', 'flexible'"):
         load_variant(_write(tmp_path, bad, "v.toml"))
-    with pytest.raises(SpecError, match="'components.carrier': unknown component"):
-        load_variant(_write(tmp_path, good + 'carrier = "rigid"\n', "v.toml"))
+    with pytest.raises(SpecError, match="'components.housing': unknown component"):
+        load_variant(_write(tmp_path, good + 'housing = "rigid"\n', "v.toml"))
     with pytest.raises(SpecError, match="file does not exist"):
         load_variant(_write(tmp_path, good.replace("gearbox.toml", "nope.toml"), "v.toml"))
 
@@ -133,3 +133,26 @@ def test_quick_variants_match_table3():
         full = load_variant(VARIANTS / f"model{n}.toml")
         # quick: 0.2 s, long enough after its 0.02 s ramps for a settled window (flexgear.study.indicators)
         assert quick.components == full.components and quick.gearbox.load_case.end_time_s <= 0.2
+
+
+def test_the_carrier_is_an_optional_component_flexible_only_where_it_turns(tmp_path):
+    """``[components] carrier``: optional (rigid when left out, as Table 3's files do); "flexible" in the planetary
+    arrangement only, refused in one line naming the field elsewhere (the star holds its carrier)."""
+    from flexgear.simulation import Simulation
+
+    text = (VARIANTS / "model7.toml").read_text().replace("gearbox = \"gearbox.toml\"",
+                                                         f"gearbox = \"{VARIANTS / 'gearbox.toml'}\"")
+    assert "carrier" not in load_variant(VARIANTS / "model7.toml").components
+    path = tmp_path / "v.toml"
+    path.write_text(text + 'carrier = "rigid"\n')
+    assert load_variant(path).components["carrier"] == "rigid"
+    path.write_text(text + 'carrier = "flexible"\n')
+    with pytest.raises(SpecError, match=r"components\.carrier.*arrangement = 'planetary'") as err:
+        load_variant(path)
+    assert "\n" not in str(err.value)
+    planetary = Path(__file__).resolve().parents[1] / "examples" / "spur_planetary"
+    assert load_variant(planetary / "flexible.toml").components["carrier"] == "flexible"
+    sim = Simulation.from_gearbox(planetary / "gearbox.toml", flexible=["carrier"])
+    assert sim.variant.components["carrier"] == "flexible" and sim.variant.components["sun"] == "rigid"
+    with pytest.raises(SpecError, match=r"components\.carrier"):
+        Simulation.from_gearbox(VARIANTS / "gearbox.toml", flexible=["carrier"])

@@ -49,7 +49,6 @@ from numba import njit
 
 from flexgear.geometry.elements import BearingElement, FixedJointElement
 from flexgear.laws.compiled import bound_entry, ramp_state, turn_columns
-from flexgear.laws.ramps import drive_angle
 from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_point, resting_node, zero_user_jacobian
 
 _ON_AXIS_M = 1e-9
@@ -334,9 +333,9 @@ class CarrierPins:
     """The pins of a flexible planet carrier, each on a rigid-body node whose coordinates are the pin's motion: the
     planets' bearings act on them (flexgear.mbs.carrier.add_pin_bearing with ``pin_node``).
 
-    The carrier (flexible ``carrier``, its frame on the axis at c_0) turns at ``spin_per_drive_angle`` times the
-    prescribed drive angle; theta is its angle at the end of each step, predicted from its spin coordinate and rate
-    at the step's start (:meth:`angle`). Pin k's RBE3 interface ``interfaces[k]`` has its point p_k
+    The carrier (flexible ``carrier``, its frame on the axis at c_0) turns; theta is its angle at the end of each
+    step, predicted from its spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the
+    longest step the integrator takes). Pin k's RBE3 interface ``interfaces[k]`` has its point p_k
     [m, carrier frame] off the axis, so, to first order in the frame's translation u, its small rotation
     (phi - theta e_z) and the modal coordinates q (module docstring), with r = R_z(theta) p_k,
 
@@ -357,8 +356,7 @@ class CarrierPins:
     leaves the change of that wind-up within one step.
     """
 
-    def __init__(self, mbs, carrier: Body, interfaces: list[str], spin_per_drive_angle: float, ramp_time: float,
-                 drive_speed: float):
+    def __init__(self, mbs, carrier: Body, interfaces: list[str], max_step_s: float):
         from exudyn.itemInterface import (
             MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
@@ -369,8 +367,7 @@ class CarrierPins:
 
         if not carrier.flexible:
             raise ValueError(f"CarrierPins: carrier {carrier.name!r} is rigid (its pins are points of the body)")
-        self.spin, self.ramp_time, self.drive_speed = float(spin_per_drive_angle), float(ramp_time), float(drive_speed)
-        self.carrier_node, self._last = carrier.node, None
+        self.carrier_node, self.max_step_s = carrier.node, float(max_step_s)
         self.points, self.forms, self.nodes, self.ties = [], [], [], []
         for name in interfaces:
             p = np.array(carrier.reduced.interface(name).point, float)
@@ -392,22 +389,18 @@ class CarrierPins:
                 markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
                 scalingMarker0=scaling0, scalingMarker1=scaling1, offset=offset)))
 
-    def theta(self, t: float) -> float:
-        """Nominal carrier angle [rad] at time ``t`` [s]."""
-        return self.spin * float(drive_angle(t, self.ramp_time, self.drive_speed))
-
     def angle(self, mbs, t: float) -> float:
         """The carrier's angle [rad] at the end of the step to time ``t`` [s], predicted from its state at the step's
-        start (its spin coordinate and rate, the previous call's time; the nominal angle before any state)."""
+        start: its spin coordinate plus its rate times the step h = t - the start's time. Outside a time step (a
+        static solve at ``t``, or no step 0 < h <= ``max_step_s``) the spin coordinate as it is."""
         import exudyn as exu
 
-        if self._last is None:
-            self._last = t
-            return self.theta(t)
-        q = mbs.GetNodeOutput(self.carrier_node, exu.OutputVariableType.Coordinates)
-        v = mbs.GetNodeOutput(self.carrier_node, exu.OutputVariableType.Coordinates_t)
-        h, self._last = t - self._last, t
-        return float(q[5] + v[5] * h)
+        ovt = exu.OutputVariableType
+        angle = float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates)[5])
+        h = t - mbs.systemData.GetTime(exu.ConfigurationType.StartOfStep)
+        if 0.0 < h <= self.max_step_s:
+            angle += float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates_t)[5]) * h
+        return angle
 
     def coefficients(self, k: int, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """(scaling of (s, carrier frame), scaling of the modal coordinates, offset) of pin ``k``'s tie at the

@@ -68,6 +68,10 @@ from flexgear.spec import CARRIER, GearboxSpec, Variant
 
 __all__ = ["build_planetary_gearbox", "carrier_mass_properties"]
 
+PIN_STEPS = 10
+"""A flexible carrier's pins predict its angle over a time step up to this many load-case steps long
+(flexgear.mbs.joints.CarrierPins: a longer "step" is a static solve)."""
+
 
 def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
     """The carrier as a disc: mass m and polar inertia J of ``[lumped_assumed]``, transverse J / 2, centred."""
@@ -177,7 +181,7 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     seat_nodes, pin_nodes = {}, {}
     extra = []
     if carrier.flexible and not reference:  # each pin's motion on a node of its own
-        carrier_pins = CarrierPins(mbs, carrier, pins, ratio, lc.ramp_time_s, lc.input_speed_rad_s)
+        carrier_pins = CarrierPins(mbs, carrier, pins, PIN_STEPS * lc.step_size_s)
         pin_nodes = dict(zip(pins, carrier_pins.nodes, strict=True))
         extra.append(carrier_pins)
     for planet, bearing, pin in zip(planets, bearings, pins, strict=True):

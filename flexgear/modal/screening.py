@@ -44,7 +44,7 @@ import numpy as np
 import pandas as pd
 
 from flexgear.modal import LinearModel, Modes
-from flexgear.schema import Variant
+from flexgear.schema import OPTIONAL_COMPONENTS, Variant
 
 __all__ = ["ModalScreening", "modal_screening", "amplification", "THRESHOLD", "TABLE3_COMPONENTS"]
 
@@ -79,10 +79,11 @@ def _table3_component(component: str) -> str:
 class ModalScreening:
     """The screening's result (module docstring).
 
-    ``table``: component (Table 3's), weighted_elastic_strain_share [-], must_be_flexible; ``recommended``: the
-    recommended variant's name; ``reason``: one line; ``modes``: the modes of the band; ``weighted``: the indices
-    of those with a resonance peak, ``weights``: their w_j; ``f_mesh_hz``, ``f_band_hz`` [Hz], ``threshold`` [-];
-    ``candidates``: Table 3's variants {name: flexible components}.
+    ``table``: component (Table 3's, and the planetary stage's carrier where it is flexible),
+    weighted_elastic_strain_share [-], must_be_flexible; ``recommended``: the recommended variant's name;
+    ``reason``: one line; ``modes``: the modes of the band; ``weighted``: the indices of those with a resonance
+    peak, ``weights``: their w_j; ``f_mesh_hz``, ``f_band_hz`` [Hz], ``threshold`` [-]; ``candidates``: Table 3's
+    variants {name: flexible components}.
     """
 
     table: pd.DataFrame
@@ -107,12 +108,13 @@ class ModalScreening:
         out = pd.DataFrame({"mode": np.asarray(self.weighted) + 1, "frequency_hz": f, "damping_ratio": zeta,
                             "kind": [self.modes.kinds[i] for i in self.weighted], "harmonic": a.argmax(axis=1) + 1,
                             "weight": self.weights})
-        for c in TABLE3_COMPONENTS:
+        screened = tuple(self.table.component)
+        for c in screened:
             out[f"share_{c}"] = 0.0
         for column in self.modes.energy.columns:
             if column.startswith("strain_") and column.endswith("_elastic"):
                 c = _table3_component(column.removeprefix("strain_").removesuffix("_elastic"))
-                if c in TABLE3_COMPONENTS:
+                if c in screened:
                     out[f"share_{c}"] += self.modes.energy[column].to_numpy()[self.weighted]
         return out
 
@@ -126,7 +128,7 @@ def table3_variants(folder: Path) -> dict[str, tuple[str, ...]]:
     out = {}
     for path in files:
         v = load_variant(path)
-        out[v.name] = tuple(c for c in TABLE3_COMPONENTS if v.components.get(c) == "flexible")
+        out[v.name] = tuple(c for c in (*TABLE3_COMPONENTS, *OPTIONAL_COMPONENTS) if v.components.get(c) == "flexible")
     return out
 
 
@@ -170,7 +172,8 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     f, zeta = found.frequencies_hz[keep], found.damping_ratios[keep]
     weights = amplification(f, np.maximum(zeta, 0.0), f_mesh)
     weights = weights / weights.sum() if weights.size else weights
-    shares = dict.fromkeys(TABLE3_COMPONENTS, 0.0)
+    # Table 3's components, and an optional one (the planetary stage's carrier) where the model has it
+    shares = dict.fromkeys((*TABLE3_COMPONENTS, *(c for c in OPTIONAL_COMPONENTS if c in model.components)), 0.0)
     for c in model.components:
         column = f"strain_{c}_elastic"
         if column in found.energy:

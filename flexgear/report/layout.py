@@ -9,7 +9,7 @@ import pandas as pd
 from matplotlib.figure import Figure
 
 from flexgear.report.figures import draw_table, fmt
-from flexgear.spec import COMPONENTS
+from flexgear.spec import COMPONENTS, OPTIONAL_COMPONENTS
 
 __all__ = ["Page", "TABLE_LINES_PER_PAGE", "paginate", "text_block", "table_pages", "components_text", "colours"]
 
@@ -59,7 +59,7 @@ def table_pages(title: str, df: pd.DataFrame, wrap: dict[str, int], widths: list
 
 def components_text(meta: dict) -> str:
     comps = meta.get("components") or {}
-    flex = [c for c in COMPONENTS if comps.get(c) == "flexible"]
+    flex = [c for c in (*COMPONENTS, *OPTIONAL_COMPONENTS) if comps.get(c) == "flexible"]
     return "all rigid" if comps and not flex else ("flexible: " + ", ".join(flex) if flex else "–")
 
 

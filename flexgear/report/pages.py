@@ -35,7 +35,7 @@ from flexgear.report.figures import draw_table, fmt  # noqa: E402
 from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
 from flexgear.report.reading_pages import contact_reading_pages  # noqa: E402
 from flexgear.report.verdict_page import verdict_page  # noqa: E402
-from flexgear.spec import COMPONENTS  # noqa: E402
+from flexgear.spec import COMPONENTS, OPTIONAL_COMPONENTS  # noqa: E402
 
 __all__ = ["ReportData", "gather", "documented_assumptions", "build_report"]
 
@@ -197,13 +197,19 @@ _PROVENANCE_COLUMNS = ["run", "backend", "status", "created", "t_end [s]", "step
 
 
 def _variant_table(d: ReportData) -> pd.DataFrame:
-    rows = []
+    """Each run's components (Table 3's columns, and a column for an optional component such as the planetary
+    stage's carrier where any run names it: rigid where another leaves it out), status and reason."""
+    rows, optional = [], [c for c in OPTIONAL_COMPONENTS
+                          if any(c in (r.meta.get("components") or {}) for r in d.runs.values())]
     for name, r in d.runs.items():
         comps = r.meta.get("components") or {}
         rows.append({"variant": name, **{c.replace("_", " "): comps.get(c, "–") for c in COMPONENTS},
+                     **{c.replace("_", " "): comps.get(c, "rigid" if comps else "–") for c in optional},
                      "status": r.meta.get("status"), "simulated time [s]": r.meta.get("t_end_s"),
                      "reason": r.meta.get("reason") or ""})
-    return pd.DataFrame(rows, columns=_VARIANT_COLUMNS)
+    columns = _VARIANT_COLUMNS[:1 + len(COMPONENTS)] + [c.replace("_", " ") for c in optional] + \
+        _VARIANT_COLUMNS[1 + len(COMPONENTS):]
+    return pd.DataFrame(rows, columns=columns)
 
 
 def _provenance_pages(d: ReportData) -> list[Page]:
