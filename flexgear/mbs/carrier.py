@@ -5,8 +5,11 @@ other side) at the planet's frame origin, realised as an ``ObjectConnectorCartes
 ``MarkerBodyPosition`` at the pin on the carrier to the planet's frame node (radial stiffness in x, y, axial in
 z: the bearing is isotropic about the axis, so the carrier's spin does not matter), plus tilt springs between
 the planet's and the carrier's tilt coordinates (both ground-frame tilts for small tilts); the planet's spin
-relative to the carrier stays free. A flexible planet's bearing acts the same way at its bore: on the seat node of
-flexgear.mbs.joints.LinearSeat, whose coordinates are the bore's motion (:func:`add_pin_bearing`).
+relative to the carrier stays free (:func:`add_planet_bearing`, :func:`add_pin_bearing`: a rigid carrier, no
+per-step update). The planetary stage's builder (flexgear.mbs.planetary) realises the same element as every other
+bearing of its production formulation, flexgear.mbs.joints.linear_bearing, between the planet's frame (or a
+flexible planet's seat node, flexgear.mbs.joints.LinearSeat) and its pin's node (flexgear.mbs.joints.CarrierPins,
+for a rigid or a flexible carrier).
 
 Contacts (flexgear.mbs.contacts.GearContact) are linearised at the reference configuration, carrier
 angle 0. With the carrier at angle theta every contact's pitch point, normal and planet centre are
@@ -130,12 +133,12 @@ def add_planet_bearing(mbs, carrier: Body, planet: Body, bearing: BearingElement
                            name or f"bearing_{planet.name}")
 
 
-def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: BearingElement, name: str,
-                    pin_node: int | None = None) -> list[int]:
-    """A bearing between the rigid node ``node`` (a planet's frame, or a flexible planet's seat node,
-    flexgear.mbs.joints.LinearSeat) whose reference position is ``point`` [m, ground] and the pin of ``carrier``
-    there, the spin free. ``pin_node``: the pin's own rigid-body node, whose coordinates are the pin's motion (a
-    flexible carrier's, flexgear.mbs.joints.CarrierPins), in place of the point fixed in the rigid ``carrier``.
+def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: BearingElement, name: str
+                    ) -> list[int]:
+    """A bearing between the rigid node ``node`` (e.g. a planet's frame) whose reference position is ``point`` [m,
+    ground] and the pin of the rigid ``carrier`` there, the spin free: Exudyn's nonlinear connectors, no per-step
+    update (flexgear.mbs.planetary realises its planets' bearings as flexgear.mbs.joints.linear_bearing on the
+    pins' nodes of flexgear.mbs.joints.CarrierPins instead).
 
     ``bearing`` about ``point`` must be diag(k_r, k_r, k_a, k_t, k_t, 0) (ValueError otherwise). Translation: an
     ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries
@@ -153,19 +156,15 @@ def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: B
 
     k_r, k_a, k_t = bearing.axisymmetric_entries()
     d_r, d_a, d_t = bearing.axisymmetric_entries(bearing.damping)
-    if pin_node is None:
-        pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
-                                               localPosition=list(np.asarray(point, float) - carrier.position)))
-    else:
-        pin = mbs.AddMarker(MarkerNodePosition(nodeNumber=pin_node))
-    tilted = carrier.node if pin_node is None else pin_node
+    pin = mbs.AddMarker(MarkerBodyPosition(bodyNumber=carrier.obj,
+                                           localPosition=list(np.asarray(point, float) - carrier.position)))
     out = [mbs.AddObject(ObjectConnectorCartesianSpringDamper(
         name=name, markerNumbers=[pin, mbs.AddMarker(MarkerNodePosition(nodeNumber=node))],
         stiffness=[k_r, k_r, k_a], damping=[d_r, d_r, d_a]))]
     for axis in (3, 4):
         out.append(mbs.AddObject(ObjectConnectorCoordinateSpringDamper(
             name=f"{name}_tilt{axis - 2}",
-            markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=tilted, coordinate=axis)),
+            markerNumbers=[mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=carrier.node, coordinate=axis)),
                            mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))],
             stiffness=k_t, damping=d_t)))
     return out

@@ -108,15 +108,21 @@ def body_axes_form(form: tuple[np.ndarray, np.ndarray, np.ndarray]) -> tuple[np.
 
 
 def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np.ndarray,
-                   series_node: int | None = None) -> int:
+                   series_node: int | None = None, other_node: int | None = None) -> int:
     """A constant 6 x 6 ``stiffness`` and ``damping`` on the six coordinates of ``node`` to ground (one
     ``ObjectGenericODE2``, its Jacobian exact): a seat's bearing (:class:`LinearSeat`) or a rigid body's on its
     linear frame (:func:`add_frame_bearing`). ``series_node``: six more coordinates added to the bearing's
-    deflection, s + e (the seat's residual motion, flexgear.mbs.residual): [[K, K], [K, K]] on (s, e)."""
+    deflection, s + e (the seat's residual motion, flexgear.mbs.residual): [[K, K], [K, K]] on (s, e).
+    ``other_node``: the bearing's other side instead of ground (a planet's pin, :class:`CarrierPins`), a rigid-body
+    node at the same reference place: the deflection s - p, [[K, -K], [-K, K]] on (s, p). A bearing isotropic about
+    the axis (diag(k_r, k_r, k_a, k_t, k_t, 0)) acts so in ground axes whatever the turning of either side."""
     from exudyn.itemInterface import ObjectGenericODE2
 
-    nodes = [node] if series_node is None else [node, series_node]
-    k, d = (np.kron(np.ones((len(nodes), len(nodes))), a) for a in (stiffness, damping))
+    if series_node is not None and other_node is not None:
+        raise ValueError(f"{name}: a bearing in series with a residual acts to ground, not on another node")
+    nodes = [node] + [n for n in (series_node, other_node) if n is not None]
+    pattern = np.array([[1.0, -1.0], [-1.0, 1.0]]) if other_node is not None else np.ones((len(nodes), len(nodes)))
+    k, d = (np.kron(pattern, a) for a in (stiffness, damping))
     return mbs.AddObject(ObjectGenericODE2(name=name, nodeNumbers=nodes, stiffnessMatrix=matrix_container(k),
                                            dampingMatrix=matrix_container(d),
                                            jacobianUserFunction=zero_user_jacobian(6 * len(nodes))))
@@ -219,8 +225,8 @@ class LinearSeat:
     ``carrier``: the rigid body on the bearing's other side (``bearing.other``; a planet on its pin of a turning
     carrier) instead of ground: the seat coordinates are then those of a rigid-body node at the bearing centre
     (displacement from its reference place and rotation, the same six numbers) and the bearing a pin bearing on the
-    carrier (flexgear.mbs.carrier.add_pin_bearing); no residual then. ``pin_node``: with ``carrier`` flexible, the
-    node of the pin's motion (:class:`CarrierPins`) the bearing acts on.
+    carrier, on the node of its pin's motion ``pin_node`` (:class:`CarrierPins`, :func:`linear_bearing` with
+    ``other_node``); no residual then.
     """
 
     def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False,
@@ -235,9 +241,10 @@ class LinearSeat:
 
         if carrier is None:
             bearing.check_to_ground(body.name)
-        elif (bearing.body, bearing.other) != (body.name, carrier.name) or residual:
+        elif (bearing.body, bearing.other) != (body.name, carrier.name) or residual or pin_node is None:
             raise ValueError(f"bearing of {bearing.body!r} on {bearing.other!r} placed on {body.name!r} at "
-                             f"{carrier.name!r}{' with a residual' if residual else ''}")
+                             f"{carrier.name!r}{' with a residual' if residual else ''}"
+                             f"{' without its pin node' if pin_node is None else ''}")
         self.spin = float(spin_per_drive_angle)
         centre = np.array(bearing.centre)
         modal_nodes, self.rows = body.span(interface_rows(body, bearing.interface, centre))
@@ -246,12 +253,10 @@ class LinearSeat:
         self.residual_node = -1
         seat_ref = np.zeros(6)  # the seat node's reference coordinates (the markers measure reference + coordinates)
         if carrier is not None:
-            from flexgear.mbs.carrier import add_pin_bearing
-
             seat_ref[:3] = body.position + centre
             self.node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{body.name}_seat", referenceCoordinates=seat_ref))
-            add_pin_bearing(mbs, carrier, self.node, body.position + centre, bearing, f"bearing_{body.name}",
-                            pin_node=pin_node)
+            linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
+                           other_node=pin_node)
         else:
             self.node = resting_node(mbs, f"{body.name}_seat", 6)
             if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
@@ -330,8 +335,8 @@ class TurningBlocks:
 
 
 class CarrierPins:
-    """The pins of a flexible planet carrier, each on a rigid-body node whose coordinates are the pin's motion: the
-    planets' bearings act on them (flexgear.mbs.carrier.add_pin_bearing with ``pin_node``).
+    """The pins of a planet carrier, rigid or flexible, each on a rigid-body node whose coordinates are the pin's
+    motion: the planets' bearings act on them (:func:`linear_bearing` with ``other_node``).
 
     The carrier (flexible ``carrier``, its frame on the axis at c_0) turns; theta is its angle at the end of each
     step, predicted from its spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the
@@ -342,7 +347,8 @@ class CarrierPins:
         s_t = c_0 + u + r + (phi - theta e_z) x r + R_theta Psi_t q,     s_r = phi + R_theta Psi_r q
 
     (s_t the pin's position [m], s_r its rotation coordinates: ground tilts, the carrier's spin angle; Psi the
-    interface's RBE3 motion per modal coordinate). One ``ObjectConnectorCoordinateVector`` per pin ties the node
+    interface's RBE3 motion per modal coordinate; none for a rigid carrier, whose pins are ``points`` [m, carrier
+    frame]). One ``ObjectConnectorCoordinateVector`` per pin ties the node
     to the carrier: s = F(r) (c_0 + u, phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the
     turned pin) and o = -(r + theta r x e_z, 0). Its frame columns, its modal columns and its offset all turn
     with theta; the pre-step call rewrites them each step (the offset grows with theta: its theta r x e_z
@@ -356,37 +362,41 @@ class CarrierPins:
     leaves the change of that wind-up within one step.
     """
 
-    def __init__(self, mbs, carrier: Body, interfaces: list[str], max_step_s: float):
+    def __init__(self, mbs, carrier: Body, names: list[str], max_step_s: float, points: list | None = None):
         from exudyn.itemInterface import (
-            MarkerNodeCoordinates,
             MarkerObjectODE2Coordinates,
             NodeRigidBodyRxyz,
             ObjectConnectorCoordinateVector,
             ObjectGenericODE2,
         )
 
-        if not carrier.flexible:
-            raise ValueError(f"CarrierPins: carrier {carrier.name!r} is rigid (its pins are points of the body)")
+        if carrier.flexible == (points is not None):
+            raise ValueError(f"CarrierPins: carrier {carrier.name!r}: a flexible carrier's pins are its interfaces "
+                             "``names``, a rigid carrier's are ``points``")
         self.carrier_node, self.max_step_s = carrier.node, float(max_step_s)
         self.points, self.forms, self.nodes, self.ties = [], [], [], []
-        for name in interfaces:
-            p = np.array(carrier.reduced.interface(name).point, float)
-            modal_nodes, rows = carrier.span(interface_rows(carrier, name, p))
+        for k, name in enumerate(names):
+            if carrier.flexible:
+                p = np.array(carrier.reduced.interface(name).point, float)
+                modal_nodes, rows = carrier.span(interface_rows(carrier, name, p))
+            else:
+                p, modal_nodes, rows = np.asarray(points[k], float) - carrier.position, [], np.zeros((6, 0))
             node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
                                                  referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
-            span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_span", nodeNumbers=[node, carrier.node],
-                                                   jacobianUserFunction=zero_user_jacobian(12)))
-            modal = (MarkerNodeCoordinates(nodeNumber=modal_nodes[0]) if len(modal_nodes) == 1 else
-                     MarkerObjectODE2Coordinates(objectNumber=mbs.AddObject(ObjectGenericODE2(
-                         name=f"{carrier.name}_{name}_modes", nodeNumbers=modal_nodes,
-                         jacobianUserFunction=zero_user_jacobian(rows.shape[1])))))
+            # marker 0 the pin's node, marker 1 the carrier's frame and the modal coordinates the pin moves with
+            spanned = [carrier.node, *modal_nodes]
+            span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_span", nodeNumbers=spanned,
+                                                   jacobianUserFunction=zero_user_jacobian(6 + rows.shape[1])))
             self.points.append(p)
             self.forms.append(turning_form(rows))
             self.nodes.append(node)
             scaling0, scaling1, offset = self.coefficients(len(self.points) - 1, 0.0)
+            own = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_own", nodeNumbers=[node],
+                                                  jacobianUserFunction=zero_user_jacobian(6)))
             self.ties.append(mbs.AddObject(ObjectConnectorCoordinateVector(
                 name=f"{carrier.name}_{name}_tie",
-                markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
+                markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=own)),
+                               mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
                 scalingMarker0=scaling0, scalingMarker1=scaling1, offset=offset)))
 
     def angle(self, mbs, t: float) -> float:
@@ -403,14 +413,14 @@ class CarrierPins:
         return angle
 
     def coefficients(self, k: int, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(scaling of (s, carrier frame), scaling of the modal coordinates, offset) of pin ``k``'s tie at the
-        carrier angle ``theta`` [rad] (class docstring; Exudyn's equation: scaling1 q - scaling0 (s, frame) -
-        offset = 0, both markers measuring reference plus displacement)."""
+        """(scaling of s, scaling of (carrier frame, modal coordinates), offset) of pin ``k``'s tie at the carrier
+        angle ``theta`` [rad] (class docstring; Exudyn's equation: scaling1 (frame, q) - scaling0 s - offset = 0,
+        both markers measuring reference plus displacement)."""
         c, s = np.cos(theta), np.sin(theta)
         r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ self.points[k]
         const, cos_part, sin_part = self.forms[k]
         offset = -np.concatenate([r + theta * np.array([r[1], -r[0], 0.0]), np.zeros(3)])
-        return np.hstack([np.eye(6), -frame_rows(r)]), const + c * cos_part + s * sin_part, offset
+        return np.eye(6), np.hstack([frame_rows(r), const + c * cos_part + s * sin_part]), offset
 
     def __call__(self, mbs, t: float) -> bool:
         theta = self.angle(mbs, t)

@@ -7,20 +7,24 @@ shaft, which takes the output bearing and the load torque. Each contact's geomet
 (flexgear.mbs.carrier.CarrierKinematics); the planets' frames are absolute, so their orbit's Coriolis and
 centripetal terms come from the rigid-body equations themselves.
 
-Components. The carrier is not a component of the gearbox file: a rigid body whose mass and polar inertia are
-``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped model's, eq. 1-13; derived from the
-gear set when the file leaves them out, flexgear.sizing), its transverse inertia half the polar (a disc). Every
-component of the file is rigid or a reduced flexible body, as in the star (flexgear.mbs.gearbox.add_component):
+Components. The carrier is a component (``[components] carrier``, optional, rigid by default). Rigid, it is a body
+whose mass and polar inertia are ``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2`` (the lumped
+model's, eq. 1-13; derived from the gear set when the file leaves them out, flexgear.sizing), its transverse inertia
+half the polar (a disc); flexible, its reduced body (flexgear.fe.carrier), its seat bolted to the output shaft's
+flange. Every component of the file is rigid or a reduced flexible body, as in the star
+(flexgear.mbs.gearbox.add_component):
 
-- the output shaft: rigid, one rigid body with the carrier; flexible, bolted to the carrier at its bolts' clamped
-  discs (a fixed joint where the star bolts the ring's flange to it), the output bearing at its seat and the load
-  torque there;
+- the output shaft: rigid, one rigid body with a rigid carrier; flexible (or beside a flexible carrier), bolted to
+  the carrier at its bolts' clamped discs (a fixed joint where the star bolts the ring's flange to it), the output
+  bearing at its seat and the load torque there;
 - the sun and the input shaft: one rigid body when both are rigid, else two bodies and the linear fixed joint of
   the star (flexgear.mbs.joints.LinearInterfaceJoint); the input bearing at the shaft's seat;
-- a flexible planet: its bore's motion on a seat node, the bearing a pin bearing on the carrier
-  (flexgear.mbs.joints.LinearSeat with ``carrier``); the modal equations spin at the planet's absolute speed
-  (flexgear.mbs.spin). Its frame orbits, but its modes are mass-orthogonal to the rigid translations (mean axes),
-  so the orbit's uniform acceleration does not load them;
+- each planet's bearing: the one linear bearing element of the production formulation
+  (flexgear.mbs.joints.linear_bearing) between the planet's frame, or a flexible planet's seat node (its bore's
+  motion, flexgear.mbs.joints.LinearSeat with ``carrier``), and its pin's node (flexgear.mbs.joints.CarrierPins:
+  the pin's motion on the rigid or flexible carrier). A flexible planet's modal equations spin at its absolute speed
+  (flexgear.mbs.spin). Its frame orbits, but its modes are mass-orthogonal to the rigid translations (mean axes), so
+  the orbit's uniform acceleration does not load them;
 - the ring: rigid, held on all six frame coordinates; flexible, held at its bolts' clamped discs by a fixed joint
   to the housing (a rigid body held to ground);
 - the gears' contact columns follow each gear's spin relative to the carrier (flexgear.mbs.train.modal_columns).
@@ -29,8 +33,8 @@ Every mode of a flexible gear stays dynamic here (no residual compliance, flexge
 dropped modes would answer their bearing's reaction in axes that turn with the carrier, which that model does not
 hold. The reference formulation (``[solver_assumed] formulation = "reference"``) builds the same stage from Exudyn's
 nonlinear objects (``ObjectFFRFreducedOrder`` with its floating-frame terms, generic joints on interface markers,
-a flexible planet's bearing as spring-dampers between its bore's point markers and the carrier's pin points): the
-check of the production formulation on the turning carrier.
+every planet's bearing as spring-dampers between its bore's (or the rigid planet's) points and the carrier's pin
+points, flexgear.mbs.elements.add_support): the check of the production formulation on the turning carrier.
 """
 
 from __future__ import annotations
@@ -41,10 +45,10 @@ from dataclasses import replace
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.elements import BearingElement, FixedJointElement
+from flexgear.geometry.elements import FixedJointElement
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
-from flexgear.mbs.carrier import Carrier, add_pin_bearing, add_planet_bearing
+from flexgear.mbs.carrier import Carrier
 from flexgear.mbs.elements import (
     add_fixed_joint,
     add_interface_joint,
@@ -61,7 +65,7 @@ from flexgear.mbs.gearbox import (
     joint_axes,
     mesh_contacts,
 )
-from flexgear.mbs.joints import CarrierPins, LinearInterfaceJoint, LinearSeat, TurningBlocks
+from flexgear.mbs.joints import CarrierPins, LinearInterfaceJoint, LinearSeat, TurningBlocks, linear_bearing
 from flexgear.mbs.spin import SpinSchedule
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import CARRIER, GearboxSpec, Variant
@@ -180,24 +184,22 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
         add_fixed_joint(mbs, ring, name="ring_housing")
     seat_nodes, pin_nodes = {}, {}
     extra = []
-    if carrier.flexible and not reference:  # each pin's motion on a node of its own
-        carrier_pins = CarrierPins(mbs, carrier, pins, PIN_STEPS * lc.step_size_s)
+    if not reference:  # each pin's motion on a node of its own, the planet's bearing between it and the planet
+        carrier_pins = CarrierPins(mbs, carrier, pins, PIN_STEPS * lc.step_size_s,
+                                   None if carrier.flexible else places)
         pin_nodes = dict(zip(pins, carrier_pins.nodes, strict=True))
         extra.append(carrier_pins)
     for planet, bearing, pin in zip(planets, bearings, pins, strict=True):
-        if reference and (planet.flexible or carrier.flexible):  # springs on the bore's and the pin's points
+        if reference:  # springs on the bore's (or the rigid planet's) points and the pin's points
             add_support(mbs, planet, bearing, other=carrier, other_interface=pin if carrier.flexible else None)
         elif planet.flexible:
             seat = LinearSeat(mbs, planet, bearing, th.planet_speed / th.input_speed, carrier=carrier,
-                              pin_node=pin_nodes.get(pin))
+                              pin_node=pin_nodes[pin])
             turning += seat.turning()
             seat_nodes[planet.name] = seat.node
-        elif pin in pin_nodes:
-            add_pin_bearing(mbs, carrier, planet.node, planet.position, bearing.at(np.zeros(3)),
-                            f"bearing_{planet.name}", pin_node=pin_nodes[pin])
-        else:
-            add_planet_bearing(mbs, carrier, planet, BearingElement.from_bearing(spec.bearings.planet, planet.name,
-                                                                                 other="carrier"))
+        else:  # the bearing about the planet's centre, its frame's origin
+            linear_bearing(mbs, f"bearing_{planet.name}", planet.node, bearing.stiffness, bearing.damping,
+                           other_node=pin_nodes[pin])
     for end, key, spin in ((input_end, "input_shaft", 1.0), (output_end, "output_shaft", ratio)):  # shafts' seats
         if end.flexible and not reference:
             turning += LinearSeat(mbs, end, supports[key].on(end.name), spin).turning()
