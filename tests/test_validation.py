@@ -271,7 +271,7 @@ VARIANT_CASES = {
     "name_empty": ({"name": ""}, "name", ("non-empty",)),
     "component_unknown": ({"components.sun": "elastic"}, "components.sun", ("'rigid', 'flexible'",)),
     "component_missing": ({"components.ring": None}, "components.ring", ("missing",)),
-    "component_extra": ({"components.carrier": "rigid"}, "components.carrier", ("unknown component",)),
+    "component_extra": ({"components.housing": "rigid"}, "components.housing", ("unknown component",)),
     "mesh_level_unknown": ({"mesh_level": "fine"}, "mesh_level", ("coarse", "default")),
     "mass_source_unknown": ({"rigid_mass_properties": "cad"}, "rigid_mass_properties", ("'mesh', 'exact'",)),
     "unknown_key": ({"descripton": "x"}, "descripton", ("unknown field",)),
