@@ -338,22 +338,22 @@ class CarrierPins:
     """The pins of a planet carrier, rigid or flexible, each on a rigid-body node whose coordinates are the pin's
     motion: the planets' bearings act on them (:func:`linear_bearing` with ``other_node``).
 
-    The carrier (flexible ``carrier``, its frame on the axis at c_0) turns; theta is its angle at the end of each
-    step, predicted from its spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the
-    longest step the integrator takes). Pin k's RBE3 interface ``interfaces[k]`` has its point p_k
-    [m, carrier frame] off the axis, so, to first order in the frame's translation u, its small rotation
+    The carrier (its frame on the axis at c_0) turns; theta is its angle at the end of each step, predicted from its
+    spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the longest step the integrator
+    takes). Pin k (a flexible carrier's RBE3 interface ``names[k]``) has its point p_k [m, carrier frame] off the
+    axis, so, to first order in the frame's translation u, its small rotation
     (phi - theta e_z) and the modal coordinates q (module docstring), with r = R_z(theta) p_k,
 
         s_t = c_0 + u + r + (phi - theta e_z) x r + R_theta Psi_t q,     s_r = phi + R_theta Psi_r q
 
     (s_t the pin's position [m], s_r its rotation coordinates: ground tilts, the carrier's spin angle; Psi the
-    interface's RBE3 motion per modal coordinate; none for a rigid carrier, whose pins are ``points`` [m, carrier
-    frame]). One ``ObjectConnectorCoordinateVector`` per pin ties the node
-    to the carrier: s = F(r) (c_0 + u, phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the
-    turned pin) and o = -(r + theta r x e_z, 0). Its frame columns, its modal columns and its offset all turn
-    with theta; the pre-step call rewrites them each step (the offset grows with theta: its theta r x e_z
-    cancels the carrier's spin coordinate's own lever, phi_z r x e_z, to round-off). The multipliers are the
-    pin's reaction on the carrier, force [N] and moment [N m] in ground axes.
+    interface's RBE3 motion per modal coordinate; none for a rigid carrier, whose pins are ``points`` [m, ground]).
+    One ``ObjectConnectorCoordinateVector`` ties the pins' nodes, six rows each, to the carrier: s = F(r) (c_0 + u,
+    phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the turned pin) and o = -(r + theta r x e_z,
+    0). Its frame columns, its modal columns and its offset all turn with theta; the pre-step call rewrites them
+    each step (two parameters for all pins; the offset grows with theta: its theta r x e_z cancels the carrier's
+    spin coordinate's own lever, phi_z r x e_z, to round-off). The multipliers are the pins' reactions on the
+    carrier, force [N] and moment [N m] in ground axes.
 
     Why the actual angle, not the nominal one: the tie's lever r is frozen over a step, so its moment about the
     axis, (r x F)_z, is off by (phi_z - theta) a F_r for a pin force F with a radial part F_r (the planets'
@@ -374,30 +374,37 @@ class CarrierPins:
             raise ValueError(f"CarrierPins: carrier {carrier.name!r}: a flexible carrier's pins are its interfaces "
                              "``names``, a rigid carrier's are ``points``")
         self.carrier_node, self.max_step_s = carrier.node, float(max_step_s)
-        self.points, self.forms, self.nodes, self.ties = [], [], [], []
-        for k, name in enumerate(names):
-            if carrier.flexible:
-                p = np.array(carrier.reduced.interface(name).point, float)
-                modal_nodes, rows = carrier.span(interface_rows(carrier, name, p))
-            else:
-                p, modal_nodes, rows = np.asarray(points[k], float) - carrier.position, [], np.zeros((6, 0))
-            node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
-                                                 referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
-            # marker 0 the pin's node, marker 1 the carrier's frame and the modal coordinates the pin moves with
-            spanned = [carrier.node, *modal_nodes]
-            span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_span", nodeNumbers=spanned,
-                                                   jacobianUserFunction=zero_user_jacobian(6 + rows.shape[1])))
-            self.points.append(p)
-            self.forms.append(turning_form(rows))
-            self.nodes.append(node)
-            scaling0, scaling1, offset = self.coefficients(len(self.points) - 1, 0.0)
-            own = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_{name}_own", nodeNumbers=[node],
-                                                  jacobianUserFunction=zero_user_jacobian(6)))
-            self.ties.append(mbs.AddObject(ObjectConnectorCoordinateVector(
-                name=f"{carrier.name}_{name}_tie",
-                markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=own)),
-                               mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
-                scalingMarker0=scaling0, scalingMarker1=scaling1, offset=offset)))
+        n = len(names)
+        if carrier.flexible:
+            self.points = np.array([carrier.reduced.interface(name).point for name in names], float)
+            rows = [interface_rows(carrier, name, p) for name, p in zip(names, self.points, strict=True)]
+            modal_nodes = list(dict.fromkeys(node for r in rows for node in carrier.span(r)[0]))
+            columns = carrier.node_columns(modal_nodes)
+            modal = np.vstack([carrier.to_coordinates(r)[:, columns] for r in rows])
+        else:
+            self.points = np.asarray(points, float).reshape(n, 3) - carrier.position
+            modal_nodes, modal = [], np.zeros((6 * n, 0))
+        self.forms = turning_form_stacked(modal)
+        self.nodes = [mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
+                                                    referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
+                      for name, p in zip(names, self.points, strict=True)]
+        # marker 0 the pins' nodes, marker 1 the carrier's frame and the modal coordinates the pins move with
+        own = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_own", nodeNumbers=self.nodes,
+                                              jacobianUserFunction=zero_user_jacobian(6 * n)))
+        span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_span",
+                                               nodeNumbers=[carrier.node, *modal_nodes],
+                                               jacobianUserFunction=zero_user_jacobian(6 + modal.shape[1])))
+        self.scaling = np.zeros((6 * n, 6 + modal.shape[1]))
+        for k in range(n):
+            self.scaling[6 * k:6 * k + 6, :6] = np.eye(6)
+        self.offset = np.zeros(6 * n)
+        self.forms = tuple(np.ascontiguousarray(f) for f in self.forms)
+        scaling1, offset = self.coefficients(0.0)
+        self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
+            name=f"{carrier.name}_pins_tie",
+            markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=own)),
+                           mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
+            scalingMarker0=np.eye(6 * n), scalingMarker1=scaling1, offset=offset))
 
     def angle(self, mbs, t: float) -> float:
         """The carrier's angle [rad] at the end of the step to time ``t`` [s], predicted from its state at the step's
@@ -412,22 +419,45 @@ class CarrierPins:
             angle += float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates_t)[5]) * h
         return angle
 
-    def coefficients(self, k: int, theta: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """(scaling of s, scaling of (carrier frame, modal coordinates), offset) of pin ``k``'s tie at the carrier
-        angle ``theta`` [rad] (class docstring; Exudyn's equation: scaling1 (frame, q) - scaling0 s - offset = 0,
-        both markers measuring reference plus displacement)."""
-        c, s = np.cos(theta), np.sin(theta)
-        r = np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]]) @ self.points[k]
-        const, cos_part, sin_part = self.forms[k]
-        offset = -np.concatenate([r + theta * np.array([r[1], -r[0], 0.0]), np.zeros(3)])
-        return np.eye(6), np.hstack([frame_rows(r), const + c * cos_part + s * sin_part]), offset
+    def coefficients(self, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """(scaling of (carrier frame, modal coordinates), offset) of the pins' ties at the carrier angle ``theta``
+        [rad], six rows per pin (class docstring; Exudyn's equation: scaling1 (frame, q) - s - offset = 0, both
+        markers measuring reference plus displacement): buffers rewritten in place by one compiled call
+        (:func:`pin_coefficients`)."""
+        const, cos_part, sin_part = self.forms
+        pin_coefficients(float(theta), self.points, const, cos_part, sin_part, self.scaling, self.offset)
+        return self.scaling, self.offset
 
     def __call__(self, mbs, t: float) -> bool:
-        theta = self.angle(mbs, t)
-        set_parameter = mbs.SetObjectParameter
-        for k, tie in enumerate(self.ties):
-            scaling0, scaling1, offset = self.coefficients(k, theta)
-            set_parameter(tie, "scalingMarker0", scaling0)
-            set_parameter(tie, "scalingMarker1", scaling1)
-            set_parameter(tie, "offset", offset)
+        scaling, offset = self.coefficients(self.angle(mbs, t))
+        mbs.SetObjectParameter(self.obj, "scalingMarker1", scaling)
+        mbs.SetObjectParameter(self.obj, "offset", offset)
         return True
+
+
+@njit(cache=True)
+def pin_coefficients(theta, points, const, cos_part, sin_part, scaling, offset):  # pragma: no cover - compiled
+    """:meth:`CarrierPins.coefficients` in place: per pin k (rows 6 k ...), r = R_z(theta) p_k, the lever block -r~
+    of F(r) in ``scaling[:, 3:6]``, the modal block C + cos(theta) A + sin(theta) B in ``scaling[:, 6:]``, and
+    ``offset`` -(r + theta r x e_z, 0)."""
+    c, s = np.cos(theta), np.sin(theta)
+    for k in range(points.shape[0]):
+        x = c * points[k, 0] - s * points[k, 1]
+        y = s * points[k, 0] + c * points[k, 1]
+        z = points[k, 2]
+        i = 6 * k
+        scaling[i, 4], scaling[i, 5] = z, -y
+        scaling[i + 1, 3], scaling[i + 1, 5] = -z, x
+        scaling[i + 2, 3], scaling[i + 2, 4] = y, -x
+        offset[i], offset[i + 1], offset[i + 2] = -(x + theta * y), -(y - theta * x), -z
+    for i in range(const.shape[0]):
+        for j in range(const.shape[1]):
+            scaling[i, 6 + j] = const[i, j] + c * cos_part[i, j] + s * sin_part[i, j]
+
+
+def turning_form_stacked(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """:func:`turning_form` of rows stacked six by six ((6 k, w): translation and rotation rows of k points)."""
+    if rows.shape[1] == 0:
+        return rows, rows, rows
+    parts = [turning_form(rows[i:i + 6]) for i in range(0, rows.shape[0], 6)]
+    return tuple(np.vstack([f[k] for f in parts]) for k in range(3))
