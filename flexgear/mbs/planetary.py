@@ -73,7 +73,7 @@ from flexgear.spec import CARRIER, GearboxSpec, Variant
 __all__ = ["build_planetary_gearbox", "carrier_mass_properties"]
 
 PIN_STEPS = 10
-"""A flexible carrier's pins predict its angle over a time step up to this many load-case steps long
+"""The carrier's pins predict its angle over a time step up to this many load-case steps long
 (flexgear.mbs.joints.CarrierPins: a longer "step" is a static solve)."""
 
 

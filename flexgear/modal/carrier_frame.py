@@ -32,8 +32,8 @@ __all__ = ["frame_pairs", "orbit", "to_carrier_frame"]
 
 def frame_pairs(mbs, model) -> list[tuple[int, int]]:
     """The system coordinates of every body frame's (u_x, u_y) and (phi_x, phi_y) pairs of the built ``model``
-    (flexgear.mbs.gearbox.GearboxModel), those of the flexible planets' seat nodes on the carrier and those of a
-    flexible carrier's pins."""
+    (flexgear.mbs.gearbox.GearboxModel), those of the flexible planets' seat nodes on the carrier and those of the
+    carrier's pins' nodes."""
     out = []
     nodes = [*(b.node for b in model.bodies.values()), *model.carrier_seat_nodes.values(),
              *model.carrier_pin_nodes.values()]

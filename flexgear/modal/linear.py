@@ -299,7 +299,7 @@ def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3
                 j = mbs.GetNodeODE2Index(model.carrier_seat_nodes[name])
                 q0[j:j + 2], v0[j:j + 2] = q0[i:i + 2], v0[i:i + 2]
                 q0[j + 5], v0[j + 5] = q0[i + 5], v0[i + 5]
-    for node in model.carrier_pin_nodes.values():  # a flexible carrier's pins orbit and turn with it
+    for node in model.carrier_pin_nodes.values():  # the carrier's pins (their nodes) orbit and turn with it
         j = mbs.GetNodeODE2Index(node)
         q0[j:j + 2], v0[j:j + 2] = orbit(np.asarray(mbs.GetNode(node)["referenceCoordinates"][:3]), theta_c, omega_c)
         q0[j + 5], v0[j + 5] = theta_c, omega_c
