@@ -83,7 +83,7 @@ def _without_friction(tmp_path: Path, formulation: str = "production", flexible:
 
 def _bearing_sensors(mbs, model, planets: int) -> list[tuple[int, int]]:
     """Per planet: sensors of the coordinates of its bearing's two nodes, the planet's side (its frame, or a flexible
-    planet's seat node) and its pin's (flexgear.mbs.joints.CarrierPins), the bearing acting between them."""
+    planet's seat node) and its pin's (flexgear.mbs.carrier.CarrierPins), the bearing acting between them."""
     import exudyn as exu
     from exudyn.itemInterface import SensorNode
 

@@ -8,7 +8,7 @@ the planet's and the carrier's tilt coordinates (both ground-frame tilts for sma
 relative to the carrier stays free (:func:`add_planet_bearing`, :func:`add_pin_bearing`: a rigid carrier, no
 per-step update). The planetary stage's builder (flexgear.mbs.planetary) realises the same element as every other
 bearing of its production formulation, flexgear.mbs.joints.linear_bearing, between the planet's frame (or a
-flexible planet's seat node, flexgear.mbs.joints.LinearSeat) and its pin's node (flexgear.mbs.joints.CarrierPins,
+flexible planet's seat node, flexgear.mbs.joints.LinearSeat) and its pin's node (flexgear.mbs.carrier.CarrierPins,
 for a rigid or a flexible carrier).
 
 Contacts (flexgear.mbs.contacts.GearContact) are linearised at the reference configuration, carrier
@@ -35,12 +35,14 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from flexgear.geometry.elements import BearingElement
 from flexgear.laws.ramps import drive_angle
-from flexgear.mbs.bodies import Body
+from flexgear.mbs.bodies import Body, zero_user_jacobian
+from flexgear.mbs.joints import interface_rows, turning_form
 
-__all__ = ["Carrier", "CarrierKinematics", "add_pin_bearing", "add_planet_bearing"]
+__all__ = ["Carrier", "CarrierKinematics", "CarrierPins", "add_pin_bearing", "add_planet_bearing", "pin_coefficients"]
 
 
 @dataclass(frozen=True)
@@ -138,7 +140,7 @@ def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: B
     """A bearing between the rigid node ``node`` (e.g. a planet's frame) whose reference position is ``point`` [m,
     ground] and the pin of the rigid ``carrier`` there, the spin free: Exudyn's nonlinear connectors, no per-step
     update (flexgear.mbs.planetary realises its planets' bearings as flexgear.mbs.joints.linear_bearing on the
-    pins' nodes of flexgear.mbs.joints.CarrierPins instead).
+    pins' nodes of flexgear.mbs.carrier.CarrierPins instead).
 
     ``bearing`` about ``point`` must be diag(k_r, k_r, k_a, k_t, k_t, 0) (ValueError otherwise). Translation: an
     ``ObjectConnectorCartesianSpringDamper`` with stiffness (k_r, k_r, k_a) and the matching damping entries
@@ -168,3 +170,133 @@ def add_pin_bearing(mbs, carrier: Body, node: int, point: np.ndarray, bearing: B
                            mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node, coordinate=axis))],
             stiffness=k_t, damping=d_t)))
     return out
+
+
+class CarrierPins:
+    """The pins of a planet carrier, rigid or flexible, each on a rigid-body node whose coordinates are the pin's
+    motion: the planets' bearings act on them (flexgear.mbs.joints.linear_bearing with ``other_node``).
+
+    The carrier (its frame on the axis at c_0) turns; theta is its angle at the end of each step, predicted from its
+    spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the longest step the integrator
+    takes). Pin k (a flexible carrier's RBE3 interface ``names[k]``) has its point p_k [m, carrier frame] off the
+    axis, so, to first order in the frame's translation u, its small rotation
+    (phi - theta e_z) and the modal coordinates q (module docstring), with r = R_z(theta) p_k,
+
+        s_t = c_0 + u + r + (phi - theta e_z) x r + R_theta Psi_t q,     s_r = phi + R_theta Psi_r q
+
+    (s_t the pin's position [m], s_r its rotation coordinates: ground tilts, the carrier's spin angle; Psi the
+    interface's RBE3 motion per modal coordinate; none for a rigid carrier, whose pins are ``points`` [m, ground]).
+    One ``ObjectConnectorCoordinateVector`` ties the pins' nodes, six rows each, to the carrier: s = F(r) (c_0 + u,
+    phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the turned pin) and o = -(r + theta r x e_z,
+    0). Its frame columns, its modal columns and its offset all turn with theta; the pre-step call rewrites them
+    each step (two parameters for all pins; the offset grows with theta: its theta r x e_z cancels the carrier's
+    spin coordinate's own lever, phi_z r x e_z, to round-off). The multipliers are the pins' reactions on the
+    carrier, force [N] and moment [N m] in ground axes.
+
+    Why the actual angle, not the nominal one: the tie's lever r is frozen over a step, so its moment about the
+    axis, (r x F)_z, is off by (phi_z - theta) a F_r for a pin force F with a radial part F_r (the planets'
+    centripetal force) at the pin radius a: the nominal angle would leave the carrier's wind-up behind it (its pins'
+    own deflection, the shafts' torsion) as a first-order error of the torque the pins pass on; the predicted angle
+    leaves the change of that wind-up within one step.
+    """
+
+    def __init__(self, mbs, carrier: Body, names: list[str], max_step_s: float, points: list | None = None):
+        from exudyn.itemInterface import (
+            MarkerObjectODE2Coordinates,
+            NodeRigidBodyRxyz,
+            ObjectConnectorCoordinateVector,
+            ObjectGenericODE2,
+        )
+
+        if carrier.flexible == (points is not None):
+            raise ValueError(f"CarrierPins: carrier {carrier.name!r}: a flexible carrier's pins are its interfaces "
+                             "``names``, a rigid carrier's are ``points``")
+        self.carrier_node, self.max_step_s = carrier.node, float(max_step_s)
+        n = len(names)
+        if carrier.flexible:
+            self.points = np.array([carrier.reduced.interface(name).point for name in names], float)
+            rows = [interface_rows(carrier, name, p) for name, p in zip(names, self.points, strict=True)]
+            modal_nodes = list(dict.fromkeys(node for r in rows for node in carrier.span(r)[0]))
+            columns = carrier.node_columns(modal_nodes)
+            modal = np.vstack([carrier.to_coordinates(r)[:, columns] for r in rows])
+        else:
+            self.points = np.asarray(points, float).reshape(n, 3) - carrier.position
+            modal_nodes, modal = [], np.zeros((6 * n, 0))
+        self.forms = turning_form_stacked(modal)
+        self.nodes = [mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
+                                                    referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
+                      for name, p in zip(names, self.points, strict=True)]
+        # marker 0 the pins' nodes, marker 1 the carrier's frame and the modal coordinates the pins move with
+        own = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_own", nodeNumbers=self.nodes,
+                                              jacobianUserFunction=zero_user_jacobian(6 * n)))
+        span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_span",
+                                               nodeNumbers=[carrier.node, *modal_nodes],
+                                               jacobianUserFunction=zero_user_jacobian(6 + modal.shape[1])))
+        self.scaling = np.zeros((6 * n, 6 + modal.shape[1]))
+        for k in range(n):
+            self.scaling[6 * k:6 * k + 6, :6] = np.eye(6)
+        self.offset = np.zeros(6 * n)
+        self.forms = tuple(np.ascontiguousarray(f) for f in self.forms)
+        scaling1, offset = self.coefficients(0.0)
+        self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
+            name=f"{carrier.name}_pins_tie",
+            markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=own)),
+                           mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
+            scalingMarker0=np.eye(6 * n), scalingMarker1=scaling1, offset=offset))
+
+    def angle(self, mbs, t: float) -> float:
+        """The carrier's angle [rad] at the end of the step to time ``t`` [s], predicted from its state at the step's
+        start: its spin coordinate plus its rate times the step h = t - the start's time. Outside a time step (a
+        static solve at ``t``, or no step 0 < h <= ``max_step_s``) the spin coordinate as it is."""
+        import exudyn as exu
+
+        ovt = exu.OutputVariableType
+        angle = float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates)[5])
+        h = t - mbs.systemData.GetTime(exu.ConfigurationType.StartOfStep)
+        if 0.0 < h <= self.max_step_s:
+            angle += float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates_t)[5]) * h
+        return angle
+
+    def coefficients(self, theta: float) -> tuple[np.ndarray, np.ndarray]:
+        """(scaling of (carrier frame, modal coordinates), offset) of the pins' ties at the carrier angle ``theta``
+        [rad], six rows per pin (class docstring; Exudyn's equation: scaling1 (frame, q) - s - offset = 0, both
+        markers measuring reference plus displacement): buffers rewritten in place by one compiled call
+        (:func:`pin_coefficients`)."""
+        const, cos_part, sin_part = self.forms
+        pin_coefficients(float(theta), self.points, const, cos_part, sin_part, self.scaling, self.offset)
+        return self.scaling, self.offset
+
+    def __call__(self, mbs, t: float) -> bool:
+        scaling, offset = self.coefficients(self.angle(mbs, t))
+        mbs.SetObjectParameter(self.obj, "scalingMarker1", scaling)
+        mbs.SetObjectParameter(self.obj, "offset", offset)
+        return True
+
+
+@njit(cache=True)
+def pin_coefficients(theta, points, const, cos_part, sin_part, scaling, offset):  # pragma: no cover - compiled
+    """:meth:`CarrierPins.coefficients` in place: per pin k (rows 6 k ...), r = R_z(theta) p_k, the lever block -r~
+    of F(r) in ``scaling[:, 3:6]``, the modal block C + cos(theta) A + sin(theta) B in ``scaling[:, 6:]``, and
+    ``offset`` -(r + theta r x e_z, 0)."""
+    c, s = np.cos(theta), np.sin(theta)
+    for k in range(points.shape[0]):
+        x = c * points[k, 0] - s * points[k, 1]
+        y = s * points[k, 0] + c * points[k, 1]
+        z = points[k, 2]
+        i = 6 * k
+        scaling[i, 4], scaling[i, 5] = z, -y
+        scaling[i + 1, 3], scaling[i + 1, 5] = -z, x
+        scaling[i + 2, 3], scaling[i + 2, 4] = y, -x
+        offset[i], offset[i + 1], offset[i + 2] = -(x + theta * y), -(y - theta * x), -z
+    for i in range(const.shape[0]):
+        for j in range(const.shape[1]):
+            scaling[i, 6 + j] = const[i, j] + c * cos_part[i, j] + s * sin_part[i, j]
+
+
+def turning_form_stacked(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """flexgear.mbs.joints.turning_form of rows stacked six by six ((6 k, w): translation and rotation rows of k
+    points)."""
+    if rows.shape[1] == 0:
+        return rows, rows, rows
+    parts = [turning_form(rows[i:i + 6]) for i in range(0, rows.shape[0], 6)]
+    return tuple(np.vstack([f[k] for f in parts]) for k in range(3))

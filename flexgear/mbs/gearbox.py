@@ -74,7 +74,7 @@ class GearboxModel:
     seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
     # planet -> the rigid-body node of its seat on a turning carrier (flexgear.mbs.joints.LinearSeat): it orbits
     carrier_seat_nodes: dict[str, int] = field(default_factory=dict)
-    # pin interface -> the rigid-body node of the carrier's pin (flexgear.mbs.joints.CarrierPins): it orbits
+    # pin interface -> the rigid-body node of the carrier's pin (flexgear.mbs.carrier.CarrierPins): it orbits
     carrier_pin_nodes: dict[str, int] = field(default_factory=dict)
 
     @property

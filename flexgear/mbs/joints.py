@@ -54,7 +54,7 @@ from flexgear.mbs.bodies import Body, frame_rows, matrix_container, motion_at_po
 _ON_AXIS_M = 1e-9
 """A joint point within this distance [m] of the spin axis lies on it (the exact geometry places it there)."""
 
-__all__ = ["CarrierPins", "LinearInterfaceJoint", "LinearSeat", "TurningBlocks",
+__all__ = ["LinearInterfaceJoint", "LinearSeat", "TurningBlocks",
            "add_frame_bearing", "body_axes_form", "frame_form",
            "interface_rows", "linear_bearing", "turning_form"]
 
@@ -113,9 +113,10 @@ def linear_bearing(mbs, name: str, node: int, stiffness: np.ndarray, damping: np
     ``ObjectGenericODE2``, its Jacobian exact): a seat's bearing (:class:`LinearSeat`) or a rigid body's on its
     linear frame (:func:`add_frame_bearing`). ``series_node``: six more coordinates added to the bearing's
     deflection, s + e (the seat's residual motion, flexgear.mbs.residual): [[K, K], [K, K]] on (s, e).
-    ``other_node``: the bearing's other side instead of ground (a planet's pin, :class:`CarrierPins`), a rigid-body
-    node at the same reference place: the deflection s - p, [[K, -K], [-K, K]] on (s, p). A bearing isotropic about
-    the axis (diag(k_r, k_r, k_a, k_t, k_t, 0)) acts so in ground axes whatever the turning of either side."""
+    ``other_node``: the bearing's other side instead of ground (a planet's pin, flexgear.mbs.carrier.CarrierPins),
+    a rigid-body node at the same reference place: the deflection s - p, [[K, -K], [-K, K]] on (s, p). A bearing
+    isotropic about the axis (diag(k_r, k_r, k_a, k_t, k_t, 0)) acts so in ground axes whatever the turning of
+    either side."""
     from exudyn.itemInterface import ObjectGenericODE2
 
     if series_node is not None and other_node is not None:
@@ -222,11 +223,11 @@ class LinearSeat:
     seat coordinates; :meth:`turning` gives the block that a :class:`TurningBlocks` pre-step function turns.
     ``residual``: the seat coordinates are the kept motion plus six more, ``residual_node``, the dropped modes'
     seat motion e_s (flexgear.mbs.residual: the bearing acts on the seat in series with it).
-    ``carrier``: the rigid body on the bearing's other side (``bearing.other``; a planet on its pin of a turning
-    carrier) instead of ground: the seat coordinates are then those of a rigid-body node at the bearing centre
-    (displacement from its reference place and rotation, the same six numbers) and the bearing a pin bearing on the
-    carrier, on the node of its pin's motion ``pin_node`` (:class:`CarrierPins`, :func:`linear_bearing` with
-    ``other_node``); no residual then.
+    ``carrier``: the carrier, rigid or flexible, on the bearing's other side (``bearing.other``; a planet on its pin
+    of a turning carrier) instead of ground: the seat coordinates are then those of a rigid-body node at the
+    bearing centre (displacement from its reference place and rotation, the same six numbers) and the bearing acts
+    between it and the node of its pin's motion ``pin_node`` (flexgear.mbs.carrier.CarrierPins,
+    :func:`linear_bearing` with ``other_node``); no residual then.
     """
 
     def __init__(self, mbs, body: Body, bearing: BearingElement, spin_per_drive_angle: float, residual: bool = False,
@@ -332,132 +333,3 @@ class TurningBlocks:
         for obj, param, matrix in self.items:
             set_parameter(obj, param, matrix)
         return True
-
-
-class CarrierPins:
-    """The pins of a planet carrier, rigid or flexible, each on a rigid-body node whose coordinates are the pin's
-    motion: the planets' bearings act on them (:func:`linear_bearing` with ``other_node``).
-
-    The carrier (its frame on the axis at c_0) turns; theta is its angle at the end of each step, predicted from its
-    spin coordinate and rate at the step's start (:meth:`angle`; ``max_step_s`` [s] the longest step the integrator
-    takes). Pin k (a flexible carrier's RBE3 interface ``names[k]``) has its point p_k [m, carrier frame] off the
-    axis, so, to first order in the frame's translation u, its small rotation
-    (phi - theta e_z) and the modal coordinates q (module docstring), with r = R_z(theta) p_k,
-
-        s_t = c_0 + u + r + (phi - theta e_z) x r + R_theta Psi_t q,     s_r = phi + R_theta Psi_r q
-
-    (s_t the pin's position [m], s_r its rotation coordinates: ground tilts, the carrier's spin angle; Psi the
-    interface's RBE3 motion per modal coordinate; none for a rigid carrier, whose pins are ``points`` [m, ground]).
-    One ``ObjectConnectorCoordinateVector`` ties the pins' nodes, six rows each, to the carrier: s = F(r) (c_0 + u,
-    phi) + R_theta Psi q - o with F(r) = [I, -r~; 0, I] (the lever to the turned pin) and o = -(r + theta r x e_z,
-    0). Its frame columns, its modal columns and its offset all turn with theta; the pre-step call rewrites them
-    each step (two parameters for all pins; the offset grows with theta: its theta r x e_z cancels the carrier's
-    spin coordinate's own lever, phi_z r x e_z, to round-off). The multipliers are the pins' reactions on the
-    carrier, force [N] and moment [N m] in ground axes.
-
-    Why the actual angle, not the nominal one: the tie's lever r is frozen over a step, so its moment about the
-    axis, (r x F)_z, is off by (phi_z - theta) a F_r for a pin force F with a radial part F_r (the planets'
-    centripetal force) at the pin radius a: the nominal angle would leave the carrier's wind-up behind it (its pins'
-    own deflection, the shafts' torsion) as a first-order error of the torque the pins pass on; the predicted angle
-    leaves the change of that wind-up within one step.
-    """
-
-    def __init__(self, mbs, carrier: Body, names: list[str], max_step_s: float, points: list | None = None):
-        from exudyn.itemInterface import (
-            MarkerObjectODE2Coordinates,
-            NodeRigidBodyRxyz,
-            ObjectConnectorCoordinateVector,
-            ObjectGenericODE2,
-        )
-
-        if carrier.flexible == (points is not None):
-            raise ValueError(f"CarrierPins: carrier {carrier.name!r}: a flexible carrier's pins are its interfaces "
-                             "``names``, a rigid carrier's are ``points``")
-        self.carrier_node, self.max_step_s = carrier.node, float(max_step_s)
-        n = len(names)
-        if carrier.flexible:
-            self.points = np.array([carrier.reduced.interface(name).point for name in names], float)
-            rows = [interface_rows(carrier, name, p) for name, p in zip(names, self.points, strict=True)]
-            modal_nodes = list(dict.fromkeys(node for r in rows for node in carrier.span(r)[0]))
-            columns = carrier.node_columns(modal_nodes)
-            modal = np.vstack([carrier.to_coordinates(r)[:, columns] for r in rows])
-        else:
-            self.points = np.asarray(points, float).reshape(n, 3) - carrier.position
-            modal_nodes, modal = [], np.zeros((6 * n, 0))
-        self.forms = turning_form_stacked(modal)
-        self.nodes = [mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
-                                                    referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
-                      for name, p in zip(names, self.points, strict=True)]
-        # marker 0 the pins' nodes, marker 1 the carrier's frame and the modal coordinates the pins move with
-        own = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_own", nodeNumbers=self.nodes,
-                                              jacobianUserFunction=zero_user_jacobian(6 * n)))
-        span = mbs.AddObject(ObjectGenericODE2(name=f"{carrier.name}_pins_span",
-                                               nodeNumbers=[carrier.node, *modal_nodes],
-                                               jacobianUserFunction=zero_user_jacobian(6 + modal.shape[1])))
-        self.scaling = np.zeros((6 * n, 6 + modal.shape[1]))
-        for k in range(n):
-            self.scaling[6 * k:6 * k + 6, :6] = np.eye(6)
-        self.offset = np.zeros(6 * n)
-        self.forms = tuple(np.ascontiguousarray(f) for f in self.forms)
-        scaling1, offset = self.coefficients(0.0)
-        self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
-            name=f"{carrier.name}_pins_tie",
-            markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=own)),
-                           mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span))],
-            scalingMarker0=np.eye(6 * n), scalingMarker1=scaling1, offset=offset))
-
-    def angle(self, mbs, t: float) -> float:
-        """The carrier's angle [rad] at the end of the step to time ``t`` [s], predicted from its state at the step's
-        start: its spin coordinate plus its rate times the step h = t - the start's time. Outside a time step (a
-        static solve at ``t``, or no step 0 < h <= ``max_step_s``) the spin coordinate as it is."""
-        import exudyn as exu
-
-        ovt = exu.OutputVariableType
-        angle = float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates)[5])
-        h = t - mbs.systemData.GetTime(exu.ConfigurationType.StartOfStep)
-        if 0.0 < h <= self.max_step_s:
-            angle += float(mbs.GetNodeOutput(self.carrier_node, ovt.Coordinates_t)[5]) * h
-        return angle
-
-    def coefficients(self, theta: float) -> tuple[np.ndarray, np.ndarray]:
-        """(scaling of (carrier frame, modal coordinates), offset) of the pins' ties at the carrier angle ``theta``
-        [rad], six rows per pin (class docstring; Exudyn's equation: scaling1 (frame, q) - s - offset = 0, both
-        markers measuring reference plus displacement): buffers rewritten in place by one compiled call
-        (:func:`pin_coefficients`)."""
-        const, cos_part, sin_part = self.forms
-        pin_coefficients(float(theta), self.points, const, cos_part, sin_part, self.scaling, self.offset)
-        return self.scaling, self.offset
-
-    def __call__(self, mbs, t: float) -> bool:
-        scaling, offset = self.coefficients(self.angle(mbs, t))
-        mbs.SetObjectParameter(self.obj, "scalingMarker1", scaling)
-        mbs.SetObjectParameter(self.obj, "offset", offset)
-        return True
-
-
-@njit(cache=True)
-def pin_coefficients(theta, points, const, cos_part, sin_part, scaling, offset):  # pragma: no cover - compiled
-    """:meth:`CarrierPins.coefficients` in place: per pin k (rows 6 k ...), r = R_z(theta) p_k, the lever block -r~
-    of F(r) in ``scaling[:, 3:6]``, the modal block C + cos(theta) A + sin(theta) B in ``scaling[:, 6:]``, and
-    ``offset`` -(r + theta r x e_z, 0)."""
-    c, s = np.cos(theta), np.sin(theta)
-    for k in range(points.shape[0]):
-        x = c * points[k, 0] - s * points[k, 1]
-        y = s * points[k, 0] + c * points[k, 1]
-        z = points[k, 2]
-        i = 6 * k
-        scaling[i, 4], scaling[i, 5] = z, -y
-        scaling[i + 1, 3], scaling[i + 1, 5] = -z, x
-        scaling[i + 2, 3], scaling[i + 2, 4] = y, -x
-        offset[i], offset[i + 1], offset[i + 2] = -(x + theta * y), -(y - theta * x), -z
-    for i in range(const.shape[0]):
-        for j in range(const.shape[1]):
-            scaling[i, 6 + j] = const[i, j] + c * cos_part[i, j] + s * sin_part[i, j]
-
-
-def turning_form_stacked(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """:func:`turning_form` of rows stacked six by six ((6 k, w): translation and rotation rows of k points)."""
-    if rows.shape[1] == 0:
-        return rows, rows, rows
-    parts = [turning_form(rows[i:i + 6]) for i in range(0, rows.shape[0], 6)]
-    return tuple(np.vstack([f[k] for f in parts]) for k in range(3))

@@ -21,7 +21,7 @@ flange. Every component of the file is rigid or a reduced flexible body, as in t
   the star (flexgear.mbs.joints.LinearInterfaceJoint); the input bearing at the shaft's seat;
 - each planet's bearing: the one linear bearing element of the production formulation
   (flexgear.mbs.joints.linear_bearing) between the planet's frame, or a flexible planet's seat node (its bore's
-  motion, flexgear.mbs.joints.LinearSeat with ``carrier``), and its pin's node (flexgear.mbs.joints.CarrierPins:
+  motion, flexgear.mbs.joints.LinearSeat with ``carrier``), and its pin's node (flexgear.mbs.carrier.CarrierPins:
   the pin's motion on the rigid or flexible carrier). A flexible planet's modal equations spin at its absolute speed
   (flexgear.mbs.spin). Its frame orbits, but its modes are mass-orthogonal to the rigid translations (mean axes), so
   the orbit's uniform acceleration does not load them;
@@ -48,7 +48,7 @@ from flexgear.design import Design, as_design
 from flexgear.geometry.elements import FixedJointElement
 from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.mbs.bodies import Body, add_rigid_body
-from flexgear.mbs.carrier import Carrier
+from flexgear.mbs.carrier import Carrier, CarrierPins
 from flexgear.mbs.elements import (
     add_fixed_joint,
     add_interface_joint,
@@ -65,7 +65,7 @@ from flexgear.mbs.gearbox import (
     joint_axes,
     mesh_contacts,
 )
-from flexgear.mbs.joints import CarrierPins, LinearInterfaceJoint, LinearSeat, TurningBlocks, linear_bearing
+from flexgear.mbs.joints import LinearInterfaceJoint, LinearSeat, TurningBlocks, linear_bearing
 from flexgear.mbs.spin import SpinSchedule
 from flexgear.mbs.train import add_gear_train
 from flexgear.spec import CARRIER, GearboxSpec, Variant
@@ -74,7 +74,7 @@ __all__ = ["build_planetary_gearbox", "carrier_mass_properties"]
 
 PIN_STEPS = 10
 """The carrier's pins predict its angle over a time step up to this many load-case steps long
-(flexgear.mbs.joints.CarrierPins: a longer "step" is a static solve)."""
+(flexgear.mbs.carrier.CarrierPins: a longer "step" is a static solve)."""
 
 
 def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
