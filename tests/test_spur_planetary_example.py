@@ -1,5 +1,5 @@
 """The spur planetary example (examples/spur_planetary/: 24/30/84, 3 planets, ring fixed, carrier output) with
-flexible gears on the turning carrier.
+flexible gears on the turning carrier, and a flexible carrier.
 
 Loss-free hand theory, independent of the package (the carrier's torque T_c, its speed Omega_c = Omega_in z_s /
 (z_s + z_r), N planets on the centre distance a_w):
@@ -14,9 +14,12 @@ Loss-free hand theory, independent of the package (the carrier's torque T_c, its
 
 The flexible planets sit on their pins through their bores' motion (flexgear.mbs.joints.LinearSeat with a carrier),
 their contact columns follow their spin relative to the carrier; the flexible ring is held at its bolts' clamped
-discs, and the flexible output shaft is bolted to the carrier at its own. The production formulation is checked
-against the reference formulation (Exudyn's nonlinear floating frame) on the turning carrier as well. Every body is
-built in a private cache from coarse meshes (about a minute of CPU).
+discs, and the flexible output shaft is bolted to the carrier at its own. The flexible carrier carries the planets'
+bearings on its pins' nodes (flexgear.mbs.carrier.CarrierPins): its pins' deflection is checked against its static
+compliance under the run's own bearing loads, its linear model against the reference formulation, its harmonic
+response against its time run. The production formulation is checked against the reference formulation (Exudyn's
+nonlinear floating frame) on the turning carrier as well. Every body is built in a private cache from coarse meshes
+(about two minutes of CPU).
 """
 
 from __future__ import annotations
