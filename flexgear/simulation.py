@@ -27,6 +27,7 @@ from flexgear.spec import (
     GearboxSpec,
     SpecError,
     Variant,
+    check_carrier,
     load_gearbox,
     load_variant,
 )
@@ -60,9 +61,6 @@ class Simulation:
             if component not in known:
                 raise SpecError(spec.source, f"components.{component}", f"unknown component; allowed: "
                                 f"{', '.join(known)}")
-        if CARRIER in flexible and spec.gears.arrangement != "planetary":
-            raise SpecError(spec.source, f"components.{CARRIER}", "a flexible carrier needs [gears] arrangement = "
-                            f"'planetary' (the {spec.gears.arrangement} arrangement holds it); expected 'rigid'")
         if mesh_level not in spec.meshing_assumed:
             raise SpecError(spec.source, "mesh_level", f"expected one of {sorted(spec.meshing_assumed)}", mesh_level)
         if rigid_mass_properties not in ("mesh", "exact"):
@@ -71,6 +69,7 @@ class Simulation:
         components = {c: ("flexible" if c in flexible else "rigid") for c in COMPONENTS}
         if CARRIER in flexible:
             components[CARRIER] = "flexible"
+        check_carrier(spec.source, components, spec)
         label = name or ("rigid" if not flexible else "flexible_" + "_".join(flexible))
         return cls(Variant(spec.source, label, spec, components, mesh_level, rigid_mass_properties))
 

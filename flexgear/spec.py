@@ -88,6 +88,7 @@ __all__ = [
     "COMPONENT_GEOMETRY",
     "load_gearbox",
     "load_variant",
+    "check_carrier",
     "spec_hash",
     "as_dict",
     "register_feasibility_check",
@@ -354,6 +355,14 @@ def _variant_gearbox(path: Path, raw: dict[str, Any], gearbox_text: str | None) 
     return gearbox
 
 
+def check_carrier(path: str | Path, components: dict[str, str], gearbox: GearboxSpec) -> None:
+    """SpecError naming ``components.carrier`` in ``path`` when ``components`` make the carrier flexible in an
+    arrangement other than the planetary stage's (the star holds its carrier)."""
+    if components.get(CARRIER) == "flexible" and gearbox.gears.arrangement != "planetary":
+        raise SpecError(path, f"components.{CARRIER}", f"a flexible carrier needs [gears] arrangement = 'planetary' "
+                        f"(the {gearbox.gears.arrangement} arrangement holds it); expected 'rigid'", "flexible")
+
+
 def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | None = None) -> Variant:
     """Load a variant file: ``gearbox = "gearbox.toml"`` plus ``[components]`` rigid/flexible.
 
@@ -389,9 +398,7 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
             raise SpecError(path, f"components.{name}", "missing; expected 'rigid' or 'flexible'")
         components[name] = _check_value(path, f"components.{name}", comps[name], str,
                                         {"choices": ("rigid", "flexible")})
-    if components.get(CARRIER) == "flexible" and gearbox.gears.arrangement != "planetary":
-        raise SpecError(path, f"components.{CARRIER}", f"a flexible carrier needs [gears] arrangement = 'planetary' "
-                        f"(the {gearbox.gears.arrangement} arrangement holds it); expected 'rigid'", "flexible")
+    check_carrier(path, components, gearbox)
 
     level = raw.get("mesh_level", "default")
     if level not in gearbox.meshing_assumed:

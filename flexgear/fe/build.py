@@ -49,7 +49,7 @@ def variant_build_items(spec: GearboxSpec, components: dict[str, str]) -> tuple[
 
 
 def build_key(spec: GearboxSpec, item: str, level: str) -> str:
-    """The cache key of the reduced body of build task ``item`` (a geometry or
+    """The cache key of the reduced body of build task ``item`` (a geometry, the planetary stage's carrier or
     :data:`~flexgear.fe.ring_shaft.TIED_PAIR`) at mesh ``level``."""
     from flexgear.fe.carrier import carrier_body_key
     from flexgear.fe.reduced import component_cache_key

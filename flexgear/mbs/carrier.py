@@ -222,7 +222,7 @@ class CarrierPins:
         else:
             self.points = np.asarray(points, float).reshape(n, 3) - carrier.position
             modal_nodes, modal = [], np.zeros((6 * n, 0))
-        self.forms = turning_form_stacked(modal)
+        self.forms = tuple(np.ascontiguousarray(f) for f in turning_form(modal))
         self.nodes = [mbs.AddNode(NodeRigidBodyRxyz(name=f"{carrier.name}_{name}_node",
                                                     referenceCoordinates=[*(carrier.position + p), 0.0, 0.0, 0.0]))
                       for name, p in zip(names, self.points, strict=True)]
@@ -236,7 +236,6 @@ class CarrierPins:
         for k in range(n):
             self.scaling[6 * k:6 * k + 6, :6] = np.eye(6)
         self.offset = np.zeros(6 * n)
-        self.forms = tuple(np.ascontiguousarray(f) for f in self.forms)
         scaling1, offset = self.coefficients(0.0)
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
             name=f"{carrier.name}_pins_tie",
@@ -292,11 +291,3 @@ def pin_coefficients(theta, points, const, cos_part, sin_part, scaling, offset):
         for j in range(const.shape[1]):
             scaling[i, 6 + j] = const[i, j] + c * cos_part[i, j] + s * sin_part[i, j]
 
-
-def turning_form_stacked(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """flexgear.mbs.joints.turning_form of rows stacked six by six ((6 k, w): translation and rotation rows of k
-    points)."""
-    if rows.shape[1] == 0:
-        return rows, rows, rows
-    parts = [turning_form(rows[i:i + 6]) for i in range(0, rows.shape[0], 6)]
-    return tuple(np.vstack([f[k] for f in parts]) for k in range(3))

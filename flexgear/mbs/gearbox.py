@@ -39,7 +39,7 @@ from flexgear.mbs.elements import (
     support_points,
 )
 from flexgear.mbs.train import add_gear_train
-from flexgear.spec import CARRIER, COMPONENT_GEOMETRY, GearboxSpec, Variant
+from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 from flexgear.theory import Theory
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
@@ -193,8 +193,8 @@ def run_cost(variant: Variant) -> float | None:
     """An estimate of a variant's run time in arbitrary units, to order the runs of a matrix longest first: the sum
     over its flexible bodies of (dynamic modes)^2 (each body's dense modal matrices and the constraint columns it
     feeds grow with it), from the cached reduced bodies' frequencies; None if one of them is not cached yet."""
-    from flexgear.fe.carrier import carrier_body_key
-    from flexgear.fe.reduced import cached_component_frequencies, cached_frequencies
+    from flexgear.fe.build import build_key
+    from flexgear.fe.reduced import cached_frequencies
 
     d = as_design(variant.gearbox)
     spec = d.spec
@@ -203,11 +203,10 @@ def run_cost(variant: Variant) -> float | None:
     for component, form in variant.components.items():
         if form != "flexible":
             continue
-        frequencies = (cached_frequencies(carrier_body_key(spec, variant.mesh_level)) if component == CARRIER else
-                       cached_component_frequencies(d, component, variant.mesh_level))
+        geometry = COMPONENT_GEOMETRY[component]
+        frequencies = cached_frequencies(build_key(spec, geometry, variant.mesh_level))
         if frequencies is None:
             return None
-        geometry = COMPONENT_GEOMETRY[component]
         count = spec.gears.planet_count if component == "planets" else 1
         cost += count * float(dynamic_modes(geometry, frequencies, cutoff)) ** 2
     return cost

@@ -68,12 +68,13 @@ def interface_rows(body: Body, interface: str, local_point: np.ndarray) -> np.nd
 
 def turning_form(rows: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(C, A, B) with blockdiag(R_z(a), R_z(a)) ``rows`` = C + cos(a) A + sin(a) B: rows (6, w) of ground
-    translation and rotation in the body frame, turned with the spin a."""
-    const, cos_part, sin_part = np.zeros_like(rows), rows.copy(), np.zeros_like(rows)
-    const[[2, 5]], cos_part[[2, 5]] = rows[[2, 5]], 0.0
+    translation and rotation in the body frame, turned with the spin a; rows (6 k, w) of k points, six by six."""
+    blocks = rows.reshape(rows.shape[0] // 6, 6, rows.shape[1])
+    const, cos_part, sin_part = np.zeros_like(blocks), blocks.copy(), np.zeros_like(blocks)
+    const[:, [2, 5]], cos_part[:, [2, 5]] = blocks[:, [2, 5]], 0.0
     for k in (0, 3):
-        sin_part[k], sin_part[k + 1] = -rows[k + 1], rows[k]
-    return const, cos_part, sin_part
+        sin_part[:, k], sin_part[:, k + 1] = -blocks[:, k + 1], blocks[:, k]
+    return tuple(a.reshape(rows.shape) for a in (const, cos_part, sin_part))
 
 
 def frame_form(point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -148,27 +148,20 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
     bearings = [replace(supports["planet"].on(name), other="carrier") for name in names]
     pins = [pin_interface(i) for i in range(len(places))]
     point = joint_point(d, "ring")  # the output shaft's flange: where the star bolts the ring to it
-    if form.get(CARRIER, "rigid") == "flexible":  # its seat on the output shaft, the planets' bearings on its pins
-        carrier = add_component(
-            mbs, "carrier", "flexible", CARRIER, np.zeros(3), spec, level, props, reduced, joints={SEAT: point},
-            spin_rad_s=th.output_speed, superelement=superelements,
-            bearing_points={pin: [place + sp.point for sp in b.axis_springs()]
-                            for pin, place, b in zip(pins, places, bearings, strict=True)})
-        if form["output_shaft"] == "rigid":
-            output_end = add_rigid_body(mbs, "output_shaft", props(spec, "output_shaft"), np.zeros(3))
-        else:
-            output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
-                                   joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
-        shafts.append(output_end)
-        join(output_end, carrier, [FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", SEAT, point)], ratio,
-             "joint_output_shaft_carrier")
-    elif form["output_shaft"] == "rigid":  # one rigid body with the carrier
+    flexible_carrier = form.get(CARRIER, "rigid") == "flexible"
+    if flexible_carrier:  # its seat on the output shaft, the planets' bearings on its pins
+        carrier = component("carrier", CARRIER, np.zeros(3), th.output_speed, joints={SEAT: point},
+                            bearing_points={pin: [place + sp.point for sp in b.axis_springs()]
+                                            for pin, place, b in zip(pins, places, bearings, strict=True)})
+    if not flexible_carrier and form["output_shaft"] == "rigid":  # one rigid body with the carrier
         carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
                                                                          props(spec, "output_shaft")), np.zeros(3))
         output_end = carrier
     else:  # bolted to the carrier at its bolts' clamped discs (where the star bolts the ring's flange to it)
-        carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(spec), np.zeros(3))
-        joint = FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", "carrier", point)
+        if not flexible_carrier:
+            carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(spec), np.zeros(3))
+        joint = FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", SEAT if flexible_carrier else "carrier",
+                                  point)
         output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
                                joints={BOLT_PATCHES: point}, support=supports["output_shaft"])
         shafts.append(output_end)

@@ -192,7 +192,7 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
     return draw
 
 
-_VARIANT_COLUMNS = ["variant", *(c.replace("_", " ") for c in COMPONENTS), "status", "simulated time [s]", "reason"]
+_RUN_COLUMNS = ["status", "simulated time [s]", "reason"]
 _PROVENANCE_COLUMNS = ["run", "backend", "status", "created", "t_end [s]", "step [s]", "config hash", "input hash"]
 
 
@@ -207,9 +207,8 @@ def _variant_table(d: ReportData) -> pd.DataFrame:
                      **{c.replace("_", " "): comps.get(c, "rigid" if comps else "–") for c in optional},
                      "status": r.meta.get("status"), "simulated time [s]": r.meta.get("t_end_s"),
                      "reason": r.meta.get("reason") or ""})
-    columns = _VARIANT_COLUMNS[:1 + len(COMPONENTS)] + [c.replace("_", " ") for c in optional] + \
-        _VARIANT_COLUMNS[1 + len(COMPONENTS):]
-    return pd.DataFrame(rows, columns=columns)
+    return pd.DataFrame(rows, columns=["variant", *(c.replace("_", " ") for c in (*COMPONENTS, *optional)),
+                                       *_RUN_COLUMNS])
 
 
 def _provenance_pages(d: ReportData) -> list[Page]:
