@@ -12,7 +12,11 @@ instant; generalized forces Q_u = F, Q_phi = p x F on the frame coordinates). Th
 (radial, tangential, axial) excites the translational-tilting and the rotational-axial families alike. The response
 is the difference of the two continuations (to first order in J the free response of the linearised system, without
 what is left of the ramps' transients): the frame velocities of the input and the output body, rotations multiplied
-by the centre distance a_w (a velocity at the planet centres' radius).
+by the centre distance a_w (a velocity at the planet centres' radius). In the planetary stage the in-plane pairs
+(v_x, v_y) and (w_x, w_y) are read in the carrier's axes, turned by the nominal carrier angle theta_c(t) as the
+linear model is (flexgear.modal.carrier_frame): with Delta x = T(theta_c) Delta x~ the ground-axes velocity is
+T (Delta x~' + Omega_c J Delta x~), so T^T Delta v holds only the frequencies of the carrier-frame modes (in ground
+axes each in-plane mode would show at f +- Omega_c / 2 pi). The star's carrier stands still: T = I.
 
 The free response (t > t_1 + tau) is a sum of damped modes, v(t) = sum_k Re(a_k e^(lambda_k t)). It is read twice:
 
@@ -45,7 +49,7 @@ from flexgear.spec import Variant
 
 __all__ = ["DEFAULT_IMPULSE_N_S", "DEFAULT_NEWTON_RELATIVE_TOLERANCE", "DEFAULT_PULSE_S", "DEFAULT_SETTLE_S",
            "DEFAULT_WINDOW_S", "ImpulseResponse", "Peak", "Pole", "clear_peaks", "damped_poles",
-           "generalized_alpha_damping", "impulse_response", "spectrum"]
+           "generalized_alpha_damping", "impulse_response", "in_carrier_axes", "spectrum"]
 
 DEFAULT_IMPULSE_N_S = 0.01
 """Impulse J of the pulse [N s]: a central member of some kg moves by about J / (m omega) ~ 1 um, a thousandth of
@@ -125,16 +129,17 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     :func:`flexgear.modal.linear.linearize` builds the variant. ``spectral_radius``: generalized-alpha's rho_inf
     (default ``[solver_assumed]``'s); ``step_s``: the step [s] (default the load case's);
     ``newton_relative_tolerance``: Newton's (default :data:`DEFAULT_NEWTON_RELATIVE_TOLERANCE`). ``mass_source``,
-    ``reduced_source``: as flexgear.mbs.gearbox.build_star_gearbox.
+    ``reduced_source``: as flexgear.mbs.assemble.build_gearbox (any arrangement).
     """
     import exudyn as exu
     from exudyn.itemInterface import LoadCoordinate, MarkerNodeCoordinate, SensorNode
     from threadpoolctl import threadpool_limits
 
     from flexgear.design import design
-    from flexgear.mbs.gearbox import build_star_gearbox
+    from flexgear.mbs.assemble import build_gearbox
     from flexgear.mbs.recording import simulation_settings
     from flexgear.mbs.run import RunGuard
+    from flexgear.modal.linear import carrier_angle
 
     spec = variant.gearbox.with_fields("contact_assumed", stiffness_variation="constant")
     if speed_rpm is not None:
@@ -159,7 +164,7 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     try:
         mbs = sc.AddSystem()
         with threadpool_limits(limits=1, user_api="blas"):
-            model = build_star_gearbox(mbs, built, mass_source, reduced_source, design=d)
+            model = build_gearbox(mbs, built, mass_source, reduced_source, design=d)
         out_node = model.bodies[model.output_body].node
         for k, q in enumerate(generalized):
             if q == 0.0:
@@ -215,9 +220,28 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     time = pushed[:n, 0] - t1
     scale = np.array([1.0 if c.split(".")[1].startswith("v") else arm for c in channels])
     velocity = (pushed[:n, 1:] - quiet[:n, 1:]) * scale
+    if "carrier" in model.bodies:  # the planetary stage: the in-plane pairs in the carrier's axes
+        theta = np.array([carrier_angle(model, spec, t)[0] for t in pushed[:n, 0]])
+        velocity = in_carrier_axes(velocity, channels, theta)
     keep = time >= -0.5 * h
     speed = lc.input_speed_rpm
     return ImpulseResponse(built, speed, rho, h, pulse_s, impulse_n_s, time[keep], velocity[keep], tuple(channels))
+
+
+def in_carrier_axes(velocity: np.ndarray, channels: tuple[str, ...], theta_c: np.ndarray) -> np.ndarray:
+    """``velocity`` (n_t, n_channels) with each in-plane pair of ``channels`` ("<side>.v_x", "<side>.v_y" and
+    "<side>.w_x", "<side>.w_y") turned into the axes at the carrier angle ``theta_c`` (n_t,) [rad]: T(theta_c)^T v
+    (module docstring); the other channels as they are."""
+    out = np.array(velocity, float, copy=True)
+    c, s = np.cos(theta_c), np.sin(theta_c)
+    index = {name: k for k, name in enumerate(channels)}
+    for name in channels:
+        side, kind = name.split(".")
+        if kind in ("v_x", "w_x"):
+            i, j = index[name], index[f"{side}.{kind[0]}_y"]
+            out[:, i] = c * velocity[:, i] + s * velocity[:, j]
+            out[:, j] = -s * velocity[:, i] + c * velocity[:, j]
+    return out
 
 
 def spectrum(response: ImpulseResponse, oversample: int = 16,
