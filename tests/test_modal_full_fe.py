@@ -48,3 +48,23 @@ def test_model7_against_full_fe():
     modes against full FE: benchmarks/bench_convergence.py --band."""
     result = compare_full_fe(load_variant(VARIANTS / "model7.toml"))
     _check(result, ["input_shaft"])
+
+
+def test_held_rigid_basis_carries_the_bodys_rigid_motions():
+    """T of flexgear.modal.full_fe.held_rigid_basis on two patches of a random cloud: a rigid motion of the whole
+    body is T [R_outside; I_6; I_6], and every column of T moves each patch rigidly."""
+    from flexgear.fe.fem import rigid_body_modes
+    from flexgear.modal.full_fe import held_rigid_basis
+
+    nodes = np.random.default_rng(3).standard_normal((40, 3))
+    patches = (np.array([2, 5, 7, 11]), np.array([20, 21, 30]))
+    t = held_rigid_basis(nodes, patches).toarray()
+    whole = rigid_body_modes(nodes)
+    held = np.concatenate([(3 * b[:, None] + np.arange(3)).ravel() for b in patches])
+    outside = np.setdiff1d(np.arange(3 * len(nodes)), held)
+    np.testing.assert_allclose(t @ np.vstack([whole[outside], np.eye(6), np.eye(6)]), whole, atol=1e-12)
+    for b in patches:
+        dofs = (3 * b[:, None] + np.arange(3)).ravel()
+        shapes = t[dofs]
+        q = np.linalg.qr(rigid_body_modes(nodes[b]))[0]
+        np.testing.assert_allclose(shapes - q @ (q.T @ shapes), 0.0, atol=1e-12)

@@ -129,9 +129,11 @@ class FreeBodySolver:
     Solves min 1/2 u^T K u - g^T u subject to C u = e for a free (singular) K, see module docstring.
     """
 
-    def __init__(self, fe: FEModel):
+    def __init__(self, fe: FEModel, rigid_modes: np.ndarray | None = None):
+        """``rigid_modes`` (n, 6): the body's rigid motions where its coordinates are not its nodes' (default
+        flexgear.fe.fem.rigid_body_modes of ``fe.nodes``)."""
         self.n = fe.n_dof
-        self.R = rigid_body_modes(fe.nodes)
+        self.R = rigid_body_modes(fe.nodes) if rigid_modes is None else np.array(rigid_modes, float)
         scale = np.linalg.norm(self.R[:, :3], axis=0).mean() / np.linalg.norm(self.R[:, 3:], axis=0).mean()
         self.R[:, 3:] *= scale
         _, _, piv = la.qr(self.R.T, mode="economic", pivoting=True)

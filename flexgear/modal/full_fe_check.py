@@ -34,6 +34,7 @@ from flexgear.modal.full_fe import (
     linear_system,
     recover,
     reduced_flexibility,
+    rigid_interfaces,
 )
 from flexgear.spec import Variant
 
@@ -178,14 +179,16 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
         name = next(nm for nm, body in system.bodies.items() if body.flexible and _component(nm) == b.component)
         body = system.bodies[name]
         fe_key = "planet" if name.startswith("planet") else name
+        rigid = tuple(itf.nodes for itf in rigid_interfaces(body.reduced))  # held rigid as the reduction holds them
         key = (variant.mesh_level, fe_key, b.weights.indices.tobytes(), np.round(b.weights.data, 12).tobytes(),
-               s_top)
+               s_top, tuple(r.tobytes() for r in rigid))
         if key not in cache:
             if fe_key not in fe_cache:
                 say(f"  {name}: full FE model")
                 fe_cache = {fe_key: body_fe_model(system.spec, name, body.reduced, variant.mesh_level)}
             say(f"  {name}: full FE flexibility at {b.weights.shape[1]} attachment motions")
-            cache[key] = full_flexibility(fe_cache[fe_key], b.weights, s_top, body.reduced.frequencies_hz)
+            cache[key] = full_flexibility(fe_cache[fe_key], b.weights, s_top, body.reduced.frequencies_hz,
+                                          rigid=rigid)
         f = cache[key]
         done[name] = (b.weights.shape[1], int(np.count_nonzero(f.eigenvalues <= s_max)),
                       int(np.count_nonzero((2 * np.pi * body.reduced.frequencies_hz) ** 2 <= s_max)), len(f.moments))
