@@ -345,17 +345,17 @@ def cmd_meshes(a: argparse.Namespace) -> int:
 def _args_export_geometry(p: argparse.ArgumentParser) -> None:
     p.add_argument("gearbox", help="gearbox file, or a variant file (its gearbox with its overrides)")
     p.add_argument("--component", action="append", default=None, metavar="NAME",
-                   help="sun, planet, ring, input_shaft or output_shaft; repeat for several (default: all five)")
+                   help="sun, planet, ring, input_shaft, output_shaft or (planetary stage) carrier; repeat for "
+                   "several (default: all of them)")
     p.add_argument("--level", default="coarse", help="mesh level of [meshing_assumed] (default: %(default)s)")
     p.add_argument("--out", default="geometry", metavar="DIR", help="output folder (default: %(default)s)")
 
 
 def cmd_export_geometry(a: argparse.Namespace) -> int:
     from flexgear.fe.geometry_export import export_geometry
-    from flexgear.spec import GEOMETRY_COMPONENTS
 
     spec = _gearbox_or_variant(a.gearbox)
-    for path in export_geometry(spec, tuple(a.component or GEOMETRY_COMPONENTS), a.level, a.out, progress=True):
+    for path in export_geometry(spec, tuple(a.component) if a.component else None, a.level, a.out, progress=True):
         unit = "mm, solid" if path.suffix == ".step" else "m, volume mesh with its regions as point data"
         print(f"{path} ({unit})")
     return 0

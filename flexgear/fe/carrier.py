@@ -25,8 +25,8 @@ from flexgear.geometry.carrier import CarrierSizes, carrier_sizes, carrier_solid
 from flexgear.progress import say
 from flexgear.spec import GearboxSpec, spec_hash
 
-__all__ = ["carrier_fe_model", "carrier_body", "carrier_body_key", "carrier_interfaces", "pin_interface", "SEAT",
-           "CUTOFF_FACTOR"]
+__all__ = ["carrier_fe_model", "carrier_volume_mesh", "carrier_body", "carrier_body_key", "carrier_interfaces",
+           "pin_interface", "SEAT", "CUTOFF_FACTOR"]
 
 CUTOFF_FACTOR = 3.0
 """The carrier's fixed-interface modes reach this multiple of the gearbox's cutoff (3.5 mesh orders). The gears carry
@@ -69,25 +69,45 @@ def _radius(face) -> float:
     return max(float(np.hypot(v.p.x, v.p.y)) for v in face.vertices)
 
 
-def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None) -> FEModel:
-    """The carrier's FE model (module docstring) at mesh ``level``, the level's element order; ``sizes`` default
-    :func:`flexgear.geometry.carrier.carrier_sizes`."""
+def _carrier_netgen_mesh(spec: GearboxSpec, level: str, sizes: CarrierSizes):
+    """The carrier's first-order Netgen mesh at mesh ``level`` (module docstring)."""
     import netgen.meshing as nm
     from netgen.occ import OCCGeometry
 
-    sizes = sizes or carrier_sizes(spec)
     settings = spec.meshing_assumed[level]
     geo = OCCGeometry(_named_solid(sizes, settings.tooth_size_mm * 1e-3))
     mp = nm.MeshingParameters(maxh=settings.body_size_mm * 1e-3, curvaturesafety=settings.elements_per_curvature_radius,
                               segmentsperedge=0.0, optsteps2d=settings.optimisation_steps,
                               optsteps3d=settings.optimisation_steps)
-    mesh = geo.GenerateMesh(mp=mp)
-    fe = fe_model(mesh, spec.material_assumed, settings.element_order)
+    return geo.GenerateMesh(mp=mp)
+
+
+def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None) -> FEModel:
+    """The carrier's FE model (module docstring) at mesh ``level``, the level's element order; ``sizes`` default
+    :func:`flexgear.geometry.carrier.carrier_sizes`."""
+    return carrier_volume_mesh(spec, level, sizes)[0]
+
+
+def carrier_volume_mesh(spec: GearboxSpec, level: str = "coarse",
+                        sizes: CarrierSizes | None = None) -> tuple[FEModel, np.ndarray]:
+    """(the carrier's FE model, its tetrahedra (e, 4 or 10) in the FE model's node numbering, Netgen's node order):
+    :func:`carrier_fe_model` and the elements it is assembled on, raised to the level's order as
+    flexgear.fe.fem.fe_model raises a mesh."""
+    sizes = sizes or carrier_sizes(spec)
+    order = spec.meshing_assumed[level].element_order
+    mesh = _carrier_netgen_mesh(spec, level, sizes)
+    fe = fe_model(mesh, spec.material_assumed, order)
     missing = [pin_interface(k) for k in range(sizes.planet_count) if pin_interface(k) not in fe.regions] + (
         [SEAT] if SEAT not in fe.regions else [])
     if missing:
         raise RuntimeError(f"carrier: the meshed solid lacks the faces {missing}")
-    return fe
+    if order == 2:
+        mesh = mesh.Copy()
+        mesh.SecondOrder()
+    elements = np.array([[q.nr - 1 for q in el.points] for el in mesh.Elements3D()], np.int64)
+    if not np.array_equal(np.array(mesh.Coordinates(), float), fe.nodes):
+        raise RuntimeError("carrier: the raised mesh's nodes are not the FE model's")
+    return fe, elements
 
 
 def carrier_interfaces(fe: FEModel, sizes: CarrierSizes) -> list:

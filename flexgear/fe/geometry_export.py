@@ -12,6 +12,9 @@
   1 on the set's nodes, else 0. Read back with ``length_unit = "m"``.
 
 A component whose geometry is a volume mesh file (``[components_geometry]``) has no solid: only its VTU is written.
+The planetary stage's carrier (flexgear.fe.carrier) is written the same way, in the gearbox frame (its origin on the
+axis at the planets' mid-plane), its point sets its faces ``seat`` and ``pin_<k>`` and the same sets as its reduction's
+interfaces (``interface_seat``, ``interface_pin_<k>``).
 """
 
 from __future__ import annotations
@@ -24,19 +27,19 @@ import numpy as np
 from flexgear.design import as_design
 from flexgear.fe.mesh import component_brep, component_mesh
 from flexgear.fe.mesh_io import write_vtu
-from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.spec import CARRIER, GEOMETRY_COMPONENTS, GearboxSpec
 
-__all__ = ["export_geometry", "write_step", "STEP_UNIT_MM"]
+__all__ = ["export_geometry", "exported_components", "write_step", "STEP_UNIT_MM"]
 
 STEP_UNIT_MM = 1e3
 """Millimetres per metre: the STEP files are written in mm."""
 
 
-def write_step(brep: Path, path: Path) -> Path:
-    """The solid of ``brep`` (metres) as a STEP file in millimetres at ``path``."""
+def write_step(brep: Path | object, path: Path) -> Path:
+    """The solid of ``brep`` (a ``.brep`` file or an OCC shape, metres) as a STEP file in millimetres at ``path``."""
     from netgen.occ import OCCGeometry, Pnt
 
-    shape = OCCGeometry(str(brep)).shape.Scale(Pnt(0, 0, 0), STEP_UNIT_MM)
+    shape = (OCCGeometry(str(brep)).shape if isinstance(brep, Path) else brep).Scale(Pnt(0, 0, 0), STEP_UNIT_MM)
     tmp = path.with_name(f".{path.name}.tmp.step")
     shape.WriteStep(str(tmp))
     tmp.replace(path)
@@ -58,19 +61,42 @@ def _point_sets(spec: GearboxSpec, component: str, nodes: np.ndarray, regions: d
     return sets
 
 
-def export_geometry(spec: GearboxSpec, components: tuple[str, ...] = GEOMETRY_COMPONENTS, level: str = "coarse",
+def exported_components(spec: GearboxSpec) -> tuple[str, ...]:
+    """The components ``flexgear export-geometry`` writes for ``spec``: every geometry component, and in the
+    planetary arrangement the carrier."""
+    return (*GEOMETRY_COMPONENTS, *((CARRIER,) if spec.gears.arrangement == "planetary" else ()))
+
+
+def _carrier_files(spec: GearboxSpec, level: str, folder: Path) -> list[Path]:
+    """The carrier's STEP and VTU (module docstring)."""
+    from flexgear.fe.carrier import carrier_volume_mesh
+    from flexgear.geometry.carrier import carrier_sizes, carrier_solid
+
+    sizes = carrier_sizes(spec)
+    fe, elements = carrier_volume_mesh(spec, level, sizes)
+    sets = {**fe.regions, **{f"interface_{name}": ids for name, ids in fe.regions.items()}}
+    return [write_step(carrier_solid(sizes), folder / f"{CARRIER}.step"),
+            write_vtu(folder / f"{CARRIER}.vtu", fe.nodes, elements, sets)]
+
+
+def export_geometry(spec: GearboxSpec, components: tuple[str, ...] | None = None, level: str = "coarse",
                     out: str | Path = "geometry", progress: bool = False) -> list[Path]:
-    """Write ``<component>.step`` and ``<component>.vtu`` of each of ``components`` at mesh ``level`` into ``out``
-    (module docstring); the paths written."""
+    """Write ``<component>.step`` and ``<component>.vtu`` of each of ``components`` (default
+    :func:`exported_components`) at mesh ``level`` into ``out`` (module docstring); the paths written."""
+    allowed = exported_components(spec)
+    components = allowed if components is None else components
     if level not in spec.meshing_assumed:
         raise ValueError(f"unknown mesh level {level!r}; the gearbox has {', '.join(sorted(spec.meshing_assumed))}")
     for c in components:
-        if c not in GEOMETRY_COMPONENTS:
-            raise ValueError(f"unknown component {c!r}; allowed: {', '.join(GEOMETRY_COMPONENTS)}")
+        if c not in allowed:
+            raise ValueError(f"unknown component {c!r}; allowed: {', '.join(allowed)}")
     folder = Path(out)
     folder.mkdir(parents=True, exist_ok=True)
     written = []
     for c in components:
+        if c == CARRIER:
+            written += _carrier_files(spec, level, folder)
+            continue
         entry = spec.components_geometry.get(c)
         if entry is None or entry.kind != "mesh":
             written.append(write_step(component_brep(spec, c, progress), folder / f"{c}.step"))
