@@ -49,9 +49,9 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from flexgear.spec import Variant
+from flexgear.modal.linear import LinearModel
 
-__all__ = ["Attachments", "LinearSystem", "Coupled", "Flexibility", "linear_system", "attachments",
+__all__ = ["Attachments", "Coupled", "Flexibility", "attachments",
            "carries_attachments", "recover", "reduced_flexibility", "body_fe_model", "full_flexibility", "assembled",
            "eigenvalues", "rigid_interfaces", "held_rigid_basis"]
 
@@ -59,53 +59,6 @@ _RANK_TOL = 1e-10  # relative singular value below which constraint rows are red
 RIGID_PATCH_TOL = 1e-9
 """An interface is a rigid patch of a reduced body when every mode's shape on its nodes lies in their rigid motions'
 span to this share of its norm (a rigid patch's modes do to round-off, 1e-15; an RBE3 interface's by far not)."""
-
-
-@dataclass
-class LinearSystem:
-    """The linearised equations over all ODE2 coordinates q (flexgear.modal.linear module docstring): M, K [SI],
-    C (constraints, coordinates), the coordinates' labels and the built model's bodies (flexgear.mbs)."""
-
-    mass: np.ndarray
-    stiffness: np.ndarray
-    constraint: np.ndarray
-    labels: tuple
-    bodies: dict
-    contacts: list
-    fourier_order: int
-    radial_band: float
-    spec: object
-
-
-def linear_system(variant: Variant, speed_rpm: float = 0.0, *, keep_all_modes: bool = True) -> LinearSystem:
-    """``variant`` built and linearised as flexgear.modal.linear.linearize does, before any elimination.
-    ``keep_all_modes``: every mode of the gears' bases kept (no residual compliance coordinates)."""
-    import exudyn as exu
-    from threadpoolctl import threadpool_limits
-
-    from flexgear.mbs.assemble import build_gearbox
-    from flexgear.modal import linear
-
-    if keep_all_modes:
-        spec = variant.gearbox.with_fields("reduction_assumed", dynamic_cutoff_mesh_orders=0.0)
-        variant = dataclasses.replace(variant, gearbox=spec)
-    built, _ = linear.with_speed(variant, speed_rpm)
-    t_star = built.gearbox.load_case.ramp_time_s
-    sc = exu.SystemContainer()
-    try:
-        mbs = sc.AddSystem()
-        with threadpool_limits(limits=1, user_api="blas"):
-            model = build_gearbox(mbs, built)
-        mbs.Assemble()
-        linear.operating_point(mbs, model, built, t_star)
-        m, k, _, c = (np.asarray(a, float) for a in exu.solver.ComputeLinearizedSystem(
-            mbs, linear.static_solver_settings(t_star), returnConstraintJacobian=True, autoAssemble=False))
-        labels = tuple(linear.coordinate_labels(mbs, model, m.shape[0]))
-    finally:
-        sc.Reset()
-    spec = built.gearbox
-    return LinearSystem(m, k, c.T if c.size else np.zeros((0, m.shape[0])), labels, model.bodies, model.contacts,
-                        spec.reduction_assumed.contact_fourier_order, spec.gears.normal_module_m, spec)
 
 
 @dataclass
@@ -155,25 +108,29 @@ def _interface_weights(nodes: np.ndarray, itf) -> sp.csr_matrix:
     return sp.csr_matrix((rows.ravel(), (r.ravel(), col.ravel())), shape=(3 * len(nodes), 6))
 
 
-def attachments(system: LinearSystem) -> list[Attachments]:
-    """Every flexible body's :class:`Attachments`: all its interfaces' RBE3 motions and the Fourier coefficients
-    of each distinct contact band (bands and local normals that coincide, the planets' turned copies, once)."""
+def attachments(system: LinearModel) -> list[Attachments]:
+    """Every flexible body's :class:`Attachments` in the linear model ``system`` (flexgear.modal.linear.linearize,
+    every mode of the gears' bases kept): all its interfaces' RBE3 motions and the Fourier coefficients of each
+    distinct contact band (bands and local normals that coincide, the planets' turned copies, once)."""
     from flexgear.modal.linear import component_name
 
+    spec = system.variant.gearbox
+    order, radial_band = spec.reduction_assumed.contact_fourier_order, spec.gears.normal_module_m
     out = []
     for name, body in system.bodies.items():
         if not body.flexible:
             continue
         comp = component_name(name)
         red = body.reduced
-        index = np.array([i for i, c in enumerate(system.labels) if c.kind == "elastic" and c.component == comp])
+        index = np.array([i for i, c in enumerate(system.full_coordinates)
+                          if c.kind == "elastic" and c.component == comp])
         blocks = [_interface_weights(red.nodes, itf) for itf in red.interfaces]
         seen = set()
         for c in system.contacts:
             if name not in (c.body1, c.body2):
                 continue
             w = _contact_weights(red.nodes, np.asarray(c.point) - body.position, np.asarray(c.normal, float),
-                                 0.5 * c.half_width, system.radial_band, system.fourier_order)
+                                 0.5 * c.half_width, radial_band, order)
             key = (w.indices.tobytes(), np.round(w.data, 12).tobytes())
             if key not in seen:
                 seen.add(key)
@@ -183,7 +140,7 @@ def attachments(system: LinearSystem) -> list[Attachments]:
         motion = np.asarray(weights.T @ shapes)
         k_e = body.modal_matrices[1] if body.modal_matrices is not None else np.diag(red.stiffness)
         out.append(Attachments(comp, index, weights, motion, np.asarray(k_e, float),
-                               system.mass[np.ix_(index, index)]))
+                               system.full_mass[np.ix_(index, index)]))
     return out
 
 
@@ -225,11 +182,11 @@ def carries_attachments(body: Attachments) -> bool:
     return bool(sv[-1] >= 1e-8 * sv[0])
 
 
-def recover(system: LinearSystem, bodies: list[Attachments]) -> Coupled:
+def recover(system: LinearModel, bodies: list[Attachments]) -> Coupled:
     """The couplings of every flexible body in attachment space (module docstring), exact where each A has full
     row rank; raises ValueError where it has not. Requires the bodies' elastic coordinates to carry no mass
     coupling to the rest."""
-    m, k, c = system.mass, system.stiffness, system.constraint
+    m, k, c = system.full_mass, system.full_stiffness, system.full_constraint
     n = m.shape[0]
     elastic = np.concatenate([b.index for b in bodies])
     rest = np.setdiff1d(np.arange(n), elastic)

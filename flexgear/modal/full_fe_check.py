@@ -31,7 +31,6 @@ from flexgear.modal.full_fe import (
     carries_attachments,
     eigenvalues,
     full_flexibility,
-    linear_system,
     recover,
     reduced_flexibility,
     rigid_interfaces,
@@ -164,7 +163,7 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
                  default=0.0)
     seconds["linearise"] = time.perf_counter() - t
     t = time.perf_counter()
-    system = linear_system(variant, 0.0)
+    system = all_model  # its couplings, before the elimination
     every = attachments(system)
     bodies = [b for b in every if carries_attachments(b)]
     coupled = recover(system, bodies)
@@ -185,7 +184,7 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
         if key not in cache:
             if fe_key not in fe_cache:
                 say(f"  {name}: full FE model")
-                fe_cache = {fe_key: body_fe_model(system.spec, name, body.reduced, variant.mesh_level)}
+                fe_cache = {fe_key: body_fe_model(variant.gearbox, name, body.reduced, variant.mesh_level)}
             say(f"  {name}: full FE flexibility at {b.weights.shape[1]} attachment motions")
             cache[key] = full_flexibility(fe_cache[fe_key], b.weights, s_top, body.reduced.frequencies_hz,
                                           rigid=rigid)

@@ -83,7 +83,9 @@ class LinearModel:
     ring and output shaft). ``elastic_parts``: {component: (indices in ``full_coordinates`` of its body's elastic
     coordinates q~, [(part, M_p, K_p)])} where one flexible body is two components (the tied ring and output
     shaft, flexgear.fe.ring_shaft.tied_part_matrices): each part's share of the body's modal mass and stiffness
-    on q~, to split a mode's elastic energy between the parts.
+    on q~, to split a mode's elastic energy between the parts. ``full_constraint`` (r, n): the constraint Jacobian
+    C over q before the elimination (C q = 0); ``bodies`` and ``contacts``: the built model's bodies and gear
+    contacts (flexgear.mbs.gearbox.GearboxModel), for the couplings of the full-FE check (flexgear.modal.full_fe).
     """
 
     variant: Variant
@@ -107,6 +109,9 @@ class LinearModel:
     static_residuals: dict[str, float] = field(default_factory=dict)  # contact name -> e_0 [m] at the operating point
     elastic_parts: dict[str, tuple[np.ndarray, list[tuple[str, np.ndarray, np.ndarray]]]] = field(
         default_factory=dict)
+    full_constraint: np.ndarray | None = None
+    bodies: dict = field(default_factory=dict)
+    contacts: list = field(default_factory=list)
 
     @property
     def n(self) -> int:
@@ -441,7 +446,7 @@ def linearize(variant: Variant, speed_rpm: float | None = None, *, t_star: float
     components = _components(spec.gears.planet_count, "carrier" in model.bodies)
     return LinearModel(variant, speed, 0.5 * (mr + mr.T), 0.5 * (dr + dr.T), 0.5 * (dr - dr.T), kr, tuple(coords),
                        basis, tuple(labels), m, k, components, flexible, parts, static, residuals,
-                       static_residuals, elastic_parts)
+                       static_residuals, elastic_parts, c, model.bodies, model.contacts)
 
 
 def _components(planets: int, carrier: bool = False) -> tuple[str, ...]:
