@@ -51,10 +51,10 @@ def test_model7_against_full_fe():
 
 
 def test_held_rigid_basis_carries_the_bodys_rigid_motions():
-    """T of flexgear.modal.full_fe.held_rigid_basis on two patches of a random cloud: a rigid motion of the whole
+    """T of flexgear.fe.patches.held_rigid_basis on two patches of a random cloud: a rigid motion of the whole
     body is T [R_outside; I_6; I_6], and every column of T moves each patch rigidly."""
     from flexgear.fe.fem import rigid_body_modes
-    from flexgear.modal.full_fe import held_rigid_basis
+    from flexgear.fe.patches import held_rigid_basis
 
     nodes = np.random.default_rng(3).standard_normal((40, 3))
     patches = (np.array([2, 5, 7, 11]), np.array([20, 21, 30]))

@@ -342,7 +342,7 @@ def test_every_component_flexible_against_the_assembly_with_the_full_fe_carrier(
     from test_modal_full_fe import _check
 
     from flexgear.fe.carrier import SEAT, carrier_body
-    from flexgear.modal.full_fe import rigid_interfaces
+    from flexgear.fe.patches import rigid_interfaces
     from flexgear.modal.full_fe_check import compare_full_fe
 
     variant = load_variant(EXAMPLE / "flexible.toml")

@@ -33,9 +33,10 @@ symmetric: the error is of second order in the series' effect on the mode shape)
   exactly as the Neumann series
   R_k = W^T (S M)^k X_0, X_0 = S W - sum_{j<c} phi_j phi_j^T W / lambda_j, with S the free body's static
   flexibility on the mean-axis subspace (one sparse Cholesky factorisation); its terms fall as (s / lambda_c)^k.
-  An interface the reduction holds as a rigid patch (RBE2, e.g. the carrier's seat: :func:`rigid_interfaces`)
-  is held so in the full model too: u = T u_t with u_b = R_b r on each patch's nodes (six coordinates r each,
-  :func:`held_rigid_basis`), K_t = T^T K T, M_t = T^T M T, W_t = T^T W (a patch's RBE3 motion is its rigid one).
+  An interface the reduction holds as a rigid patch (RBE2, e.g. the carrier's seat; found by
+  flexgear.fe.patches.rigid_interfaces) is held so in the full model too: u = T u_t with u_b = R_b r on each
+  patch's nodes (six coordinates r each, flexgear.fe.patches.held_rigid_basis), K_t = T^T K T, M_t = T^T M T,
+  W_t = T^T W (a patch's RBE3 motion is its rigid one).
 
 The linearisation used for the couplings keeps every mode of the gears' bases (no residual compliance,
 ``dynamic_cutoff_mesh_orders = 0``): the full FE carries that compliance itself.
@@ -53,12 +54,9 @@ from flexgear.modal.linear import LinearModel
 
 __all__ = ["Attachments", "Coupled", "Flexibility", "attachments",
            "carries_attachments", "recover", "reduced_flexibility", "body_fe_model", "full_flexibility", "assembled",
-           "eigenvalues", "rigid_interfaces", "held_rigid_basis"]
+           "eigenvalues"]
 
 _RANK_TOL = 1e-10  # relative singular value below which constraint rows are redundant
-RIGID_PATCH_TOL = 1e-9
-"""An interface is a rigid patch of a reduced body when every mode's shape on its nodes lies in their rigid motions'
-span to this share of its norm (a rigid patch's modes do to round-off, 1e-15; an RBE3 interface's by far not)."""
 
 
 @dataclass
@@ -374,49 +372,6 @@ def body_fe_model(spec, name: str, reduced, level: str):
     return fe
 
 
-def _rigid_complement(points: np.ndarray) -> np.ndarray:
-    """(3k, 3k - 6): an orthonormal basis of the motions of the ``points`` (k, 3) that are not rigid."""
-    from flexgear.fe.fem import rigid_body_modes
-
-    q = np.linalg.qr(rigid_body_modes(points), mode="complete")[0]
-    return q[:, 6:]
-
-
-def rigid_interfaces(reduced) -> list:
-    """The interfaces of ``reduced`` (flexgear.fe.cms.ReducedBody) that move as rigid patches in every mode
-    (:data:`RIGID_PATCH_TOL`)."""
-    shapes = reduced.modes.reshape(len(reduced.nodes), 3, -1)
-    out = []
-    for itf in reduced.interfaces:
-        on = shapes[itf.nodes].reshape(3 * len(itf.nodes), -1)
-        free = _rigid_complement(reduced.nodes[itf.nodes])
-        if np.linalg.norm(free.T @ on) <= RIGID_PATCH_TOL * np.linalg.norm(on):
-            out.append(itf)
-    return out
-
-
-def held_rigid_basis(nodes: np.ndarray, patches: tuple[np.ndarray, ...]) -> sp.csr_matrix:
-    """T (3n, 3n - 3 sum k_b + 6 p): the coordinates of every node outside the ``patches`` (node index arrays of
-    ``nodes`` (n, 3), disjoint) as they are, in order, then six rigid motions r per patch, u_b = R_b r (translations
-    and rotations about the nodes' mean, flexgear.fe.fem.rigid_body_modes, so that a rigid motion R of the whole
-    body is T [R_outside; I_6; ...])."""
-    from flexgear.fe.fem import rigid_body_modes
-
-    n = 3 * len(nodes)
-    held = np.concatenate([(3 * np.asarray(b)[:, None] + np.arange(3)).ravel() for b in patches])
-    keep = np.setdiff1d(np.arange(n), held)
-    rows, cols, vals = [keep], [np.arange(len(keep))], [np.ones(len(keep))]
-    centre = nodes.mean(axis=0)
-    for j, b in enumerate(patches):
-        dofs = (3 * np.asarray(b)[:, None] + np.arange(3)).ravel()
-        modes = rigid_body_modes(nodes[b], centre)
-        rows.append(np.repeat(dofs, 6))
-        cols.append(np.tile(len(keep) + 6 * j + np.arange(6), len(dofs)))
-        vals.append(modes.ravel())
-    return sp.csr_matrix((np.concatenate(vals), (np.concatenate(rows), np.concatenate(cols))),
-                         shape=(n, len(keep) + 6 * len(patches)))
-
-
 def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.ndarray, cut: float = 2.25,
                      tol: float = 1e-10, max_terms: int = 80, rigid: tuple[np.ndarray, ...] = ()) -> Flexibility:
     """The full FE model's H(s) at the attachments ``weights`` W (3n, n_a) for s <= ``s_max`` (module docstring):
@@ -424,7 +379,7 @@ def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.
     lambda >= ``cut`` s_max, the others as the series R_k = W^T X_k, X_k = S M X_{k-1}, until s_max^k |R_k| <= ``tol``
     |R_0| (its ratio s_max / lambda_c <= 1 / ``cut``). ``frequencies_hz``: the reduced body's free-free
     frequencies (each above the full model's of the same order), to size the eigen solve. ``rigid``: node sets held
-    as rigid patches as the reduction holds them (module docstring, :func:`held_rigid_basis`)."""
+    as rigid patches as the reduction holds them (module docstring, flexgear.fe.patches.held_rigid_basis)."""
     from threadpoolctl import threadpool_limits
 
     from flexgear.fe.cms import FreeBodySolver
@@ -434,6 +389,7 @@ def full_flexibility(fe, weights: sp.spmatrix, s_max: float, frequencies_hz: np.
             from types import SimpleNamespace
 
             from flexgear.fe.fem import rigid_body_modes
+            from flexgear.fe.patches import held_rigid_basis
 
             t = held_rigid_basis(fe.nodes, rigid)
             kept = t[:, :t.shape[1] - 6 * len(rigid)].tocsc().indices  # the coordinates outside, in order

@@ -24,6 +24,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from flexgear.fe.patches import rigid_interfaces
 from flexgear.modal.full_fe import (
     assembled,
     attachments,
@@ -33,7 +34,6 @@ from flexgear.modal.full_fe import (
     full_flexibility,
     recover,
     reduced_flexibility,
-    rigid_interfaces,
 )
 from flexgear.spec import Variant
 
