@@ -88,6 +88,9 @@ def export_geometry(spec: GearboxSpec, components: tuple[str, ...] | None = None
     if level not in spec.meshing_assumed:
         raise ValueError(f"unknown mesh level {level!r}; the gearbox has {', '.join(sorted(spec.meshing_assumed))}")
     for c in components:
+        if c == CARRIER and c not in allowed:
+            raise ValueError(f"component 'carrier': the {spec.gears.arrangement} arrangement holds its carrier, "
+                             "which has no solid (a carrier needs [gears] arrangement = 'planetary')")
         if c not in allowed:
             raise ValueError(f"unknown component {c!r}; allowed: {', '.join(allowed)}")
     folder = Path(out)
