@@ -150,17 +150,22 @@ def test_linear_runup_of_one_mode_is_the_swept_prediction():
     """The linear run-up of a one-mode system (unit mass, forced by s(t) Re(e^{i 2 pi phi})) is swept_peak's own
     signal: both integrate the same ODE exactly for the piecewise-linear forcing, so they coincide to round-off;
     split into segments of the same system, with the state carried across, it is unchanged."""
-    from flexgear.study.runup_linear import LinearSystem, linear_response, match_linear
+    from flexgear.harmonic.base import Operating
+    from flexgear.study.runup_linear import linear_response, match_linear
 
     t, n, load = _fast_runup()
     f, z = 955.0, 0.073
     w = 2 * math.pi * f
-    one = LinearSystem(np.eye(1), np.array([[2 * z * w]]), np.array([[w * w]]), np.ones((1, 1), complex), np.eye(1))
+    # one mode, its acceleration the output; no contact (the force is given): an operating point without meshes
+    one = Operating(np.eye(1), np.array([[2 * z * w]]), np.array([[w * w]]), np.zeros((0, 1)), np.zeros(0),
+                    np.zeros(0), np.zeros(0), np.zeros((0, 1), complex), np.zeros(0, int), (), np.eye(1), np.zeros(1),
+                    2 * math.pi * f)
+    unit = np.ones((1, 1), complex)
     phase = mesh_phase(t, n, PER_RPM)
-    y = linear_response(t, phase, load, [one])[0]
+    y = linear_response(t, phase, load, [one], unit)[0]
     reference = _driven(t, n, load, f, z, 1)
     assert np.abs(y - reference).max() <= 1e-9 * np.abs(reference).max()
-    split = linear_response(t, phase, load, [one] * 3, [0, t.size // 3, 2 * t.size // 3])[0]
+    split = linear_response(t, phase, load, [one] * 3, unit, [0, t.size // 3, 2 * t.size // 3])[0]
     assert np.abs(split - y).max() <= 1e-9 * np.abs(y).max()
     found = ridges(order_tracks(t, y, n, PER_RPM, orders=(1,), ramp_end_s=STUDY_RAMP))
     assert found["speed_rpm"].iloc[0] == pytest.approx(swept_peak(t, n, PER_RPM, 1, f, z, excitation=load), rel=1e-12)
@@ -177,7 +182,7 @@ def test_linear_runup_at_constant_speed_is_the_harmonic_solve():
     the track window's side lobes (-92 dB) of the other harmonics."""
     from flexgear.harmonic.base import ACCEL_INDICATORS, Operating, _solve, excitation
     from flexgear.study.runup import SIDE_LOBE_DB
-    from flexgear.study.runup_linear import LinearSystem, linear_response
+    from flexgear.study.runup_linear import linear_response
 
     mass = np.diag([1.0, 2.0, 1.5])
     k = np.array([[6.0, -2.0, 0.0], [-2.0, 9.0, -3.0], [0.0, -3.0, 7.0]]) * 4e7  # modes of 700-1700 Hz
@@ -191,11 +196,11 @@ def test_linear_runup_at_constant_speed_is_the_harmonic_solve():
                    np.arange(2), ("outer_mesh_force_1_n", "inner_mesh_force_1_n"), accel, np.zeros(3),
                    2 * math.pi * f_m)
     steady = _solve(dataclasses.replace(op, k_t=np.zeros(2)), harmonics)
-    system = LinearSystem(mass, damping + gyro, k, excitation(op, harmonics)[1], accel)
+    forces = excitation(op, harmonics)[1]
     t = np.arange(0.0, 0.2, DT)  # > 30 time constants 1 / (zeta omega) of the slowest decaying mode
     n = np.full(t.size, f_m / PER_RPM)
-    y = linear_response(t, mesh_phase(t, n, PER_RPM), np.ones(t.size), [system])
-    direct = accel @ np.linalg.solve(mass, system.forces.T)  # (4, H): a^T M^-1 f_h
+    y = linear_response(t, mesh_phase(t, n, PER_RPM), np.ones(t.size), [op], forces)
+    direct = accel @ np.linalg.solve(mass, forces.T)  # (4, H): a^T M^-1 f_h
     for i, name in enumerate(ACCEL_INDICATORS):
         amp = np.abs(steady[name])
         tracks = order_tracks(t, y[i], n, PER_RPM, orders=(1, 2))

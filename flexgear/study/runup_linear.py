@@ -50,6 +50,7 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
+from flexgear.harmonic.base import Operating
 from flexgear.modal.eigenmodes import state_space_roots
 from flexgear.results import RunResult
 from flexgear.study.runup import (
@@ -64,7 +65,7 @@ from flexgear.study.runup import (
     ridges,
 )
 
-__all__ = ["LinearSystem", "LinearRunUp", "linear_response", "linear_runup", "match_linear", "RAMP_POINTS",
+__all__ = ["LinearRunUp", "linear_response", "linear_runup", "match_linear", "RAMP_POINTS",
            "SERIES_LIMIT"]
 
 RAMP_POINTS = 12
@@ -75,19 +76,6 @@ its range."""
 SERIES_LIMIT = 1e-3
 """|z| = |lambda dt| below which the step coefficients b0, b1 are evaluated by their Taylor series (their closed
 forms lose digits to cancellation as z -> 0; the series' truncation error is below |z|^4 / 120)."""
-
-
-@dataclass(frozen=True)
-class LinearSystem:
-    """One linear model (module docstring): ``mass``, ``damping`` (D + G), ``stiffness`` (n, n) [SI];
-    ``forces`` (H, n) complex: f_h of harmonics 1..H [N, N m]; ``outputs`` (m, n): the rows a of the outputs'
-    accelerations [-]."""
-
-    mass: np.ndarray
-    damping: np.ndarray
-    stiffness: np.ndarray
-    forces: np.ndarray
-    outputs: np.ndarray
 
 
 def _step_coefficients(lam: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -101,9 +89,10 @@ def _step_coefficients(lam: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarr
     return e1 + 1.0, dt * (r0 - r1), dt * r1
 
 
-def _modal(system: LinearSystem) -> tuple[np.ndarray, ...]:
+def _modal(system: Operating, forces: np.ndarray) -> tuple[np.ndarray, ...]:
     """(lambda (2n,), V, V^-1 in the undamped modal state (p, p'), Phi (n, n), P (2n, H) = V^-1 B f_h,
-    Q (2n, H) = V^-1 B conj(f_h), R (m, 2n): the outputs' modal part, and their direct term (m, H) a^T M^-1 f_h)."""
+    Q (2n, H) = V^-1 B conj(f_h), R (m, 2n): the outputs' modal part, and their direct term (m, H) a^T M^-1 f_h) of
+    ``system`` (M, D + G, K and the outputs' rows ``accel``) under ``forces`` (H, n) f_h."""
     from scipy.linalg import eigh
 
     m, c, k = system.mass, system.damping, system.stiffness
@@ -112,20 +101,22 @@ def _modal(system: LinearSystem) -> tuple[np.ndarray, ...]:
     kt, ct = phi.T @ k @ phi, phi.T @ c @ phi
     lam, v = state_space_roots(np.eye(n), ct, kt)
     vinv = np.linalg.inv(v)
-    fm = system.forces @ phi  # (H, n): modal forces Phi^T f_h
+    fm = forces @ phi  # (H, n): modal forces Phi^T f_h
     p = vinv[:, n:] @ fm.T
     q = vinv[:, n:] @ fm.conj().T
-    ao = system.outputs @ phi  # a^T z'' = a^T Phi p'', p'' = -Kt p - Ct p' + Phi^T u
+    ao = system.accel @ phi  # a^T z'' = a^T Phi p'', p'' = -Kt p - Ct p' + Phi^T u
     r = (ao @ np.hstack([-kt, -ct])) @ v
     direct = ao @ fm.T
     return lam, v, vinv, phi, p, q, r, direct
 
 
 def linear_response(time_s: np.ndarray, phase_cycles: np.ndarray, envelope: np.ndarray,
-                    systems: Sequence[LinearSystem], starts: Sequence[int] = (0,)) -> np.ndarray:
+                    systems: Sequence[Operating], forces: np.ndarray, starts: Sequence[int] = (0,)) -> np.ndarray:
     """Outputs y (m, T) [m/s^2] of the linear model(s) driven by s(t) Re sum_h f_h e^{i 2 pi h phi(t)} (module
-    docstring) from rest; ``systems[j]`` holds from sample ``starts[j]`` (``starts[0]`` = 0) to the next start,
-    the state carried across each switch; all on the same coordinates, with the same number of harmonics."""
+    docstring) from rest: ``systems[j]`` (flexgear.harmonic.base.Operating: its M, D + G, K and the outputs' rows
+    ``accel`` (m, n)) holds from sample ``starts[j]`` (``starts[0]`` = 0) to the next start, the state carried
+    across each switch, all on the same coordinates; ``forces`` (H, n) complex: f_h of harmonics 1..H [N, N m]
+    (flexgear.harmonic.base.excitation of the operating point), the same for every system."""
     from scipy.signal import lfilter
 
     t = np.asarray(time_s, float)
@@ -135,12 +126,12 @@ def linear_response(time_s: np.ndarray, phase_cycles: np.ndarray, envelope: np.n
     if len(systems) != len(starts) or starts[0] != 0:
         raise ValueError("one start per system, the first at sample 0")
     s = np.asarray(envelope, float)
-    h = np.arange(1, systems[0].forces.shape[0] + 1)
+    h = np.arange(1, forces.shape[0] + 1)
     ends = list(starts[1:]) + [t.size - 1]
-    y = np.zeros((systems[0].outputs.shape[0], t.size))
+    y = np.zeros((systems[0].accel.shape[0], t.size))
     x = None  # physical state (z, z') at the segment's first sample
     for sys_, k0, k1 in zip(systems, starts, ends, strict=True):
-        lam, v, vinv, phi, p, q, r, direct = _modal(sys_)
+        lam, v, vinv, phi, p, q, r, direct = _modal(sys_, forces)
         n = phi.shape[0]
         seg = slice(k0, k1 + 1)
         e = np.exp(2j * math.pi * np.outer(h, phase_cycles[seg]))  # (H, T_seg)
@@ -180,11 +171,9 @@ class LinearRunUp:
     harmonics: int
 
 
-def _systems(variant: Any, harmonics: int, speeds: np.ndarray, torques: np.ndarray) -> tuple[list[LinearSystem],
-                                                                                               list[Any]]:
-    """The linear systems at ``speeds`` [rpm] under load torques ``torques`` [N m] on the first one's coordinates,
-    and their flexgear.harmonic.base.Operating (static forces F_0, excitation, output rows)."""
-    from flexgear.harmonic.base import ACCEL_INDICATORS, excitation
+def _operating(variant: Any, harmonics: int, speeds: np.ndarray, torques: np.ndarray) -> list[Any]:
+    """The operating points (flexgear.harmonic.base.Operating) at ``speeds`` [rpm] under load torques ``torques``
+    [N m], on the first one's coordinates."""
     from flexgear.harmonic.response import frozen_operating
     from flexgear.modal.linear import linearize
 
@@ -193,9 +182,7 @@ def _systems(variant: Any, harmonics: int, speeds: np.ndarray, torques: np.ndarr
         spec = variant.gearbox.with_fields("load_case", load_torque_nm=float(torque))
         models.append(linearize(dataclasses.replace(variant, gearbox=spec), speed_rpm=float(n),
                                 cutoff_rpm=variant.gearbox.load_case.input_speed_rpm))
-    ops = frozen_operating(models, harmonics)
-    return [LinearSystem(op.mass, op.damping, op.stiffness, excitation(op, harmonics)[1],
-                         op.accel[:len(ACCEL_INDICATORS)]) for op in ops], ops
+    return frozen_operating(models, harmonics)
 
 
 def linear_runup(result: RunResult, variant: Any, along_ramp: bool = False, harmonics: int | None = None,
@@ -206,7 +193,7 @@ def linear_runup(result: RunResult, variant: Any, along_ramp: bool = False, harm
     nominal speed) or, with ``along_ramp``, at :data:`RAMP_POINTS` points of the ramp; ``harmonics`` H (default
     the variant's ``[contact_assumed] stiffness_harmonics``, the run's excitation); the bearing accelerations'
     order tracks and ridges as flexgear.study.runup.runup reads the run's."""
-    from flexgear.harmonic.base import ACCEL_INDICATORS
+    from flexgear.harmonic.base import ACCEL_INDICATORS, excitation
 
     s = result.signals
     t = s["time_s"].to_numpy()
@@ -218,20 +205,19 @@ def linear_runup(result: RunResult, variant: Any, along_ramp: bool = False, harm
     raw = mesh_excitation(s, window_s, reference_n=1.0)  # the window-averaged total mesh force [N]
     if raw is None:
         raise ValueError(f"run {result.name!r} recorded no mesh force")
-    nominal, ops = _systems(variant, hh, np.array([lc.input_speed_rpm]), np.array([lc.load_torque_nm]))
-    f_static = float(ops[0].f0.sum())
-    envelope = raw / f_static
+    nominal = _operating(variant, hh, np.array([lc.input_speed_rpm]), np.array([lc.load_torque_nm]))
+    forces = excitation(nominal[0], hh)[1]  # F_0 C_h s(t): the load once, in s(t), at every operating point
+    envelope = raw / float(nominal[0].f0.sum())
     if along_ramp:
         t_lo = float(t[np.searchsorted(n, MIN_MESH_CYCLES / (per_rpm * window_s))])  # the first resolved speed
         times = np.linspace(t_lo, ramp, RAMP_POINTS)
         at = np.searchsorted(t, times)
-        systems = [dataclasses.replace(sy, forces=nominal[0].forces)  # F_0 C_h s(t): the load once, in s(t)
-                   for sy in _systems(variant, hh, n[at], lc.load_torque_nm * envelope[at])[0]]
+        systems = _operating(variant, hh, n[at], lc.load_torque_nm * envelope[at])
         starts = [0] + [int(k) for k in 0.5 * (at[1:] + at[:-1])]
     else:
         at = np.array([t.size - 1])
         systems, starts = nominal, [0]
-    y = linear_response(t, mesh_phase(t, n, per_rpm), envelope, systems, starts)
+    y = linear_response(t, mesh_phase(t, n, per_rpm), envelope, systems, forces, starts)
     sig = pd.DataFrame({"time_s": t, "input_speed_rpm": n, **dict(zip(ACCEL_INDICATORS, y, strict=True))})
     tracks, found = {}, {}
     excited = [k for k in orders if k <= hh]  # the model is linear: the orders above H carry nothing
