@@ -142,9 +142,11 @@ def _pairs(x_red: np.ndarray, x_full: np.ndarray, common: slice, s_red: np.ndarr
 
 
 def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=None,
-                    cache: dict | None = None) -> FullFEComparison:
+                    cache: dict | None = None, hold_rigid_patches: bool = True) -> FullFEComparison:
     """:class:`FullFEComparison` of ``variant`` at zero speed below ``f_max_hz`` (default
-    :func:`default_f_max_hz`). ``progress``: a callable taking a message, or None; ``cache``: a dict that keeps
+    :func:`default_f_max_hz`). ``hold_rigid_patches``: False leaves the interfaces the reductions hold rigid free to
+    deform in the full FE models (RBE3): the effect of that assumption, not a check of the reduction.
+    ``progress``: a callable taking a message, or None; ``cache``: a dict that keeps
     the full FE flexibilities between calls (they depend on the mesh, the attachments and ``f_max_hz`` only)."""
     from flexgear.modal.linear import linearize
 
@@ -178,7 +180,7 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
         name = next(nm for nm, body in system.bodies.items() if body.flexible and _component(nm) == b.component)
         body = system.bodies[name]
         fe_key = "planet" if name.startswith("planet") else name
-        rigid = tuple(itf.nodes for itf in rigid_interfaces(body.reduced))  # held rigid as the reduction holds them
+        rigid = tuple(itf.nodes for itf in rigid_interfaces(body.reduced)) if hold_rigid_patches else ()
         key = (variant.mesh_level, fe_key, b.weights.indices.tobytes(), np.round(b.weights.data, 12).tobytes(),
                s_top, tuple(r.tobytes() for r in rigid))
         if key not in cache:
