@@ -39,13 +39,12 @@ SHOWN = 0.01  # poles of at least this share of the largest amplitude are listed
 
 
 def impulse(files: list[str], step_s: float, settle_s: float, ground_axes: bool) -> None:
-    if ground_axes:
-        impulse_module.in_carrier_axes = lambda velocity, channels, theta: velocity
     for file in files:
         v = load_variant(file)
         v = dataclasses.replace(v, gearbox=v.gearbox.with_fields("load_case", ramp_time_s=RAMP_S))
         lin = modes(linearize(v), F_MAX_HZ)
-        response = impulse_module.impulse_response(v, window_s=WINDOW_S, step_s=step_s, settle_s=settle_s)
+        response = impulse_module.impulse_response(v, window_s=WINDOW_S, step_s=step_s, settle_s=settle_s,
+                                                   carrier_axes=not ground_axes)
         poles = impulse_module.damped_poles(response, ORDER, sample_s=SAMPLE_S, f_max_hz=F_MAX_HZ)
         largest = max(p.amplitude for p in poles)
         print(f"{file}: step {step_s * 1e6:g} us, settled {settle_s * 1e3:g} ms")

@@ -91,23 +91,21 @@ def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSiz
 def carrier_volume_mesh(spec: GearboxSpec, level: str = "coarse",
                         sizes: CarrierSizes | None = None) -> tuple[FEModel, np.ndarray]:
     """(the carrier's FE model, its tetrahedra (e, 4 or 10) in the FE model's node numbering, Netgen's node order):
-    :func:`carrier_fe_model` and the elements it is assembled on, raised to the level's order as
-    flexgear.fe.fem.fe_model raises a mesh."""
+    :func:`carrier_fe_model` and the elements it is assembled on (a second-order mesh raised from the first-order
+    one, as flexgear.fe.fem.fe_model raises a mesh, and taken by it as it is)."""
+    from flexgear.fe.mesh import mesh_arrays
+
     sizes = sizes or carrier_sizes(spec)
     order = spec.meshing_assumed[level].element_order
     mesh = _carrier_netgen_mesh(spec, level, sizes)
+    if order == 2:
+        mesh.SecondOrder()
     fe = fe_model(mesh, spec.material_assumed, order)
     missing = [pin_interface(k) for k in range(sizes.planet_count) if pin_interface(k) not in fe.regions] + (
         [SEAT] if SEAT not in fe.regions else [])
     if missing:
         raise RuntimeError(f"carrier: the meshed solid lacks the faces {missing}")
-    if order == 2:
-        mesh = mesh.Copy()
-        mesh.SecondOrder()
-    elements = np.array([[q.nr - 1 for q in el.points] for el in mesh.Elements3D()], np.int64)
-    if not np.array_equal(np.array(mesh.Coordinates(), float), fe.nodes):
-        raise RuntimeError("carrier: the raised mesh's nodes are not the FE model's")
-    return fe, elements
+    return fe, mesh_arrays(mesh, order)[1]
 
 
 def carrier_interfaces(fe: FEModel, sizes: CarrierSizes) -> list:

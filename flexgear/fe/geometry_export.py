@@ -69,12 +69,12 @@ def exported_components(spec: GearboxSpec) -> tuple[str, ...]:
 
 def _carrier_files(spec: GearboxSpec, level: str, folder: Path) -> list[Path]:
     """The carrier's STEP and VTU (module docstring)."""
-    from flexgear.fe.carrier import carrier_volume_mesh
+    from flexgear.fe.carrier import carrier_interfaces, carrier_volume_mesh
     from flexgear.geometry.carrier import carrier_sizes, carrier_solid
 
     sizes = carrier_sizes(spec)
     fe, elements = carrier_volume_mesh(spec, level, sizes)
-    sets = {**fe.regions, **{f"interface_{name}": ids for name, ids in fe.regions.items()}}
+    sets = {**fe.regions, **{f"interface_{itf.name}": itf.nodes for itf in carrier_interfaces(fe, sizes)}}
     return [write_step(carrier_solid(sizes), folder / f"{CARRIER}.step"),
             write_vtu(folder / f"{CARRIER}.vtu", fe.nodes, elements, sets)]
 

@@ -50,6 +50,7 @@ from flexgear.progress import say
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, MeshingSettings
 
 __all__ = [
+    "mesh_arrays",
     "ComponentMesh",
     "MeshSizes",
     "MeshSource",
@@ -247,7 +248,9 @@ def _netgen_mesh(brep: Path, layout: ComponentLayout, sizes: MeshSizes):
     return geo.GenerateMesh(mp=mp)
 
 
-def _arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def mesh_arrays(ngmesh, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(nodes (n, 3), tetrahedra (e, 4 or 10), boundary triangles (t, 3 or 6)) of a Netgen mesh of ``order``, node
+    indices from 0 in Netgen's numbering and node order."""
     nodes = np.array(ngmesh.Coordinates(), float)
     n_el, n_tri = (10, 6) if order > 1 else (4, 3)
     elements = np.array([[p.nr - 1 for p in el.points] for el in ngmesh.Elements3D()], np.int64)
@@ -399,7 +402,7 @@ def _build_mesh(source: MeshSource, order: int, paths: dict[str, Path], brep: Pa
         first = source_mesh(source, 1, progress)
         ngmesh = _load_netgen_mesh(first.vol_path, brep)  # as stored: the same raised mesh cold or warm
         ngmesh.SecondOrder()
-    nodes, elements, surface = _arrays(ngmesh, order)
+    nodes, elements, surface = mesh_arrays(ngmesh, order)
     build = time.perf_counter() - t0
     surface = _orient_outward(nodes, surface)
     regions = source.regions(nodes, np.unique(surface))

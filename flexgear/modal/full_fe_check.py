@@ -165,10 +165,9 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
                  default=0.0)
     seconds["linearise"] = time.perf_counter() - t
     t = time.perf_counter()
-    system = all_model  # its couplings, before the elimination
-    every = attachments(system)
+    every = attachments(all_model)  # the couplings of the all-modes model, before its elimination
     bodies = [b for b in every if carries_attachments(b)]
-    coupled = recover(system, bodies)
+    coupled = recover(all_model, bodies)
     s_all = _frequencies(all_model, s_max)
     s_rec, x_rec = eigenvalues(*assembled(coupled, [reduced_flexibility(b) for b in bodies])[:2], s_max=s_max)
     recovery = float(np.abs(np.sqrt(s_rec / s_all) - 1.0).max()) if len(s_rec) == len(s_all) else np.inf
@@ -177,8 +176,8 @@ def compare_full_fe(variant: Variant, f_max_hz: float | None = None, progress=No
     cache = {} if cache is None else cache
     flex, fe_cache, done = [], {}, {}
     for b in bodies:
-        name = next(nm for nm, body in system.bodies.items() if body.flexible and _component(nm) == b.component)
-        body = system.bodies[name]
+        name = next(nm for nm, body in all_model.bodies.items() if body.flexible and _component(nm) == b.component)
+        body = all_model.bodies[name]
         fe_key = "planet" if name.startswith("planet") else name
         rigid = tuple(itf.nodes for itf in rigid_interfaces(body.reduced)) if hold_rigid_patches else ()
         key = (variant.mesh_level, fe_key, b.weights.indices.tobytes(), np.round(b.weights.data, 12).tobytes(),

@@ -122,14 +122,16 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
                      impulse_n_s: float = DEFAULT_IMPULSE_N_S, pulse_s: float = DEFAULT_PULSE_S,
                      settle_s: float = DEFAULT_SETTLE_S, window_s: float = DEFAULT_WINDOW_S,
                      step_s: float | None = None, newton_relative_tolerance: float | None = None,
-                     mass_source=None, reduced_source=None) -> ImpulseResponse:
+                     mass_source=None, reduced_source=None, carrier_axes: bool = True) -> ImpulseResponse:
     """The response of ``variant`` to a force pulse on its output-shaft bearing at steady state (module docstring).
 
     ``speed_rpm``: input speed [rpm] (default the load case's); mesh stiffness constant (its mean), as
     :func:`flexgear.modal.linear.linearize` builds the variant. ``spectral_radius``: generalized-alpha's rho_inf
     (default ``[solver_assumed]``'s); ``step_s``: the step [s] (default the load case's);
     ``newton_relative_tolerance``: Newton's (default :data:`DEFAULT_NEWTON_RELATIVE_TOLERANCE`). ``mass_source``,
-    ``reduced_source``: as flexgear.mbs.assemble.build_gearbox (any arrangement).
+    ``reduced_source``: as flexgear.mbs.assemble.build_gearbox (any arrangement). ``carrier_axes``: False reads a
+    planetary stage's record in ground axes (module docstring: each in-plane mode then shows at f +- the carrier's
+    speed).
     """
     import exudyn as exu
     from exudyn.itemInterface import LoadCoordinate, MarkerNodeCoordinate, SensorNode
@@ -220,9 +222,8 @@ def impulse_response(variant: Variant, speed_rpm: float | None = None, *, spectr
     time = pushed[:n, 0] - t1
     scale = np.array([1.0 if c.split(".")[1].startswith("v") else arm for c in channels])
     velocity = (pushed[:n, 1:] - quiet[:n, 1:]) * scale
-    if "carrier" in model.bodies:  # the planetary stage: the in-plane pairs in the carrier's axes
-        theta = np.array([carrier_angle(model, spec, t)[0] for t in pushed[:n, 0]])
-        velocity = in_carrier_axes(velocity, channels, theta)
+    if carrier_axes and "carrier" in model.bodies:  # the planetary stage: the in-plane pairs in the carrier's axes
+        velocity = in_carrier_axes(velocity, channels, carrier_angle(model, spec, pushed[:n, 0])[0])
     keep = time >= -0.5 * h
     speed = lc.input_speed_rpm
     return ImpulseResponse(built, speed, rho, h, pulse_s, impulse_n_s, time[keep], velocity[keep], tuple(channels))

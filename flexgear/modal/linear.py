@@ -334,14 +334,15 @@ def operating_point(mbs, model, variant: Variant, t_star: float, passes: int = 3
     mbs.systemData.SetODE2Coordinates_t(v0, exu.ConfigurationType.Initial)
 
 
-def carrier_angle(model, spec, t_star: float) -> tuple[float, float]:
-    """(angle [rad], rate [rad/s]) of the planetary stage's nominal carrier at ``t_star``: the drive's angle and
-    speed times the carrier's ratio z_s / (z_s + z_r)."""
+def carrier_angle(model, spec, t_star: float | np.ndarray) -> tuple[float | np.ndarray, float]:
+    """(angle [rad], rate [rad/s]) of the planetary stage's nominal carrier at ``t_star`` [s] (a time, or an array
+    of times and then their angles): the drive's angle and speed times the carrier's ratio z_s / (z_s + z_r)."""
     from flexgear.laws.ramps import drive_angle
 
     th, lc = model.theory, spec.load_case
     ratio = th.output_speed / th.input_speed
-    return ratio * float(drive_angle(t_star, lc.ramp_time_s, lc.input_speed_rad_s)), th.output_speed
+    angle = ratio * np.asarray(drive_angle(np.asarray(t_star, float), lc.ramp_time_s, lc.input_speed_rad_s))
+    return (float(angle) if angle.ndim == 0 else angle), th.output_speed
 
 
 RETRY_RELATIVE_TOLERANCE = 1e-10
