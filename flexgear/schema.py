@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from flexgear.schema_fields import SpecError, choice_field, derived_field, num_field
+from flexgear.schema_fields import SpecError, choice_field, derived_field, num_field, numbers_field
 from flexgear.schema_geometry import ComponentGeometry
 from flexgear.schema_screening import (
     IndicatorTolerance,
@@ -64,6 +64,31 @@ class GearSet:
     helix_angle_deg: float = num_field(0.0, 45.0)
     normal_pressure_angle_deg: float = num_field(10.0, 30.0)
     arrangement: str = choice_field("star", "planetary", default="star")
+    planet_positions_deg: tuple[float, ...] = numbers_field(
+        0.0, 360.0, hi_open=True,
+        doc="polar angle of each planet's centre [deg], increasing; left out: equally spaced from 0")
+
+    @property
+    def assembly_step_rad(self) -> float:
+        """Angle between neighbouring positions at which a planet assembles, 2 pi / (z_s + z_r) [rad]: at polar
+        angle psi a planet meshes with sun and ring only if (z_s + z_r) psi / (2 pi) is an integer."""
+        return 2.0 * math.pi / (self.sun_teeth + self.ring_teeth)
+
+    @property
+    def planet_positions_rad(self) -> tuple[float, ...]:
+        """Each planet's polar angle [rad]: the given positions on the nearest assembly angle
+        (:attr:`assembly_step_rad`; flexgear.spec refuses a position farther off than
+        ``PLANET_POSITION_TOLERANCE_STEPS``), else N equally spaced from 0."""
+        if not self.planet_positions_deg:
+            return tuple(2.0 * math.pi * k / self.planet_count for k in range(self.planet_count))
+        step = self.assembly_step_rad
+        return tuple(step * round(math.radians(a) / step) for a in self.planet_positions_deg)
+
+    @property
+    def equally_spaced(self) -> bool:
+        """Whether the planets are equally spaced (left out, or given so)."""
+        psi, n = self.planet_positions_rad, self.planet_count
+        return all(abs(a - psi[0] - 2.0 * math.pi * k / n) < 1e-9 for k, a in enumerate(psi))
 
     @property
     def normal_module_m(self) -> float:

@@ -8,7 +8,7 @@ from dataclasses import field
 from pathlib import Path
 from typing import Any
 
-__all__ = ["SpecError", "num_field", "derived_field", "choice_field", "text_field"]
+__all__ = ["SpecError", "num_field", "numbers_field", "derived_field", "choice_field", "text_field"]
 
 
 class SpecError(ValueError):
@@ -26,6 +26,12 @@ def num_field(lo: float | None = None, hi: float | None = None, *, lo_open: bool
     value left out of the file follows the gear data where :mod:`flexgear.sizing` gives one, else ``default``."""
     meta = {"lo": lo, "hi": hi, "lo_open": lo_open, "integer": integer, "doc": doc}
     return field(default=default, metadata={**meta, "derived": True} if derived else meta)
+
+
+def numbers_field(lo: float | None = None, hi: float | None = None, *, hi_open: bool = False, doc: str = "") -> Any:
+    """Optional field holding a list of numbers, each in [``lo``, ``hi``] (``hi`` excluded when ``hi_open``);
+    left out, the empty tuple (validated on load, stored as a tuple of floats)."""
+    return field(default=(), metadata={"lo": lo, "hi": hi, "hi_open": hi_open, "sequence": True, "doc": doc})
 
 
 def derived_field(lo: float | None = None, hi: float | None = None, *, lo_open: bool = False, doc: str = "") -> Any:

@@ -73,6 +73,8 @@ def _broken_value(f: dataclasses.Field | None, hint: Any) -> tuple[Any, str]:
         return "fast", "expected a table"
     if "choices" in meta:
         return "bogus", "one of"
+    if meta.get("sequence"):
+        return [meta["lo"] - 1.0], "expected a value"
     if hint is str:
         return 5, "string"
     if meta.get("integer"):
@@ -92,7 +94,7 @@ def _set(data: dict, dotted: str, value: Any) -> dict:
     for t in tables:
         node = node[t]
     if value is _DELETE:
-        del node[name]
+        node.pop(name, None)  # a field the file does not give is left out already
     else:
         node[name] = value
     return out

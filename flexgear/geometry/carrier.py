@@ -11,14 +11,17 @@ operating centre distance a_w) at the gear set's polar angle psi_k (flexgear.geo
   radius r_w (the planet's tip circle and a clearance) round each planet, which cuts it into N posts.
 
 Sizes follow the gear set (:class:`CarrierSizes`, each a named default relative to the module, the pin or the face
-width, and each may be given). Exact mass properties (:func:`carrier_mass_properties`) integrate the sections: a
-plate's area A = pi (R_p^2 - r_b^2) - N pi r_pin^2, polar moment J = pi (R_p^4 - r_b^4) / 2 - N pi r_pin^2 (r_pin^2
-/ 2 + a_w^2); the posts' annulus less the part of each window inside it, whose area and polar moment are
+width, and each may be given). Exact mass properties (:func:`carrier_mass_properties`) integrate the sections, for
+any planet positions, by their area A, first moments Q = int (x, y) dA and second moments S = int (x, y) (x, y)^T dA:
+a plate is the annulus between r_b and R_p less N pin bores (discs: A = pi r_pin^2, Q = A c, S = A (r_pin^2 / 4 I +
+c c^T) at centre c); the posts' annulus less the part of each window inside it, in the window's own axes (x'
+towards its centre)
 
-    A_w = int_R1^R2 phi(r) r dr,   J_w = int_R1^R2 phi(r) r^3 dr,   phi(r) = 2 acos((r^2 + a_w^2 - r_w^2) / (2 a_w r))
+    A_w = int phi r dr,   Q_x' = int 2 sin(phi / 2) r^2 dr,   S_x'x', S_y'y' = int (phi +- sin phi) r^3 / 2 dr,
+    phi(r) = 2 acos((r^2 + a_w^2 - r_w^2) / (2 a_w r))   (R_1 <= r <= R_p)
 
 (phi the window's angular width at radius r, 0 or 2 pi beyond its reach), by Gauss-Legendre quadrature on the
-pieces between the points where phi has a square-root end (r = a_w -+ r_w).
+pieces between the points where phi has a square-root end (r = a_w -+ r_w), then turned to the planet's angle.
 """
 
 from __future__ import annotations
@@ -28,8 +31,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from flexgear.geometry.involute import gear_set_geometry_of
-from flexgear.geometry.layout import stacked_prism_mass_properties
+from flexgear.geometry.involute import gear_set_geometry_of, min_planet_gap
 from flexgear.geometry.massprops import MassProperties
 from flexgear.schema import ComponentsAssumed, GearSet, GearSetAssumed
 from flexgear.spec import GearboxSpec
@@ -88,7 +90,7 @@ class CarrierSizes:
                              f"the plates (outer radius {self.plate_outer_radius:.6g} m)")
         if a - self.pin_radius <= self.bore_radius:
             raise ValueError("carrier: the pin bores reach the plates' central bore")
-        if n >= 2 and 2.0 * self.window_radius >= 2.0 * a * math.sin(math.pi / n):
+        if n >= 2 and 2.0 * self.window_radius >= 2.0 * a * math.sin(min_planet_gap(self.planet_angles) / 2):
             raise ValueError(f"carrier: the planets' windows (radius {self.window_radius:.6g} m) overlap: no room for "
                              f"posts between {n} planets on a {a:.6g} m pin circle")
         if not (self.plate_thickness > 0.0 and self.gap > 0.0):
@@ -150,34 +152,83 @@ def carrier_solid(sizes: CarrierSizes):
     return plates[0] + cage + plates[1]
 
 
-def _window_integrals(a: float, rw: float, r1: float, r2: float) -> tuple[float, float]:
-    """(A_w, J_w) of the module docstring: area [m^2] and polar moment [m^4] of the part of a window of radius
-    ``rw`` centred at distance ``a`` from the axis that lies between radii ``r1`` and ``r2``."""
+@dataclass(frozen=True)
+class _Section:
+    """A plane section's area A [m^2], first moments Q = int (x, y) dA [m^3] and second moments S = int (x, y)
+    (x, y)^T dA [m^4] about the axis."""
+
+    area: float
+    first: np.ndarray
+    second: np.ndarray
+
+    def __sub__(self, other: _Section) -> _Section:
+        return _Section(self.area - other.area, self.first - other.first, self.second - other.second)
+
+    def __add__(self, other: _Section) -> _Section:
+        return _Section(self.area + other.area, self.first + other.first, self.second + other.second)
+
+
+def _annulus(r_in: float, r_out: float) -> _Section:
+    """Annulus between radii ``r_in`` and ``r_out``: A = pi (R^2 - r^2), S = pi (R^4 - r^4) / 4 I."""
+    return _Section(math.pi * (r_out**2 - r_in**2), np.zeros(2), math.pi * (r_out**4 - r_in**4) / 4 * np.eye(2))
+
+
+def _disc(radius: float, centre: np.ndarray) -> _Section:
+    """Disc of ``radius`` at ``centre`` (2,): A = pi r^2, Q = A c, S = A (r^2 / 4 I + c c^T)."""
+    area = math.pi * radius**2
+    return _Section(area, area * centre, area * (radius**2 / 4 * np.eye(2) + np.outer(centre, centre)))
+
+
+def _window(a: float, rw: float, r1: float, r2: float, psi: float) -> _Section:
+    """The part between radii ``r1`` and ``r2`` of a window of radius ``rw`` centred at distance ``a`` from the
+    axis at polar angle ``psi`` (module docstring), in its own axes (x' towards the window) first:
+    A = int phi r dr, Q_x' = int 2 sin(phi / 2) r^2 dr, S_x'x' = int (phi + sin phi) r^3 / 2 dr,
+    S_y'y' = int (phi - sin phi) r^3 / 2 dr; then turned by ``psi``."""
     cuts = sorted({r1, r2, *(r for r in (a - rw, a + rw) if r1 < r < r2)})
     x, w = np.polynomial.legendre.leggauss(_QUADRATURE_POINTS)
-    area = polar = 0.0
+    area = first = s_xx = s_yy = 0.0
     for lo, hi in zip(cuts[:-1], cuts[1:], strict=True):
         r = 0.5 * (hi - lo) * x + 0.5 * (hi + lo)
         cos_half = (r**2 + a**2 - rw**2) / (2.0 * a * r)
         phi = 2.0 * np.arccos(np.clip(cos_half, -1.0, 1.0))
-        area += 0.5 * (hi - lo) * float(np.sum(w * phi * r))
-        polar += 0.5 * (hi - lo) * float(np.sum(w * phi * r**3))
-    return area, polar
+        half = 0.5 * (hi - lo)
+        area += half * float(np.sum(w * phi * r))
+        first += half * float(np.sum(w * 2.0 * np.sin(phi / 2) * r**2))
+        s_xx += half * float(np.sum(w * (phi + np.sin(phi)) * r**3 / 2))
+        s_yy += half * float(np.sum(w * (phi - np.sin(phi)) * r**3 / 2))
+    turn = np.array([[math.cos(psi), -math.sin(psi)], [math.sin(psi), math.cos(psi)]])
+    return _Section(area, first * turn[:, 0], turn @ np.diag([s_xx, s_yy]) @ turn.T)
+
+
+def _prisms_mass_properties(prisms: list[tuple[_Section, float, float]], rho: float) -> MassProperties:
+    """Mass properties of prisms along z, each (section, z0, z1 [m]), at density ``rho`` [kg/m^3]: about the
+    origin I_xx = rho (S_yy L + A (z1^3 - z0^3) / 3), I_yy likewise, I_zz = rho (S_xx + S_yy) L,
+    I_xy = -rho S_xy L, I_xz = -rho Q_x (z1^2 - z0^2) / 2, I_yz likewise; then moved to the centre of mass."""
+    mass, moment, inertia = 0.0, np.zeros(3), np.zeros((3, 3))
+    for sec, z0, z1 in prisms:
+        length, z2, z3 = z1 - z0, (z1**2 - z0**2) / 2, (z1**3 - z0**3) / 3
+        mass += rho * sec.area * length
+        moment += rho * np.array([sec.first[0] * length, sec.first[1] * length, sec.area * z2])
+        sxx, syy, sxy = sec.second[0, 0], sec.second[1, 1], sec.second[0, 1]
+        inertia += rho * np.array([[syy * length + sec.area * z3, -sxy * length, -sec.first[0] * z2],
+                                   [-sxy * length, sxx * length + sec.area * z3, -sec.first[1] * z2],
+                                   [-sec.first[0] * z2, -sec.first[1] * z2, (sxx + syy) * length]])
+    com = moment / mass
+    return MassProperties(mass, com, inertia - mass * (com @ com * np.eye(3) - np.outer(com, com)))
 
 
 def carrier_mass_properties(sizes: CarrierSizes, density: float) -> MassProperties:
     """Mass [kg], centre of mass [m] and inertia about it [kg m^2] of the carrier of ``sizes`` at ``density``
-    [kg/m^3], from the exact section integrals (module docstring); the pins' N-fold pattern (N >= 3) makes the
-    transverse inertia axisymmetric."""
+    [kg/m^3], from the exact section integrals (module docstring), for any planet positions: unequally spaced
+    pins and windows move the centre of mass off the axis and make the transverse inertia unequal."""
     s = sizes
-    n, a = s.planet_count, s.pin_circle_radius
-    plate_area = math.pi * (s.plate_outer_radius**2 - s.bore_radius**2) - n * math.pi * s.pin_radius**2
-    plate_polar = (math.pi * (s.plate_outer_radius**4 - s.bore_radius**4) / 2
-                   - n * math.pi * s.pin_radius**2 * (s.pin_radius**2 / 2 + a**2))
-    win_area, win_polar = _window_integrals(a, s.window_radius, s.post_inner_radius, s.plate_outer_radius)
-    post_area = math.pi * (s.plate_outer_radius**2 - s.post_inner_radius**2) - n * win_area
-    post_polar = math.pi * (s.plate_outer_radius**4 - s.post_inner_radius**4) / 2 - n * win_polar
+    centres = s.pin_centres()[:, :2]
+    plate = _annulus(s.bore_radius, s.plate_outer_radius)
+    posts = _annulus(s.post_inner_radius, s.plate_outer_radius)
+    for c, psi in zip(centres, s.planet_angles, strict=True):
+        plate = plate - _disc(s.pin_radius, c)
+        posts = posts - _window(s.pin_circle_radius, s.window_radius, s.post_inner_radius, s.plate_outer_radius,
+                                psi)
     half = s.gap / 2
-    return stacked_prism_mass_properties([(plate_area, plate_polar, -half - s.plate_thickness, -half),
-                                          (post_area, post_polar, -half, half),
-                                          (plate_area, plate_polar, half, half + s.plate_thickness)], density)
+    return _prisms_mass_properties([(plate, -half - s.plate_thickness, -half), (posts, -half, half),
+                                    (plate, half, half + s.plate_thickness)], density)

@@ -42,7 +42,7 @@ import dataclasses
 import math
 from collections.abc import Callable
 
-from flexgear.geometry.involute import Gear, gear_set_geometry, transverse_pressure_angle
+from flexgear.geometry.involute import Gear, gear_set_geometry, min_planet_gap, transverse_pressure_angle
 from flexgear.geometry.profile import ToothProfile, tooth_profile
 from flexgear.spec import GearboxSpec, SpecError, register_feasibility_check
 
@@ -164,7 +164,11 @@ def _teeth(spec: GearboxSpec) -> None:
                             "expected a value that gives it a larger profile shift, or more teeth",
                             _value(spec, field))
     tip_d = 2 * gs.planet.tip_radius
-    spacing = 2 * gs.centre_distance * math.sin(math.pi / g.planet_count) if g.planet_count > 1 else math.inf
+    spacing = 2 * gs.centre_distance * math.sin(min_planet_gap(gs.planet_angles) / 2)
+    if spacing <= tip_d and g.planet_positions_deg:
+        raise SpecError(spec.source, "gears.planet_positions_deg",
+                        f"neighbouring planets' tip circles overlap (closest centres {spacing / _MM:.2f} mm apart <= "
+                        f"tip diameter {tip_d / _MM:.2f} mm); expected planets farther apart", g.planet_positions_deg)
     if spacing <= tip_d:
         fit = max(n for n in range(1, g.planet_count)
                   if n == 1 or 2 * gs.centre_distance * math.sin(math.pi / n) > tip_d)

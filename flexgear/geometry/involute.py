@@ -34,6 +34,7 @@ __all__ = [
     "base_helix_angle",
     "Gear",
     "GearMesh",
+    "min_planet_gap",
     "gear_set_geometry_of",
     "Mesh",
     "HelixHalf",
@@ -266,6 +267,7 @@ class GearSetGeometry:
     planet_count: int
     helix_layout: str
     half_gap: float
+    planet_positions: tuple[float, ...] = ()  # each planet's polar angle [rad]; () = equally spaced from 0
 
     @property
     def helix_face_width(self) -> float:
@@ -275,8 +277,19 @@ class GearSetGeometry:
 
     @property
     def planet_angles(self) -> np.ndarray:
-        """Angular positions of the (equally spaced) planets [rad]."""
+        """Angular positions of the planets [rad]: ``planet_positions``, else equally spaced from 0."""
+        if self.planet_positions:
+            return np.asarray(self.planet_positions, float)
         return 2 * math.pi * np.arange(self.planet_count) / self.planet_count
+
+
+def min_planet_gap(angles: np.ndarray | tuple[float, ...]) -> float:
+    """Smallest polar angle between neighbouring planets [rad] (pi for one planet: no neighbour closer than the
+    far side)."""
+    psi = np.sort(np.mod(np.asarray(angles, float), 2 * math.pi))
+    if psi.size < 2:
+        return math.pi
+    return float(np.diff(np.r_[psi, psi[0] + 2 * math.pi]).min())
 
 
 def _mesh_angle(z1: int, z2: int, x1: float, x2: float, alpha_n: float, alpha_t: float) -> float:
@@ -347,5 +360,5 @@ def _gear_set_geometry(g, a) -> GearSetGeometry:
     sun, planet, ring = gear(g.sun_teeth, xs, False), gear(g.planet_teeth, xp, False), gear(g.ring_teeth, xr, True)
     return GearSetGeometry(
         sun, planet, ring, GearMesh(sun, planet, aw, aw_sp), GearMesh(planet, ring, aw, aw_pr),
-        aw, g.planet_count, a.helix_layout, a.half_gap_m,
+        aw, g.planet_count, a.helix_layout, a.half_gap_m, g.planet_positions_rad if g.planet_positions_deg else (),
     )

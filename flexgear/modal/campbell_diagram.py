@@ -47,7 +47,8 @@ l = k z_s mod N:
 
 A crossing of order k with a mode of another kind makes no resonance (the order does not excite it), and a planet
 mode (central members at rest) none at the bearings of the central members. Modes of other kinds (``mixed``,
-``elastic_*``: symmetry broken) are taken as excited by every order.
+``elastic_*``: symmetry broken) are taken as excited by every order, and so is every mode when the planets are not
+equally spaced (gears.planet_positions_deg): the rule needs the cyclic symmetry.
 """
 
 from __future__ import annotations
@@ -271,6 +272,7 @@ def campbell(variant: Variant, speeds_rpm: Sequence[float], f_max_hz: float | No
                          "damping_ratio": m.damping_ratios[jj], "kind": m.kinds[jj]})
     table = pd.DataFrame(rows, columns=["speed_rpm", "mode", "frequency_hz", "damping_ratio", "kind"])
     table = table.sort_values(["speed_rpm", "frequency_hz"], ignore_index=True)
-    crossings = order_crossings(table, per_rpm, orders, spec.gears.sun_teeth, spec.gears.planet_count)
+    crossings = order_crossings(table, per_rpm, orders, spec.gears.sun_teeth,
+                                spec.gears.planet_count if spec.gears.equally_spaced else None)
     return Campbell(variant.name, table, crossings, per_rpm, band, tuple(orders),
                     float(macs.min()) if macs.size else 1.0)

@@ -151,7 +151,9 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
     def draw(fig: Figure) -> None:
         left = fig.add_axes([0.05, 0.08, 0.42, 0.8])
         right = fig.add_axes([0.53, 0.08, 0.42, 0.8])
-        t1 = pd.DataFrame({"gear": ["sun", f"planet (x{g.planet_count})", "ring"],
+        where = ("" if g.equally_spaced else
+                 " at " + ", ".join(f"{math.degrees(a):.4g}" for a in g.planet_positions_rad) + "°")
+        t1 = pd.DataFrame({"gear": ["sun", f"planet (x{g.planet_count}{where})", "ring"],
                            "teeth": [g.sun_teeth, g.planet_teeth, g.ring_teeth],
                            "normal module [mm]": [g.normal_module_mm] * 3,
                            "helix angle [°]": [g.helix_angle_deg] * 3,
