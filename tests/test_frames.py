@@ -86,6 +86,24 @@ def test_asymmetric_body_is_refused():
         axisymmetric_frame_mass(MASS, [0.01 * r_g, 0.0, 0.0], np.diag([J_T, J_T, J_P]), 1e-4)
 
 
+def test_asymmetric_body_takes_the_exact_frame():
+    """The same body added as a frame (flexgear.mbs.bodies.add_frame_inertia): Exudyn's exact ``ObjectRigidBody``,
+    which keeps the imbalance, instead of the linear frame; an axisymmetric one gets the linear frame."""
+    import exudyn as exu
+    from exudyn.itemInterface import NodeRigidBodyRxyz
+
+    from flexgear.mbs.bodies import add_frame_inertia
+
+    r_g = np.sqrt(J_P / MASS)
+    mbs = exu.SystemContainer().AddSystem()
+    for offset, linear in ((0.01 * r_g, False), (0.0, True)):
+        node = mbs.AddNode(NodeRigidBodyRxyz(referenceCoordinates=[0.0] * 6))
+        obj, frame = add_frame_inertia(mbs, f"body_{linear}", node, MASS, [offset, 0.0, 0.0],
+                                       np.diag([J_T, J_T, J_P]), SPIN, 1e-4)
+        assert (frame is not None) == linear
+        assert ("GenericODE2" if linear else "RigidBody") in str(mbs.GetObject(obj)["objectType"])
+
+
 def _model1_runs(ramp_time_s: float, end_time_s: float) -> list:
     """Model 1 on a shortened load case in the reference and the production formulation."""
     from flexgear.mbs.run import run_variant

@@ -16,7 +16,8 @@ M (6 x 6, constant) the mass matrix of the axisymmetric body at the reference, [
 gyroscopic term of a body spinning at Omega about its tilted axis (kinetic energy of R = R_x R_y R_z to second
 order: 1/2 J_t (phi_x'^2 + phi_y'^2) + 1/2 J_p phi_z'^2 + J_p phi_y phi_x' phi_z'). Every body's mass matrix is then
 constant and Exudyn computes it once per run. Left out: the lateral centre-of-mass offset and the inertia's
-asymmetry of the meshed body (< ``frame_axisymmetry_tolerance``, checked), terms of second order in the tilts.
+asymmetry of the meshed body (< ``frame_axisymmetry_tolerance``; a body beyond it, such as a carrier with unequally
+spaced planets, takes Exudyn's exact ``ObjectRigidBody``), terms of second order in the tilts.
 The reference formulation uses Exudyn's ``ObjectRigidBody`` (exact; its mass matrix depends on the angles, so
 Exudyn rebuilds the whole system's mass matrix in every Newton iteration).
 """
@@ -31,7 +32,7 @@ from flexgear.geometry.elements import lever_rows
 from flexgear.geometry.massprops import MassProperties, inertia_about_point
 
 __all__ = ["Body", "LinearFrame", "add_frame_inertia", "add_linear_frame", "add_rigid_body", "axisymmetric_frame_mass",
-           "frame_rows", "matrix_container", "zero_user_jacobian"]
+           "frame_asymmetry", "frame_rows", "matrix_container", "zero_user_jacobian"]
 
 
 @dataclass(frozen=True)
@@ -85,18 +86,29 @@ def add_rigid_body(mbs, name: str, props: MassProperties, position: np.ndarray, 
 def add_frame_inertia(mbs, label: str, node: int, mass: float, com, inertia, spin_rad_s: float,
                       linear_frame_tolerance: float | None) -> tuple[int, LinearFrame | None]:
     """The inertia of a body frame on ``node``: ``mass`` [kg], ``com`` [m] and ``inertia`` [kg m^2] about the frame
-    origin (body axes). ``linear_frame_tolerance`` None: Exudyn's ``ObjectRigidBody`` named ``label`` (exact);
-    else :func:`add_linear_frame` at the nominal spin ``spin_rad_s`` [rad/s] with that axisymmetry tolerance.
+    origin (body axes). ``linear_frame_tolerance`` None, or a body less axisymmetric than it
+    (:func:`frame_asymmetry`, e.g. a carrier with unequally spaced planets): Exudyn's ``ObjectRigidBody`` named
+    ``label`` (exact); else :func:`add_linear_frame` at the nominal spin ``spin_rad_s`` [rad/s].
     Returns (object, its LinearFrame or None)."""
     from exudyn.itemInterface import ObjectRigidBody
     from exudyn.rigidBodyUtilities import InertiaTensor2Inertia6D
 
-    if linear_frame_tolerance is None:
+    if linear_frame_tolerance is None or frame_asymmetry(mass, com, inertia) > linear_frame_tolerance:
         return mbs.AddObject(ObjectRigidBody(name=label, nodeNumber=node, mass=float(mass),
                                              inertia=InertiaTensor2Inertia6D(np.asarray(inertia, float)),
                                              centerOfMass=[float(v) for v in com])), None
     frame = add_linear_frame(mbs, label, node, mass, com, inertia, spin_rad_s, linear_frame_tolerance)
     return frame.obj, frame
+
+
+def frame_asymmetry(mass: float, com, inertia) -> float:
+    """What the linear frame leaves out, relative: the largest of the lateral centre-of-mass offset over the radius
+    of gyration sqrt(J_p / m), and an off-diagonal of the inertia ``inertia`` [kg m^2] about the frame origin or
+    J_xx - J_yy over J_p (``mass`` [kg], ``com`` [m])."""
+    c, j = np.asarray(com, float), np.asarray(inertia, float)
+    polar = float(j[2, 2])
+    return max(float(np.hypot(c[0], c[1])) / np.sqrt(polar / mass), abs(j[0, 0] - j[1, 1]) / polar,
+               *(abs(j[a, b]) / polar for a, b in ((0, 1), (0, 2), (1, 2))))
 
 
 def axisymmetric_frame_mass(mass: float, com, inertia, tolerance: float, name: str = "body"
@@ -107,8 +119,7 @@ def axisymmetric_frame_mass(mass: float, com, inertia, tolerance: float, name: s
     J_xx - J_yy relative to J_p."""
     c, j = np.asarray(com, float), np.asarray(inertia, float)
     polar = float(j[2, 2])
-    defect = max(float(np.hypot(c[0], c[1])) / np.sqrt(polar / mass), abs(j[0, 0] - j[1, 1]) / polar,
-                 *(abs(j[a, b]) / polar for a, b in ((0, 1), (0, 2), (1, 2))))
+    defect = frame_asymmetry(mass, com, inertia)
     if defect > tolerance:
         raise ValueError(f"{name}: a linear frame needs an axisymmetric body; its asymmetry {defect:.2e} exceeds "
                          f"[solver_assumed] frame_axisymmetry_tolerance = {tolerance:g}")
