@@ -29,7 +29,7 @@ from flexgear.geometry.layout import (
 from flexgear.geometry.massprops import MassProperties
 from flexgear.geometry.profile import ToothProfile
 from flexgear.geometry.supports import seat_supports
-from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
+from flexgear.spec import CARRIER, GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
 from flexgear.theory import Theory, gear_set_theory
 
 __all__ = ["Design", "design", "as_design", "register_part_masses"]
@@ -43,7 +43,8 @@ class Design:
     ring (flexgear.geometry.layout.tooth_profiles); ``layouts``: every geometry component's prisms in its frame
     (flexgear.spec.GEOMETRY_COMPONENTS); ``masses``: each one's mass [kg], centre of mass [m] and inertia about it
     [kg m^2] from the exact section integrals (flexgear.geometry.layout.component_mass_properties, cached on disk
-    under the same key), or for a part from a file its own geometry's (flexgear.fe.imported_mass); ``supports``: the
+    under the same key), or for a part from a file its own geometry's (flexgear.fe.imported_mass; a carrier from a
+file too); ``supports``: the
     Table 2 bearings at their seats (flexgear.geometry.supports.gearbox_supports); ``meshes``: the contact geometry
     of the sun-planet ("outer", sun = gear 1 of hand +1 in the +z half) and the planet-ring ("inner", planet = gear
     1 of hand -1) mesh, with ``[contact_assumed] stiffness_harmonics`` harmonics in the contact-line series.
@@ -65,6 +66,18 @@ class Design:
     def mass_properties(self, component: str) -> MassProperties:
         """The exact mass properties of ``component`` (``masses[component]``: kg, m, kg m^2)."""
         return self.masses[component]
+
+    def carrier_disc(self) -> tuple[float, float]:
+        """(mass [kg], polar inertia [kg m^2]) of a planetary stage's carrier as its rigid body and the lumped model
+        take it (a centred disc): ``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2``, but where the
+        carrier comes from a file (``[components_geometry] carrier``) and the gearbox file leaves them out, the
+        part's own (``masses["carrier"]``)."""
+        la, derived = self.spec.lumped_assumed, self.spec.derived
+        part = self.masses.get(CARRIER)
+        mass = part.mass if part is not None and "lumped_assumed.carrier_mass_kg" in derived else la.carrier_mass_kg
+        inertia = (float(part.inertia[2, 2]) if part is not None and "lumped_assumed.carrier_inertia_kg_m2" in derived
+                   else la.carrier_inertia_kg_m2)
+        return mass, inertia
 
 
 _DESIGNS: dict[str, Design] = {}
@@ -89,7 +102,7 @@ def design(spec: GearboxSpec) -> Design:
         profiles = tooth_profiles(geo, spec.gears_assumed.root_fillet_coefficient)
         layouts = {c: gear_set_layout(spec, geo, c) for c in GEOMETRY_COMPONENTS}
         rho = spec.material_assumed.density_kg_m3
-        imported = [c for c in GEOMETRY_COMPONENTS if c in spec.components_geometry]
+        imported = [c for c in (*GEOMETRY_COMPONENTS, CARRIER) if c in spec.components_geometry]
         masses = {c: cached_mass_properties(spec, c, lambda c=c: layout_mass_properties(layouts[c], profiles, rho))
                   for c in GEOMETRY_COMPONENTS if c not in imported}
         supports = seat_supports(spec, layouts["input_shaft"], layouts["output_shaft"])

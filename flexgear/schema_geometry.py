@@ -4,12 +4,12 @@
     ring = { file = "parts/ring.step", length_unit = "mm" }
     sun = { file = "parts/sun.msh", length_unit = "mm", regions = { bore = { physical_group = "bore" } } }
 
-One entry per component of the geometry (sun, planet, ring, input_shaft, output_shaft), the path relative to the
-gearbox file. Read when the gearbox is loaded: the file must exist and not be empty, and its SHA-256 is taken
-then, so that its content (not its name or place) enters the spec hash and every cache key of the component
-(flexgear.geometry.layout.geometry_hash): a changed file rebuilds its mesh and reduced body. What the file holds
-(a solid, tetrahedra, teeth that match the gear data, the regions the reduction needs) is checked when the
-component is meshed (flexgear.fe.imported).
+One entry per component of the geometry (sun, planet, ring, input_shaft, output_shaft, and a planetary stage's
+carrier), the path relative to the gearbox file. Read when the gearbox is loaded: the file must exist and not be
+empty, and its SHA-256 is taken then, so that its content (not its name or place) enters the spec hash and every
+cache key of the component (flexgear.geometry.layout.geometry_hash): a changed file rebuilds its mesh and reduced
+body. What the file holds (a solid, tetrahedra, teeth that match the gear data, the regions the reduction needs) is
+checked when the component is meshed (flexgear.fe.imported).
 
 ``regions`` (optional) names where the part's interface regions are, one selector per region
 (:class:`RegionSelector`; the regions of each component: :data:`SELECTABLE_REGIONS`); a region not named keeps its
@@ -46,18 +46,20 @@ GEOMETRY_FORMATS = {".step": "step", ".stp": "step", ".brep": "brep", ".brp": "b
 """File suffix (lower case) -> kind: an OCC solid (STEP, BREP), meshed by flexgear, or a volume mesh (meshio)."""
 LENGTH_UNITS = {"m": 1.0, "mm": 1e-3}
 """Length unit of a file's coordinates -> metres per unit."""
-_COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft")
+_COMPONENTS = ("sun", "planet", "ring", "input_shaft", "output_shaft", "carrier")
 SELECTABLE_REGIONS = {"sun": ("bore", "flanks", "contact_band"), "planet": ("bore", "flanks", "contact_band"),
                       "ring": ("flanks", "bolt_holes", "bolt_hole_<k>", "bolt_discs", "contact_band"),
                       "input_shaft": ("bearing_seat", "gear_seat"),
-                      "output_shaft": ("bearing_seat", "bolt_holes", "bolt_hole_<k>", "bolt_discs")}
+                      "output_shaft": ("bearing_seat", "bolt_holes", "bolt_hole_<k>", "bolt_discs"),
+                      "carrier": ("seat", "pin_<k>")}
 """Component -> the mesh regions its reduction's interfaces and contact bands stand on (``bolt_hole_<k>``: the
-k-th bolt hole alone, k = 0, 1, ...; ``bolt_discs``: the bolts' clamped discs on the flange or web face, one
-patch per bolt, in place of the discs the bolt circle and ``bolt_clamp_diameter_mm`` give, flexgear.fe.bolted;
-``contact_band``: a gear's contact band, a cylinder only: ``radius`` the circle the mesh loads act on and its
-modes are sensed at, ``tolerance`` the band's radial half-width (default: the gear data's, one normal module),
-``z`` its axial range (each helix half's band is cut to it; default: the gear data's halves), in place of the
-operating pitch circle and the helix halves, flexgear.fe.reduced.contact_band_override)."""
+k-th bolt hole alone, k = 0, 1, ...; ``bolt_discs``: the bolts' clamped discs on the flange or web face, one patch
+per bolt, in place of the discs the bolt circle and ``bolt_clamp_diameter_mm`` give, flexgear.fe.bolted; ``seat``
+and ``pin_<k>``: a planetary stage's carrier's bore on the output shaft and planet k's pin bores,
+flexgear.fe.carrier_part; ``contact_band``: a gear's contact band, a cylinder only: ``radius`` the circle the mesh
+loads act on and its modes are sensed at, ``tolerance`` the band's radial half-width (default: the gear data's, one
+normal module), ``z`` its axial range (each helix half's band is cut to it; default: the gear data's halves), in
+place of the operating pitch circle and the helix halves, flexgear.fe.reduced.contact_band_override)."""
 CONTACT_BAND = "contact_band"
 """The selectable region that is a gear's contact band (a circle band for the reduction's loads and the contacts'
 mode sensing), not a set of boundary nodes."""
@@ -155,8 +157,7 @@ def _selectors(path: Path, field: str, component: str, unit: str, file: Path, ra
     out = []
     for region, table in raw.items():
         where = f"{field}.{region}"
-        k = region.removeprefix("bolt_hole_")
-        if region not in allowed and not ("bolt_hole_<k>" in allowed and k.isdigit() and k == str(int(k))):
+        if region not in allowed and not any(_numbered(region, pattern) for pattern in allowed):
             raise SpecError(path, where, f"unknown region of the {component}; allowed: {', '.join(allowed)}")
         if not isinstance(table, dict) or len(table) != 1 or next(iter(table)) not in SELECTOR_KINDS:
             kinds = " | ".join(f"{k} = ..." for k in SELECTOR_KINDS)
@@ -173,6 +174,15 @@ def _selectors(path: Path, field: str, component: str, unit: str, file: Path, ra
     if "bolt_holes" in names and any(n.startswith("bolt_hole_") for n in names):
         raise SpecError(path, field, "give bolt_holes (its holes are bolt_hole_<k>) or bolt_hole_<k>, not both")
     return tuple(sorted(out, key=lambda s: s.region))
+
+
+def _numbered(region: str, pattern: str) -> bool:
+    """Whether ``region`` is one of the numbered regions ``pattern`` stands for (``bolt_hole_<k>``: ``bolt_hole_0``,
+    ``bolt_hole_1``, ...)."""
+    if not pattern.endswith("<k>"):
+        return False
+    k = region.removeprefix(pattern[:-3])
+    return k != region and k.isdigit() and k == str(int(k))
 
 
 def _selector(path: Path, field: str, region: str, kind: str, value: Any, unit: str, file: Path) -> RegionSelector:

@@ -314,6 +314,9 @@ def _check_consistency(spec: GearboxSpec) -> None:
             "(or give gears.planet_positions_deg)",
             g.planet_count,
         )
+    if CARRIER in spec.components_geometry and g.arrangement != "planetary":
+        raise SpecError(p, f"components_geometry.{CARRIER}", "a carrier from a file needs [gears] arrangement = "
+                        "'planetary' (the star holds its carrier)", g.arrangement)
     weights = dataclasses.astuple(spec.screening.weights)
     if abs(sum(weights) - 1.0) > 1e-9:
         raise SpecError(p, "screening.weights", "expected weights that sum to 1", sum(weights))

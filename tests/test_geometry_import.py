@@ -88,7 +88,8 @@ def test_table_is_checked_on_load_in_one_line(tmp_path):
         'ring = { file = "part.step", length_unit = "inch" }': "expected one of 'm', 'mm'",
         'ring = { file = "part.iges", length_unit = "mm" }': "unsupported file type '.iges'",
         'ring = { file = "part.step" }': "components_geometry.ring.length_unit': missing",
-        'carrier = { file = "part.step", length_unit = "mm" }': "unknown component",
+        'carrier = { file = "part.step", length_unit = "mm" }': "arrangement = 'planetary'",  # the star holds it
+        'housing = { file = "part.step", length_unit = "mm" }': "unknown component",
         'ring = { file = "part.step", length_unit = "mm", scale = 2 }': "unknown field",
     }
     (tmp_path / "empty.step").write_bytes(b"")

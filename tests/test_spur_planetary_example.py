@@ -274,6 +274,26 @@ def test_the_flexible_carriers_linear_model_turns_with_it_and_matches_the_refere
     np.testing.assert_allclose(production, reference, rtol=1e-3)
 
 
+def harmonic_against_time_run(variant, columns: tuple[str, ...]) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """{column: (the harmonic response's 1x and 2x amplitudes, the settled time run's)} of ``variant`` at its load
+    case's speed: flexgear.harmonic.harmonic_response linearised as the time model is built, three harmonics
+    (Hill's method: more than read), against the whole mesh cycles of the run's last 0.1 s."""
+    from flexgear.harmonic import harmonic_response
+    from flexgear.mbs.run import run_variant
+    from flexgear.study.compare import harmonic_amplitudes
+    from flexgear.theory import mesh_frequency_hz
+
+    spec = variant.gearbox
+    rpm = spec.load_case.input_speed_rpm
+    response = harmonic_response(variant, [rpm], 3, linearization="each")
+    signals = run_variant(variant).signals
+    t = signals.time_s.to_numpy()
+    dt, f_mesh = float(t[-1] - t[-2]), mesh_frequency_hz(spec, rpm)
+    n = int(math.floor(0.1 * f_mesh) / f_mesh / dt)  # whole mesh cycles of the last 0.1 s
+    return {c: (response.amplitudes(c).iloc[0].to_numpy()[:2],
+                harmonic_amplitudes(signals[c].to_numpy()[-n:], dt, f_mesh, (1, 2))) for c in columns}
+
+
 def test_the_flexible_carriers_harmonic_response_matches_its_time_run(tmp_path, example_cache):
     """The carrier alone flexible, frictionless, at the example's 3000 rpm with a 5 us step (the derived step's
     integration error would be larger than the check): the linearised model's harmonic response
@@ -282,24 +302,12 @@ def test_the_flexible_carriers_harmonic_response_matches_its_time_run(tmp_path, 
     (measured 0.05 % and 0.3 %)."""
     import dataclasses
 
-    from flexgear.harmonic import harmonic_response
-    from flexgear.mbs.run import run_variant
-    from flexgear.study.compare import harmonic_amplitudes
-    from flexgear.theory import mesh_frequency_hz
-
     variant = load_variant(_without_friction(tmp_path, flexible=("carrier",)))
-    rpm = variant.gearbox.load_case.input_speed_rpm
     spec = variant.gearbox.with_fields("load_case", step_size_s=5e-6, end_time_s=0.3)
-    variant = dataclasses.replace(variant, gearbox=spec)
-    response = harmonic_response(variant, [rpm], 3, linearization="each")  # Hill: more harmonics than read
-    signals = run_variant(variant).signals
-    t = signals.time_s.to_numpy()
-    dt, f_mesh = float(t[-1] - t[-2]), mesh_frequency_hz(spec, rpm)
-    n = int(math.floor(0.1 * f_mesh) / f_mesh / dt)  # whole mesh cycles of the last 0.1 s
-    for column in ("outer_mesh_force_1_n", "inner_mesh_force_1_n"):
-        timed = harmonic_amplitudes(signals[column].to_numpy()[-n:], dt, f_mesh, (1, 2))
-        np.testing.assert_allclose(response.amplitudes(column).iloc[0].to_numpy()[:2], timed, rtol=0.02,
-                                   err_msg=column)
+    found = harmonic_against_time_run(dataclasses.replace(variant, gearbox=spec),
+                                      ("outer_mesh_force_1_n", "inner_mesh_force_1_n"))
+    for column, (response, timed) in found.items():
+        np.testing.assert_allclose(response, timed, rtol=0.02, err_msg=column)
 
 
 def test_every_component_flexible_the_modes_turning_with_the_carrier_ring_in_its_time_run(example_cache):

@@ -18,11 +18,14 @@ from dataclasses import replace
 
 import numpy as np
 
+from flexgear.fe.carrier_part import imported_carrier_mesh, level_mesh
 from flexgear.fe.cms import ReducedBody, interface, reduce
 from flexgear.fe.fem import FEModel, fe_model
+from flexgear.fe.imported import IMPORT_VERSION
 from flexgear.fe.reduced import cached_reduced_body
 from flexgear.geometry.carrier import CarrierSizes, carrier_sizes, carrier_solid
 from flexgear.progress import say
+from flexgear.schema import CARRIER
 from flexgear.spec import GearboxSpec, spec_hash
 
 __all__ = ["carrier_fe_model", "carrier_volume_mesh", "carrier_body", "carrier_body_key", "carrier_interfaces",
@@ -71,15 +74,8 @@ def _radius(face) -> float:
 
 def _carrier_netgen_mesh(spec: GearboxSpec, level: str, sizes: CarrierSizes):
     """The carrier's first-order Netgen mesh at mesh ``level`` (module docstring)."""
-    import netgen.meshing as nm
-    from netgen.occ import OCCGeometry
-
     settings = spec.meshing_assumed[level]
-    geo = OCCGeometry(_named_solid(sizes, settings.tooth_size_mm * 1e-3))
-    mp = nm.MeshingParameters(maxh=settings.body_size_mm * 1e-3, curvaturesafety=settings.elements_per_curvature_radius,
-                              segmentsperedge=0.0, optsteps2d=settings.optimisation_steps,
-                              optsteps3d=settings.optimisation_steps)
-    return geo.GenerateMesh(mp=mp)
+    return level_mesh(_named_solid(sizes, settings.tooth_size_mm * 1e-3), settings)
 
 
 def carrier_fe_model(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSizes | None = None) -> FEModel:
@@ -96,6 +92,8 @@ def carrier_volume_mesh(spec: GearboxSpec, level: str = "coarse",
     from flexgear.fe.mesh import mesh_arrays
 
     sizes = sizes or carrier_sizes(spec)
+    if CARRIER in spec.components_geometry:
+        return imported_carrier_mesh(spec, level, sizes, SEAT, pin_interface)
     order = spec.meshing_assumed[level].element_order
     mesh = _carrier_netgen_mesh(spec, level, sizes)
     if order == 2:
@@ -141,5 +139,7 @@ def carrier_body_key(spec: GearboxSpec, level: str = "coarse", sizes: CarrierSiz
     """The cache key of :func:`carrier_body` (flexgear.fe.reduced.reduced_cache_path names its file): every input
     of the carrier's mesh and reduction hashed."""
     sizes = sizes or carrier_sizes(spec)
-    key = spec_hash(sizes, spec.meshing_assumed[level], spec.material_assumed, _max_hz(spec), _VERSION)
+    imported = spec.components_geometry.get(CARRIER)  # the file's content and selectors, when it comes from one
+    key = spec_hash(sizes, spec.meshing_assumed[level], spec.material_assumed, _max_hz(spec), _VERSION,
+                    *(() if imported is None else (imported, IMPORT_VERSION)))
     return f"carrier-{level}-{key}"

@@ -53,7 +53,7 @@ from flexgear.schema_geometry import CONTACT_BAND, SELECTABLE_REGIONS, Component
 from flexgear.spec import GearboxSpec
 
 __all__ = ["GeometryFileError", "ImportedMesh", "imported_brep", "imported_mesh", "check_imported_mesh",
-           "IMPORT_VERSION"]
+           "read_solid", "check_extent", "volume_arrays", "IMPORT_VERSION"]
 
 IMPORT_VERSION = 1
 """Bump when the import's construction changes without the file or a config value changing (enters the keys)."""
@@ -100,33 +100,40 @@ def imported_brep(spec: GearboxSpec | Design, component: str, progress: bool = F
     path = cache_dir() / f"solid-{layout.name}-{geometry_hash(d.spec, component, IMPORT_VERSION)}.brep"
 
     def read() -> object:
-        from netgen.occ import OCCGeometry, Pnt
-
-        try:
-            with _quiet():
-                shape = OCCGeometry(str(entry.source)).shape
-        except Exception as exc:  # netgen raises NgException or RuntimeError for a damaged file
-            raise GeometryFileError(component, entry, f"cannot be read as {entry.kind.upper()} "
-                                    f"({exc.__class__.__name__}: {' '.join(str(exc).split())[:120]})") from None
-        solids = shape.solids
-        if len(solids) != 1:
-            raise GeometryFileError(component, entry, f"holds {len(solids)} solids ({len(shape.faces)} faces); "
-                                    "expected one closed solid")
-        solid = solids[0]
-        if not solid.mass > 0:
-            raise GeometryFileError(component, entry, f"its solid has no volume ({solid.mass})")
-        if entry.scale != 1.0:
-            solid = solid.Scale(Pnt(0, 0, 0), entry.scale)
-        lo, hi = solid.bounding_box
-        _check_extent(component, entry, layout, max(abs(lo[0]), abs(lo[1]), abs(hi[0]), abs(hi[1])))
-        return solid
+        return read_solid(component, entry, d.layouts[component].outer_radius)
 
     return cached_brep(path, read, f"{component}: solid read from {entry.source.name}", progress)
 
 
-def _check_extent(component: str, entry: ComponentGeometry, layout: ComponentLayout, radius: float) -> None:
-    """Refuse a part whose largest radius [m] is far from its layout's (a wrong length unit)."""
-    expected = layout.outer_radius
+def read_solid(component: str, entry: ComponentGeometry, expected_radius: float):
+    """The one solid of ``component``'s STEP or BREP file, scaled to metres (netgen.occ); refused
+    (:class:`GeometryFileError`) when the file cannot be read, holds no solid or several, has no volume, or reaches
+    far from ``expected_radius`` [m] (:func:`check_extent`)."""
+    from netgen.occ import OCCGeometry, Pnt
+
+    try:
+        with _quiet():
+            shape = OCCGeometry(str(entry.source)).shape
+    except Exception as exc:  # netgen raises NgException or RuntimeError for a damaged file
+        raise GeometryFileError(component, entry, f"cannot be read as {entry.kind.upper()} "
+                                f"({exc.__class__.__name__}: {' '.join(str(exc).split())[:120]})") from None
+    solids = shape.solids
+    if len(solids) != 1:
+        raise GeometryFileError(component, entry, f"holds {len(solids)} solids ({len(shape.faces)} faces); "
+                                "expected one closed solid")
+    solid = solids[0]
+    if not solid.mass > 0:
+        raise GeometryFileError(component, entry, f"its solid has no volume ({solid.mass})")
+    if entry.scale != 1.0:
+        solid = solid.Scale(Pnt(0, 0, 0), entry.scale)
+    lo, hi = solid.bounding_box
+    check_extent(component, entry, expected_radius, max(abs(lo[0]), abs(lo[1]), abs(hi[0]), abs(hi[1])))
+    return solid
+
+
+def check_extent(component: str, entry: ComponentGeometry, expected: float, radius: float) -> None:
+    """Refuse a part whose largest radius ``radius`` [m] is far from the gear data's ``expected`` [m] (a wrong
+    length unit)."""
     if not (expected / _UNIT_RATIO < radius < expected * _UNIT_RATIO):
         raise GeometryFileError(component, entry, f"reaches r = {radius:.6g} m with length_unit = "
                                 f"{entry.length_unit!r}, but the gear data give {expected:.6g} m: is the length "
@@ -147,7 +154,7 @@ class ImportedMesh(ComponentMesh):
         return ngsolve.Mesh(netgen_mesh(*self.fe_arrays))
 
 
-def _volume_arrays(volume, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def volume_arrays(volume, order: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(nodes, elements, boundary triangles) of ``volume`` at element ``order``: its vertices alone for 1; for 2 its
     own edge nodes, or the edges' midpoints of a first-order file (appended after the vertices)."""
     el = volume.elements
@@ -180,12 +187,13 @@ def imported_mesh(spec: GearboxSpec | Design, component: str, level: str, order:
             volume = read_volume_mesh(entry.source, entry.scale)
         except MeshFileError as exc:
             raise GeometryFileError(component, entry, str(exc).split(": ", 1)[1]) from None
-        _check_extent(component, entry, d.layouts[component], float(np.hypot(*volume.nodes[:, :2].T).max()))
+        check_extent(component, entry, d.layouts[component].outer_radius,
+                     float(np.hypot(*volume.nodes[:, :2].T).max()))
         meshes = {}
         for k in {order, settings.element_order}:
-            nodes, elements, surface = _volume_arrays(volume, k)
+            nodes, elements, surface = volume_arrays(volume, k)
             meshes[k] = ImportedMesh(component, level, k, nodes, elements, surface, regions(nodes, np.unique(surface)))
-            meshes[k].fe_arrays = _volume_arrays(volume, settings.element_order)
+            meshes[k].fe_arrays = volume_arrays(volume, settings.element_order)
         mesh, checked = meshes[order], meshes[settings.element_order]
     else:
         solid_key = geometry_hash(spec, component, IMPORT_VERSION)

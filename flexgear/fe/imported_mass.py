@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from flexgear.design import Design, register_part_masses
 from flexgear.geometry.massprops import MassProperties
+from flexgear.schema import CARRIER
 
 __all__ = ["imported_mass_properties"]
 
@@ -30,6 +31,17 @@ def imported_mass_properties(d: Design, component: str) -> MassProperties:
     spec = d.spec
     entry = spec.components_geometry[component]
     rho = spec.material_assumed.density_kg_m3
+    level = max(spec.meshing_assumed, key=lambda name: spec.meshing_assumed[name].element_order)
+    if component == CARRIER:  # no layout: the solid as flexgear.fe.carrier_part reads it, or its mesh's FE model
+        from flexgear.fe.carrier import carrier_fe_model
+        from flexgear.fe.imported import read_solid
+        from flexgear.geometry.carrier import carrier_sizes
+        from flexgear.geometry.solids import occ_mass_properties
+
+        if entry.kind == "mesh":
+            return carrier_fe_model(spec, level).mass_properties()
+        solid = read_solid(component, entry, carrier_sizes(spec).plate_outer_radius)
+        return MassProperties(*occ_mass_properties(solid, rho))
     if entry.kind != "mesh":
         from netgen.occ import OCCGeometry
 
@@ -39,7 +51,6 @@ def imported_mass_properties(d: Design, component: str) -> MassProperties:
         return MassProperties(*occ_mass_properties(solid, rho))
     from flexgear.fe.fem import fe_model
 
-    level = max(spec.meshing_assumed, key=lambda name: spec.meshing_assumed[name].element_order)
     order = spec.meshing_assumed[level].element_order
     mesh = imported_mesh(d, component, level, order)
     return fe_model(mesh.ngsolve_mesh(), spec.material_assumed, order).mass_properties()

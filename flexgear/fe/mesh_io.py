@@ -156,9 +156,12 @@ def boundary_faces(elements: np.ndarray, nodes: np.ndarray) -> np.ndarray:
     return np.column_stack([tri, np.array(mids, np.int64).reshape(-1, 3)])
 
 
-def netgen_mesh(nodes: np.ndarray, elements: np.ndarray, surface: np.ndarray):
+def netgen_mesh(nodes: np.ndarray, elements: np.ndarray, surface: np.ndarray,
+                labels: dict[str, np.ndarray] | None = None):
     """A Netgen mesh of the tetrahedra ``elements`` (Netgen order, 4 or 10 nodes) on ``nodes`` [m] with the boundary
-    triangles ``surface`` (3 or 6 nodes) as one boundary ("default", as the components' own meshes). A second-order
+    triangles ``surface`` (3 or 6 nodes) as one boundary ("default", as the components' own meshes), but the rows of
+    ``surface`` that ``labels`` {name: boolean mask over the rows} names: each such set a boundary of that name
+    (flexgear.fe.fem.fe_model makes each a region, its nodes weighted by their share of its area). A second-order
     mesh keeps its edge nodes where they are (flexgear.fe.fem.fe_model uses it as it is)."""
     import netgen.meshing as nm
     from netgen.csg import Pnt
@@ -166,10 +169,17 @@ def netgen_mesh(nodes: np.ndarray, elements: np.ndarray, surface: np.ndarray):
     mesh = nm.Mesh(dim=3)
     for p in np.asarray(nodes, float):
         mesh.Add(nm.MeshPoint(Pnt(float(p[0]), float(p[1]), float(p[2]))))
-    face = mesh.Add(nm.FaceDescriptor(bc=1, domin=1, surfnr=1))
-    mesh.SetBCName(0, "default")
+    surface = np.asarray(surface, np.int64)
+    label = np.zeros(len(surface), np.int64)  # 0: "default"
+    names = ["default", *(labels or {})]
+    for k, mask in enumerate((labels or {}).values(), start=1):
+        label[np.asarray(mask, bool) & (label == 0)] = k
+    faces = []
+    for k, name in enumerate(names):
+        faces.append(mesh.Add(nm.FaceDescriptor(bc=k + 1, domin=1, surfnr=k + 1)))
+        mesh.SetBCName(k, name)
     for el in np.asarray(elements, np.int64) + 1:
         mesh.Add(nm.Element3D(1, [nm.PointId(int(i)) for i in el]))
-    for tri in np.asarray(surface, np.int64) + 1:
-        mesh.Add(nm.Element2D(face, [nm.PointId(int(i)) for i in tri]))
+    for tri, k in zip(surface + 1, label, strict=True):
+        mesh.Add(nm.Element2D(faces[k], [nm.PointId(int(i)) for i in tri]))
     return mesh

@@ -186,8 +186,8 @@ class LumpedParameters:
         else:
             ring = member(*mi("ring"), geo.ring.base_radius, None, held=True)
             m_out, i_out = mi("output_shaft")
-            carrier = member(la.carrier_mass_kg + m_out, la.carrier_inertia_kg_m2 + i_out, geo.centre_distance,
-                             "output_shaft")
+            m_c, i_c = d.carrier_disc()
+            carrier = member(m_c + m_out, i_c + i_out, geo.centre_distance, "output_shaft")
             fixed = ("ring",)
         if hold_input:
             fixed = (*fixed, "sun")

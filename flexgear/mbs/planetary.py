@@ -77,11 +77,11 @@ PIN_STEPS = 10
 (flexgear.mbs.carrier.CarrierPins: a longer "step" is a static solve)."""
 
 
-def carrier_mass_properties(spec: GearboxSpec) -> MassProperties:
-    """The carrier as a disc: mass m and polar inertia J of ``[lumped_assumed]``, transverse J / 2, centred."""
-    la = spec.lumped_assumed
-    j = la.carrier_inertia_kg_m2
-    return MassProperties(la.carrier_mass_kg, np.zeros(3), np.diag([0.5 * j, 0.5 * j, j]))
+def carrier_mass_properties(spec: GearboxSpec | Design) -> MassProperties:
+    """The carrier as a disc: mass m and polar inertia J of ``[lumped_assumed]`` (or of the carrier's part from a
+    file, flexgear.design.Design.carrier_disc), transverse J / 2, centred."""
+    m, j = as_design(spec).carrier_disc()
+    return MassProperties(m, np.zeros(3), np.diag([0.5 * j, 0.5 * j, j]))
 
 
 def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Design | None = None,
@@ -154,12 +154,12 @@ def build_planetary_gearbox(mbs, variant: Variant, mass_source=None, design: Des
                             bearing_points={pin: [place + sp.point for sp in b.axis_springs()]
                                             for pin, place, b in zip(pins, places, bearings, strict=True)})
     if not flexible_carrier and form["output_shaft"] == "rigid":  # one rigid body with the carrier
-        carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(spec),
+        carrier = add_rigid_body(mbs, "carrier", combine_mass_properties(carrier_mass_properties(d),
                                                                          props(spec, "output_shaft")), np.zeros(3))
         output_end = carrier
     else:  # bolted to the carrier at its bolts' clamped discs (where the star bolts the ring's flange to it)
         if not flexible_carrier:
-            carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(spec), np.zeros(3))
+            carrier = add_rigid_body(mbs, "carrier", carrier_mass_properties(d), np.zeros(3))
         joint = FixedJointElement("output_shaft", BOLT_PATCHES, "carrier", SEAT if flexible_carrier else "carrier",
                                   point)
         output_end = component("output_shaft", "output_shaft", np.zeros(3), th.output_speed,
