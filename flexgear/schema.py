@@ -51,6 +51,11 @@ COMPONENT_GEOMETRY = {**{c: c for c in GEOMETRY_COMPONENTS}, "planets": "planet"
 """Table 3 component (or geometry) name -> its geometry name."""
 
 
+PLANET_POSITION_TOLERANCE_STEPS = 0.01
+"""A given planet position may lie this share of an assembly step (360 deg / (z_s + z_r)) off an angle where the
+planet assembles; it is taken at that angle (:attr:`GearSet.planet_positions_rad`)."""
+
+
 # --------------------------------------------------------------------------- gearbox tables
 @dataclass(frozen=True)
 class GearSet:
@@ -77,12 +82,29 @@ class GearSet:
     @property
     def planet_positions_rad(self) -> tuple[float, ...]:
         """Each planet's polar angle [rad]: the given positions on the nearest assembly angle
-        (:attr:`assembly_step_rad`; flexgear.spec refuses a position farther off than
-        ``PLANET_POSITION_TOLERANCE_STEPS``), else N equally spaced from 0."""
+        (:attr:`assembly_step_rad`; flexgear.spec refuses a position farther off, :meth:`position_problem`), else N
+        equally spaced from 0."""
         if not self.planet_positions_deg:
             return tuple(2.0 * math.pi * k / self.planet_count for k in range(self.planet_count))
         step = self.assembly_step_rad
         return tuple(step * round(math.radians(a) / step) for a in self.planet_positions_deg)
+
+    def position_problem(self) -> str | None:
+        """What is wrong with the given planet positions (None: nothing): one angle per planet, increasing, each
+        where a planet assembles within ``PLANET_POSITION_TOLERANCE_STEPS`` of a step, no two on one angle."""
+        given = self.planet_positions_deg
+        step = math.degrees(self.assembly_step_rad)
+        off = [a for a in given if abs(a / step - round(a / step)) > PLANET_POSITION_TOLERANCE_STEPS]
+        if len(given) != self.planet_count:
+            return f"expected one angle per planet ({self.planet_count}, gears.planet_count)"
+        if any(b <= a for a, b in zip(given, given[1:], strict=False)):
+            return "expected increasing angles"
+        if off:
+            return (f"a planet at {off[0]:g} deg does not assemble: expected multiples of 360 / (sun_teeth + "
+                    f"ring_teeth) = {step:.6g} deg")
+        if len(set(self.planet_positions_rad)) < len(given):
+            return f"expected distinct assembly angles (multiples of {step:.6g} deg)"
+        return None
 
     @property
     def equally_spaced(self) -> bool:

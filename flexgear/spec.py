@@ -280,34 +280,13 @@ def _check_loaded(spec: GearboxSpec) -> None:
                         "flexgear.sizing; give the field in the file)") from None
 
 
-PLANET_POSITION_TOLERANCE_STEPS = 0.01
-"""A given planet position may lie this share of an assembly step (360 deg / (z_s + z_r)) off an angle where the
-planet assembles; it is taken at that angle (flexgear.schema.GearSet.planet_positions_rad)."""
-
-
-def _check_planet_positions(p: Path, g: Any) -> None:
-    """Given planet positions: one per planet, increasing, each where a planet assembles (within the tolerance)."""
-    name, given = "gears.planet_positions_deg", list(g.planet_positions_deg)
-    if len(given) != g.planet_count:
-        raise SpecError(p, name, f"expected one angle per planet ({g.planet_count}, gears.planet_count)", given)
-    if any(b <= a for a, b in zip(given, given[1:], strict=False)):
-        raise SpecError(p, name, "expected increasing angles", given)
-    step = 360.0 / (g.sun_teeth + g.ring_teeth)
-    for angle in given:
-        if abs(angle / step - round(angle / step)) > PLANET_POSITION_TOLERANCE_STEPS:
-            raise SpecError(p, name, f"a planet at {angle:g} deg does not assemble: expected multiples of 360 / "
-                            f"(sun_teeth + ring_teeth) = {step:.6g} deg", given)
-    if len(set(g.planet_positions_rad)) < len(given):
-        raise SpecError(p, name, f"expected distinct assembly angles (multiples of {step:.6g} deg)", given)
-
-
 def _check_consistency(spec: GearboxSpec) -> None:
     g, p = spec.gears, spec.source
     if g.ring_teeth <= g.planet_teeth + g.sun_teeth // 2:
         raise SpecError(p, "gears.ring_teeth", "expected ring_teeth > sun_teeth/2 + planet_teeth", g.ring_teeth)
-    if g.planet_positions_deg:
-        _check_planet_positions(p, g)
-    elif (g.sun_teeth + g.ring_teeth) % g.planet_count:
+    if g.planet_positions_deg and (problem := g.position_problem()):
+        raise SpecError(p, "gears.planet_positions_deg", problem, list(g.planet_positions_deg))
+    if not g.planet_positions_deg and (g.sun_teeth + g.ring_teeth) % g.planet_count:
         raise SpecError(
             p, "gears.planet_count",
             "equally spaced planets need (sun_teeth + ring_teeth) divisible by planet_count "

@@ -7,6 +7,9 @@ size on the pin bores (where the planets' bearing loads enter). Named faces beco
   it the planet's bearing, acts: RBE3, its point the pin's centre on the mid-plane;
 - ``seat``: the output-side plate's bore, on the output shaft: a rigid interface (the shaft's spline holds it).
 
+A carrier from the user's file (``[components_geometry] carrier``) is meshed or read by flexgear.fe.carrier_part,
+its seat and pins found there by geometry; everything below is the same for it.
+
 The reduced body is the Craig-Bampton reduction of flexgear.fe.cms with those interfaces and every fixed-interface
 mode below :data:`CUTOFF_FACTOR` times the gearbox's ``[reduction_assumed] fixed_interface_cutoff_hz``, cached by its
 inputs' hash.
@@ -88,7 +91,8 @@ def carrier_volume_mesh(spec: GearboxSpec, level: str = "coarse",
                         sizes: CarrierSizes | None = None) -> tuple[FEModel, np.ndarray]:
     """(the carrier's FE model, its tetrahedra (e, 4 or 10) in the FE model's node numbering, Netgen's node order):
     :func:`carrier_fe_model` and the elements it is assembled on (a second-order mesh raised from the first-order
-    one, as flexgear.fe.fem.fe_model raises a mesh, and taken by it as it is)."""
+    one, as flexgear.fe.fem.fe_model raises a mesh, and taken by it as it is); from the carrier's file where the
+    gearbox names one (flexgear.fe.carrier_part)."""
     from flexgear.fe.mesh import mesh_arrays
 
     sizes = sizes or carrier_sizes(spec)
