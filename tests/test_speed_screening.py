@@ -74,3 +74,28 @@ def test_matrix_takes_a_speed_range():
     args = _parser().parse_args(["matrix", "model_variants/model1.toml", "--speeds-rpm", "1000:3000:1000"])
     assert args.speeds_rpm == [1000.0, 2000.0, 3000.0]
     assert _parser().parse_args(["matrix", "model_variants/model1.toml"]).speeds_rpm is None
+
+
+def test_the_matrix_screens_each_variants_speed_curves_in_its_pool(tmp_path):
+    """``flexgear matrix --speeds-rpm``: each variant's curves are a job of their own in the run pool, screened
+    together when the runs are in: the same table as :func:`speed_screening` of the same variants in one process."""
+    import pandas as pd
+    from conftest import VARIANTS
+
+    from flexgear.spec import load_variant
+    from flexgear.study.matrix import run_matrix
+
+    text = (VARIANTS / "quick" / "model1.toml").read_text().replace('"../gearbox.toml"',
+                                                                     f'"{VARIANTS / "gearbox.toml"}"')
+    (tmp_path / "base.toml").write_text(text.replace('name = "model1"', 'name = "base"'))
+    (tmp_path / "frictionless.toml").write_text(text.replace('name = "model1"', 'name = "frictionless"')
+                                                + "\n[overrides.contact]\nfriction_coefficient = 0.0\n")
+    paths = [tmp_path / "base.toml", tmp_path / "frictionless.toml"]
+    speeds = [3000.0, 6000.0]
+    run_matrix(paths, tmp_path / "out", t_end_s=0.002, reference="base", speeds_rpm=speeds, progress=False)
+    pooled = pd.read_csv(tmp_path / "out" / "speed_screening.csv")
+    alone = speed_screening([load_variant(p) for p in paths], speeds, reference="base").table
+    assert len(pooled) == len(alone) > 0
+    for column in ("reference_value", "difference"):
+        np.testing.assert_allclose(pooled[column].to_numpy(), alone[column].to_numpy(), rtol=1e-9, atol=1e-12)
+    assert (tmp_path / "out" / "speed_screening.txt").read_text().startswith("base: the reference")

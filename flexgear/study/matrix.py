@@ -63,7 +63,13 @@ from flexgear.study.pool import (
 )
 from flexgear.study.purposes import ALL_PURPOSES, verdict_table
 from flexgear.study.screening import ReferenceNotUsable, Selection, screen
-from flexgear.study.speed_screening import job_files, operating_speed_rpm, speed_job, write_speed_screening
+from flexgear.study.speed_screening import (
+    job_files,
+    operating_speed_rpm,
+    screened_curves,
+    speed_curve_job,
+    write_speed_screening,
+)
 
 __all__ = ["RunTask", "make_task", "run_matrix", "run_input_hash", "run_task", "save_task_result", "write_table",
            "screen_directory"]
@@ -288,15 +294,31 @@ def _prepare(out_dir: Path, paths: list[Path], t_end_s: float | str | None, time
 
 def _jobs(f: _Folder, speeds_rpm: Sequence[float] | None, modal: bool) -> list[tuple[Any, Callable, tuple]]:
     """The folder's screenings that need no run, for the pool: the modal screening of an all-flexible reference,
-    the speed screening of its variants."""
+    and each variant's curves over the speed range (one job per variant, screened together by :func:`_finish`)."""
     jobs: list[tuple[Any, Callable, tuple]] = []
     ref = f.variants.get(f.reference)
     if modal and ref is not None and all(form == "flexible" for form in ref.components.values()):
         jobs.append((("modal", str(f.out_dir)), modal_job, *job_files([ref])))
-    if speeds_rpm and f.variants:
-        jobs.append((("speed", str(f.out_dir)), speed_job,
-                     (job_files(f.variants.values()), list(speeds_rpm), f.reference)))
+    if speeds_rpm:
+        jobs += [(("speed", str(f.out_dir), name), speed_curve_job, (file, list(speeds_rpm)))
+                 for name, file in zip(f.variants, job_files(f.variants.values()), strict=True)]
     return jobs
+
+
+def _speed_screening(f: _Folder, done: dict) -> Any:
+    """The folder's speed screening from its variants' curves among the jobs' results ``done`` (None: not asked);
+    a failed curve is the screening's result."""
+    curves = {name: done[key] for name in f.variants if (key := ("speed", str(f.out_dir), name)) in done}
+    if not curves:
+        return None
+    failed = next((c for c in curves.values() if isinstance(c, BaseException)), None)
+    if failed is not None:
+        return failed
+    try:
+        first = next(iter(f.variants.values()))
+        return screened_curves(list(f.variants.values()), curves, f.reference or first.gearbox.screening.reference)
+    except ValueError as exc:
+        return exc
 
 
 def _finish(f: _Folder, metas: dict, done: dict, progress: bool, reference: str | None) -> pd.DataFrame:
@@ -309,8 +331,9 @@ def _finish(f: _Folder, metas: dict, done: dict, progress: bool, reference: str 
     screening = screen_directory(f.out_dir, f.names, settings, progress, reference)
     if ("modal", str(f.out_dir)) in done:
         write_modal_verdict(f.out_dir, f.reference, done["modal", str(f.out_dir)], progress)
-    if ("speed", str(f.out_dir)) in done:
-        write_speed_screening(f.out_dir, done["speed", str(f.out_dir)], operating_speed_rpm(f.variants.values()))
+    speed = _speed_screening(f, done)
+    if speed is not None:
+        write_speed_screening(f.out_dir, speed, operating_speed_rpm(f.variants.values()))
     screening = screening.reindex(columns=["variant", "bias_pct", "cv_pct", "distance_pct", "sigma", "zone",
                                            "selected"])
     return table.merge(screening, on="variant", how="left")
@@ -342,7 +365,10 @@ def run_matrix(variant_paths: Sequence[str | Path], out_dir: str | Path, t_end_s
     order = {key: k for k, key in enumerate(_run_order(pending))}
     tasks = sorted((t for f in folders for t in f.tasks), key=lambda t: (t.key in waits, order[t.key]))
     jobs = [j for f in folders for j in _jobs(f, speeds_rpm, modal and runner is None)] if runner is None else []
-    metas, done = execute(tasks, workers, scheduler, runner, progress, jobs, first)
+    # a speed curve whose variant has cold bodies to wait for goes after the runs that wait for none, the rest before
+    ahead = [j for j in jobs if j[0][0] == "speed" and (j[0][1], j[0][2]) not in waits]
+    jobs = [j for j in jobs if j not in ahead]
+    metas, done = execute(tasks, workers, scheduler, runner, progress, jobs, first, ahead, waits)
     tables = [_finish(f, metas, done, progress, reference) for f in folders]
     if len(tables) == 1:
         return tables[0]

@@ -191,14 +191,18 @@ def say_progress(progress: bool, text: str) -> None:
 
 def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, progress: bool, bar: Progress,
               jobs: Sequence[tuple[Any, Callable, tuple]] = (),
-              first: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, list[RunTask], dict]:
-    """Submit the ``first`` jobs (key, function, arguments: a cold body that runs wait for), the runs, then the
-    ``jobs``: work that needs no run (the modal and speed screenings), taken by a worker when the runs leave one
-    free. Each run's result is saved in its folder as it arrives. Returns the runs' metas by :attr:`RunTask.key`,
-    the runs whose worker died, the jobs' results by key (an exception raised by a job is its result)."""
+              first: Sequence[tuple[Any, Callable, tuple]] = (), ahead: Sequence[tuple[Any, Callable, tuple]] = (),
+              waiting: set | frozenset = frozenset()) -> tuple[dict, list[RunTask], dict]:
+    """Submit the ``first`` jobs (key, function, arguments: a cold body that runs wait for), the runs that wait for
+    none, the ``ahead`` jobs, the runs whose key is in ``waiting``, then the ``jobs``: work that needs no run (the
+    modal and speed screenings), taken by a worker when the runs leave one free. Each run's result is saved in its
+    folder as it arrives. Returns the runs' metas by :attr:`RunTask.key`, the runs whose worker died, the jobs'
+    results by key (an exception raised by a job is its result)."""
     several = len({t.out_dir for t in tasks}) > 1
     side = {submit(fn, *args): key for key, fn, args in first}
-    futures = {submit(run_task, t, runner): t for t in tasks}
+    futures = {submit(run_task, t, runner): t for t in tasks if t.key not in waiting}
+    side.update({submit(fn, *args): key for key, fn, args in ahead})
+    futures.update({submit(run_task, t, runner): t for t in tasks if t.key in waiting})
     side.update({submit(fn, *args): key for key, fn, args in jobs})
     started = last_beat = time.perf_counter()
     metas: dict[tuple[str, str], dict] = {}
@@ -229,7 +233,8 @@ def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, pro
         now = time.perf_counter()
         if (futures or side) and now - last_beat >= _HEARTBEAT_S:
             last_beat = now
-            pending = [_label(t, several) for t in futures.values()] + [str(k[0]) for k in side.values()]
+            pending = [_label(t, several) for t in futures.values()] + [":".join(map(str, (k[0], *k[2:])))
+                                                                       for k in side.values()]
             say_progress(progress, f"running or queued {len(pending)}: {', '.join(pending)} "
                                    f"({now - started:.0f} s elapsed)")
         if (futures or side) and not finished:
@@ -244,9 +249,11 @@ def _label(task: RunTask, several: bool) -> str:
 
 def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: Runner | None,
             progress: bool, jobs: Sequence[tuple[Any, Callable, tuple]] = (),
-            first: Sequence[tuple[Any, Callable, tuple]] = ()) -> tuple[dict, dict]:
-    """Run ``first`` (local pools only), ``tasks`` and ``jobs`` in one pool (module docstring, :func:`_run_pool`);
-    returns the runs' metas by key and the jobs' results by key."""
+            first: Sequence[tuple[Any, Callable, tuple]] = (), ahead: Sequence[tuple[Any, Callable, tuple]] = (),
+            waiting: set | frozenset = frozenset()) -> tuple[dict, dict]:
+    """Run ``first`` (local pools only), ``tasks``, ``ahead`` and ``jobs`` in one pool (module docstring,
+    :func:`_run_pool`); ``ahead``: jobs queued before the tasks whose key is in ``waiting`` (runs that wait for a
+    cold body of ``first``). Returns the runs' metas by key and the jobs' results by key."""
     if not tasks and not jobs:
         return {}, {}
     # on a terminal a bar; in a log the per-run lines of _say are the progress
@@ -261,13 +268,13 @@ def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: R
                 key = f"flexgear-run-{args[0].name}-{args[0].input_hash}" if fn is run_task else None
                 return client.submit(fn, *args, pure=False, key=key)
 
-            metas, died, done = _run_pool(tasks, submit, runner, progress, bar, jobs)
+            metas, died, done = _run_pool(tasks, submit, runner, progress, bar, [*ahead, *jobs])
     else:
         say_progress(progress, f"{len(tasks)} runs" + (f" and {len(jobs)} screening jobs" if jobs else "")
              + f" on {workers} local worker process(es)")
         ctx = get_context("spawn")
         with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
-            metas, died, done = _run_pool(tasks, pool.submit, runner, progress, bar, jobs, first)
+            metas, died, done = _run_pool(tasks, pool.submit, runner, progress, bar, jobs, first, ahead, waiting)
         # A dead worker breaks the whole pool: rerun each affected task alone to find the culprit.
         retry, died = died, []
         for task in retry:

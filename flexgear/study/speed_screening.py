@@ -39,7 +39,8 @@ from typing import Any
 import numpy as np
 import pandas as pd
 
-__all__ = ["SpeedScreening", "speed_indicators", "compare_curves", "speed_screening", "screen_speed_range",
+__all__ = ["SpeedScreening", "speed_indicators", "compare_curves", "speed_screening", "screened_curves",
+           "speed_curve_job", "screen_speed_range",
            "SPEED_INDICATORS", "SpeedBand", "acceptable_band", "speed_bands", "BAND_COLUMNS"]
 
 SPEED_INDICATORS = {"dynamic_factor": "load", "input_bearing_rms": "db", "output_bearing_rms": "db",
@@ -155,6 +156,19 @@ def _flexible_count(variant: Any) -> int:
     return sum((planets if c == "planets" else 1) for c, f in variant.components.items() if f == "flexible")
 
 
+def _reference(variants: Sequence[Any], reference: str) -> str:
+    """The reference's name among ``variants`` (unique names): ``reference``, or "" = the one with the most flexible
+    bodies, the first on a tie."""
+    names = [v.name for v in variants]
+    if len(set(names)) != len(names):
+        raise ValueError(f"variant names must be unique: {', '.join(names)}")
+    if not reference:
+        reference = max(variants, key=_flexible_count).name
+    if reference not in names:
+        raise ValueError(f"reference {reference!r} is not among the variants ({', '.join(names)})")
+    return reference
+
+
 def speed_screening(variants: Sequence[Any], speeds_rpm: Sequence[float], reference: str = "",
                     harmonics: int | None = None,
                     response: Callable[..., Any] | None = None) -> SpeedScreening:
@@ -166,36 +180,39 @@ def speed_screening(variants: Sequence[Any], speeds_rpm: Sequence[float], refere
     from flexgear.harmonic import harmonic_response
     from flexgear.harmonic.base import DEFAULT_HARMONICS
 
-    names = [v.name for v in variants]
-    if len(set(names)) != len(names):
-        raise ValueError(f"variant names must be unique: {', '.join(names)}")
-    if not reference:
-        reference = max(variants, key=_flexible_count).name
-    if reference not in names:
-        raise ValueError(f"reference {reference!r} is not among the variants ({', '.join(names)})")
+    reference = _reference(variants, reference)
     run = response or harmonic_response
     h = DEFAULT_HARMONICS if harmonics is None else int(harmonics)
-    curves = {v.name: speed_indicators(run(v, list(speeds_rpm), h)) for v in variants}
-    ref = variants[names.index(reference)]
-    return compare_curves(curves, reference, _tea(ref.gearbox.screening))
+    return screened_curves(variants, {v.name: speed_indicators(run(v, list(speeds_rpm), h)) for v in variants},
+                           reference)
 
 
-def speed_job(variant_files: Sequence[tuple[str, str, str]], speeds_rpm: Sequence[float],
-              reference: str = "") -> SpeedScreening:
-    """Worker side: :func:`speed_screening` of the variants given as (variant file, its text, its gearbox's text);
-    ``reference`` "" = the gearbox's ``[screening] reference`` (then, if empty, the most flexible variant)."""
+def screened_curves(variants: Sequence[Any], curves: dict[str, pd.DataFrame], reference: str = "") -> SpeedScreening:
+    """:func:`compare_curves` of the variants' indicator curves ``curves`` (by name, :func:`speed_indicators`)
+    against ``reference`` ("" as in :func:`speed_screening`), with its TEa."""
+    reference = _reference(variants, reference)
+    ref = next(v for v in variants if v.name == reference)
+    return compare_curves(dict(curves), reference, _tea(ref.gearbox.screening))
+
+
+def speed_curve_job(variant_file: tuple[str, str, str], speeds_rpm: Sequence[float]) -> pd.DataFrame:
+    """Worker side: one variant's indicator curves over ``speeds_rpm`` [rpm] (:func:`speed_indicators` of its
+    harmonic response, flexgear.harmonic's default harmonics), the variant given as (variant file, its text, its
+    gearbox's text); a matrix screens them together (:func:`screened_curves`), each variant a job of its own so that
+    a pool's workers share them."""
+    from flexgear.harmonic import harmonic_response
+    from flexgear.harmonic.base import DEFAULT_HARMONICS
     from flexgear.spec import load_variant
 
-    variants = [load_variant(path, text, gearbox) for path, text, gearbox in variant_files]
-    if not variants:
-        raise ValueError("no variants to screen over the speed range")
-    return speed_screening(variants, speeds_rpm, reference or variants[0].gearbox.screening.reference or "")
+    variant = load_variant(*variant_file)
+    return speed_indicators(harmonic_response(variant, list(speeds_rpm), DEFAULT_HARMONICS))
 
 
 def write_speed_screening(out_dir: str | Path, result: SpeedScreening | BaseException,
                           operating_rpm: float | None) -> str:
-    """Write :func:`speed_job`'s ``result`` into the results folder ``out_dir``: speed_screening.csv (the table),
-    speed_screening_summary.csv and speed_screening.txt (one line per variant); when the folder holds a verdict
+    """Write a speed screening ``result`` (:func:`screened_curves`) into the results folder ``out_dir``:
+    speed_screening.csv (the table), speed_screening_summary.csv and speed_screening.txt (one line per variant);
+    when the folder holds a verdict
     against a reference variant (verdict.csv), also speed_bands.csv (:func:`speed_bands` about ``operating_rpm``,
     the variants' load-case input speed) and one line per band in the text; returns the text. A failed screening
     (the exception as ``result``) is one line in the text."""
@@ -219,8 +236,8 @@ def write_speed_screening(out_dir: str | Path, result: SpeedScreening | BaseExce
 
 
 def job_files(variants: Sequence[Any]) -> list[tuple[str, str, str]]:
-    """(variant file, its text, its gearbox file's text) of each loaded variant (flexgear.spec.Variant), for
-    :func:`speed_job`."""
+    """(variant file, its text, its gearbox file's text) of each loaded variant (flexgear.spec.Variant), for the
+    pool's jobs (:func:`speed_curve_job`, flexgear.study.matrix.modal_job)."""
     return [(str(v.source), Path(v.source).read_text(), Path(v.gearbox.source).read_text()) for v in variants]
 
 
