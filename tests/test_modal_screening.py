@@ -12,7 +12,7 @@ import pytest
 from conftest import VARIANTS
 
 from flexgear.modal import linearize, modal_screening
-from flexgear.modal.screening import TABLE3_COMPONENTS, amplification, recommend, table3_variants
+from flexgear.modal.screening import TABLE3_COMPONENTS, amplification, folder_variants, recommend
 from flexgear.spec import load_variant
 
 
@@ -62,7 +62,8 @@ def test_threshold_bounds(model4_linear):
 
 
 def test_recommend_all_flexible_when_none_fits():
-    candidates = table3_variants(VARIANTS)
+    candidates = folder_variants(VARIANTS)
+    assert list(candidates) == [f"model{k}" for k in range(1, 8)]  # Table 3's order; gearbox.toml is no variant
     assert candidates["model7"] == TABLE3_COMPONENTS and candidates["model1"] == ()
     name, reason = recommend(("input_shaft", "sun"), candidates)  # only model 7 has both
     assert name == "model7" and "model7" in reason
@@ -90,3 +91,15 @@ def test_matrix_sets_the_modal_screening_beside_the_westgard_verdict(model4_line
         assert (tmp_path / "modal_screening.txt").read_text().strip() == text
     not_a_variant = type("NotAVariant", (), {"name": "x"})()   # cannot be linearised: recorded, not raised
     assert "Modal screening of x not done" in modal_verdict(tmp_path, not_a_variant)
+
+
+def test_any_gearbox_folder_recommends_among_its_own_variants():
+    """The spur planetary example's folder (rigid.toml, flexible.toml beside gearbox.toml: no Table 3 names): its
+    variants are the candidates, and a screening that asks for a flexible ring and carrier recommends the one
+    variant that has them."""
+    folder = VARIANTS.parent / "examples" / "spur_planetary"
+    candidates = folder_variants(folder)
+    assert candidates == {"flexible": (*TABLE3_COMPONENTS, "carrier"), "rigid": ()}
+    name, reason = recommend(("ring", "carrier"), candidates)
+    assert name == "flexible" and "fewest flexible components" in reason
+    assert recommend((), candidates)[0] == "rigid"

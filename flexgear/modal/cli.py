@@ -12,7 +12,7 @@ mode, kind, frequency_hz) and campbell.png.
 
 ``flexgear modal-screening VARIANT [--f-band-hz F] [--threshold S] [--out DIR]`` (flexgear.modal.screening; VARIANT
 the all-flexible model 7) prints and writes DIR/<variant>/modal_screening.csv (component,
-weighted_elastic_strain_share, must_be_flexible) and the recommended Table 3 variant.
+weighted_elastic_strain_share, must_be_flexible) and the recommended variant beside it.
 
 The parser pieces follow flexgear.cli's pattern: :data:`SUBCOMMAND`, :data:`CAMPBELL`, :data:`SCREENING` (name,
 help, arguments, command) or :func:`add_parsers`.

@@ -29,9 +29,10 @@ frequency error of 1/sqrt(0.95) - 1 = 2.6 %, the half-power bandwidth 2 zeta of 
 i.e. the rigid model would move a resonance out of the band in which the flexible model's response is within a
 factor sqrt(2) of its peak).
 
-Recommendation. The Table 3 variant (model_variants/model1.toml ... model7.toml, beside the given variant) with the
-fewest flexible components that has every component that must be flexible flexible (the lower model number on a
-tie); the all-flexible model 7 if none has them all.
+Recommendation. The variant (of the same gear set, beside the given one: Table 3's model_variants/model1.toml ...
+model7.toml for the study; or the matrix's variants) with the fewest flexible components that has every component
+that must be flexible flexible (the first on a tie: Table 3's lower model number); the one with the most flexible
+components if none has them all.
 """
 
 from __future__ import annotations
@@ -46,7 +47,8 @@ import pandas as pd
 from flexgear.modal import LinearModel, Modes
 from flexgear.schema import OPTIONAL_COMPONENTS, Variant
 
-__all__ = ["ModalScreening", "modal_screening", "amplification", "THRESHOLD", "TABLE3_COMPONENTS"]
+__all__ = ["ModalScreening", "modal_screening", "amplification", "folder_variants", "flexible_components", "THRESHOLD",
+           "TABLE3_COMPONENTS"]
 
 THRESHOLD = 0.05
 """Weighted elastic strain share above which a component must be flexible (module docstring: 2.6 % frequency)."""
@@ -119,44 +121,59 @@ class ModalScreening:
         return out
 
 
-def table3_variants(folder: Path) -> dict[str, tuple[str, ...]]:
-    """Table 3's variants in ``folder`` (model<number>.toml, in number order): {name: its flexible components}."""
-    from flexgear.spec import load_variant
+def folder_variants(folder: Path, gears: object | None = None) -> dict[str, tuple[str, ...]]:
+    """The variant files in ``folder`` (every ``*.toml`` that loads as a variant, of the gear set ``gears``
+    (flexgear.schema.GearSet) when given): {name: its flexible components}, Table 3's ``model<number>.toml`` first in
+    number order, the others by file name."""
+    from flexgear.spec import SpecError, load_variant
 
-    files = sorted((p for p in Path(folder).glob("model*.toml") if _TABLE3.match(p.name)),
-                   key=lambda p: int(_TABLE3.match(p.name).group(1)))
+    def order(p: Path) -> tuple:
+        match = _TABLE3.match(p.name)
+        return (0, int(match.group(1)), "") if match else (1, 0, p.name)
+
     out = {}
-    for path in files:
-        v = load_variant(path)
-        out[v.name] = tuple(c for c in (*TABLE3_COMPONENTS, *OPTIONAL_COMPONENTS) if v.components.get(c) == "flexible")
+    for path in sorted(Path(folder).glob("*.toml"), key=order):
+        try:
+            v = load_variant(path)
+        except (SpecError, OSError, ValueError):  # not a variant file (a gearbox file, a sweep file)
+            continue
+        if gears is None or v.gearbox.gears == gears:
+            out[v.name] = flexible_components(v)
     return out
+
+
+def flexible_components(variant: Variant) -> tuple[str, ...]:
+    """The components ``variant`` makes flexible, in Table 3's order (the carrier last)."""
+    return tuple(c for c in (*TABLE3_COMPONENTS, *OPTIONAL_COMPONENTS) if variant.components.get(c) == "flexible")
 
 
 def recommend(must: tuple[str, ...], candidates: dict[str, tuple[str, ...]]) -> tuple[str, str]:
     """(name, one-line reason): the candidate with the fewest flexible components that holds all of ``must``, the
     first of them on a tie; the one with the most flexible components if none holds them all."""
     if not candidates:
-        return "", (f"{', '.join(must) or 'no component'} must be flexible; the folder holds no Table 3 variant "
-                    "(model<N>.toml) to recommend")
+        return "", (f"{', '.join(must) or 'no component'} must be flexible; no variant of this gear set beside it "
+                    "to recommend")
     fits = [name for name, flexible in candidates.items() if set(must) <= set(flexible)]
     if fits:
         name = min(fits, key=lambda n: len(candidates[n]))
         what = ", ".join(must) if must else "no component"
         flexible = ", ".join(candidates[name]) or "none"
-        return name, (f"{what} must be flexible; {name} is the Table 3 variant with the fewest flexible "
+        return name, (f"{what} must be flexible; {name} is the variant with the fewest flexible "
                       f"components ({flexible}) that has them")
     name = max(candidates, key=lambda n: len(candidates[n]))
-    return name, f"{', '.join(must)} must be flexible; no Table 3 variant has them all but {name}"
+    return name, f"{', '.join(must)} must be flexible; no variant has them all but {name}"
 
 
 def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: float | None = None, *,
-                    threshold: float = THRESHOLD, variants_dir: str | Path | None = None) -> ModalScreening:
+                    threshold: float = THRESHOLD, variants_dir: str | Path | None = None,
+                    candidates: dict[str, tuple[str, ...]] | None = None) -> ModalScreening:
     """Screen the components of ``variant_flexible_all`` (Table 3's model 7, or its :class:`LinearModel` at the
     operating point) by their weighted elastic strain share (module docstring).
 
     ``f_band_hz`` [Hz]: the excitation band (default 10 f_m at the load case's input speed); ``threshold`` [-]:
-    the share above which a component must be flexible; ``variants_dir``: the folder of Table 3's variant files
-    (default: the variant file's own folder).
+    the share above which a component must be flexible; ``candidates`` {name: flexible components}: the variants
+    to recommend from (default :func:`folder_variants` of ``variants_dir``, the variant file's own folder when
+    None, of its gear set).
     """
     from flexgear.modal import linearize, mesh_frequency_hz, modes, resonant
 
@@ -181,7 +198,8 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     table = pd.DataFrame({"component": list(shares), "weighted_elastic_strain_share": list(shares.values())})
     table["must_be_flexible"] = table.weighted_elastic_strain_share > threshold
     must = tuple(table.component[table.must_be_flexible])
-    folder = Path(variants_dir) if variants_dir is not None else Path(variant.source).parent
-    candidates = table3_variants(folder)
+    if candidates is None:
+        folder = Path(variants_dir) if variants_dir is not None else Path(variant.source).parent
+        candidates = folder_variants(folder, variant.gearbox.gears)
     name, reason = recommend(must, candidates)
     return ModalScreening(table, name, reason, found, keep, weights, f_mesh, band, threshold, candidates)

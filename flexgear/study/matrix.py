@@ -124,13 +124,15 @@ def screen_directory(out_dir: Path, names: Sequence[str], settings: ScreeningSet
     return table
 
 
-def modal_job(variant_file: str, variant_text: str, gearbox_text: str) -> tuple[pd.DataFrame, pd.DataFrame, str, float]:
+def modal_job(variant_file: str, variant_text: str, gearbox_text: str,
+              candidates: dict[str, tuple[str, ...]] | None = None) -> tuple[pd.DataFrame, pd.DataFrame, str, float]:
     """Worker side: the modal screening of the all-flexible reference (flexgear.modal.screening) from its files'
-    content: (component table, mode table, recommended variant, band [Hz])."""
+    content, recommending among ``candidates`` {name: flexible components} (the matrix's variants; None: the
+    variant files beside it): (component table, mode table, recommended variant, band [Hz])."""
     from flexgear.modal.screening import modal_screening
 
     m = modal_screening(load_variant(variant_file, variant_text, gearbox_text),
-                        variants_dir=Path(variant_file).parent)
+                        variants_dir=Path(variant_file).parent, candidates=candidates)
     return m.table, m.mode_table(), m.recommended, m.f_band_hz
 
 
@@ -298,7 +300,10 @@ def _jobs(f: _Folder, speeds_rpm: Sequence[float] | None, modal: bool) -> list[t
     jobs: list[tuple[Any, Callable, tuple]] = []
     ref = f.variants.get(f.reference)
     if modal and ref is not None and all(form == "flexible" for form in ref.components.values()):
-        jobs.append((("modal", str(f.out_dir)), modal_job, *job_files([ref])))
+        from flexgear.modal.screening import flexible_components
+
+        flexible = {name: flexible_components(v) for name, v in f.variants.items()}
+        jobs.append((("modal", str(f.out_dir)), modal_job, (*job_files([ref])[0], flexible)))
     if speeds_rpm:
         jobs += [(("speed", str(f.out_dir), name), speed_curve_job, (file, list(speeds_rpm)))
                  for name, file in zip(f.variants, job_files(f.variants.values()), strict=True)]
