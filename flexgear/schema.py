@@ -16,6 +16,7 @@ from typing import Any
 
 from flexgear.schema_fields import SpecError, choice_field, derived_field, num_field, numbers_field
 from flexgear.schema_geometry import ComponentGeometry
+from flexgear.schema_published import PublishedResults
 from flexgear.schema_screening import (
     IndicatorTolerance,
     IndicatorWeights,
@@ -414,6 +415,7 @@ class GearboxSpec:
     derived: tuple[str, ...] = ()
     # components whose solid or volume mesh comes from a file (flexgear.schema_geometry); the files' content hashed
     components_geometry: dict[str, ComponentGeometry] = field(default_factory=dict)
+    published: PublishedResults | None = None  # a source study's results, for the report (flexgear.schema_published)
 
     def with_changes(self, **tables: Any) -> GearboxSpec:
         """A new spec with whole tables replaced (``spec.with_changes(load_case=lc)``)."""

@@ -54,6 +54,7 @@ from flexgear.schema import (
     Variant,
 )
 from flexgear.schema_geometry import components_geometry_table
+from flexgear.schema_published import published_table
 from flexgear.schema_screening import PURPOSE_NAMES
 
 __all__ = [
@@ -251,7 +252,7 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
     hints = get_type_hints(GearboxSpec)
     built: dict[str, Any] = {}
     derived: list[str] = []
-    rest = sorted(tables - set(FIRST_TABLES) - {"title", "meshing_assumed", "components_geometry"})
+    rest = sorted(tables - set(FIRST_TABLES) - {"title", "meshing_assumed", "components_geometry", "published"})
     for name in (*FIRST_TABLES, *rest):
         data = with_derived(path, name, hints[name], raw.get(name, {}), built, derived)
         built[name] = _build(hints[name], data, path, name)
@@ -262,6 +263,7 @@ def load_gearbox(path: str | Path, text: str | None = None) -> GearboxSpec:
         for level, table in levels.items()
     }
     built["components_geometry"] = components_geometry_table(path, raw.get("components_geometry", {}))
+    built["published"] = published_table(path, raw.get("published"))
     spec = GearboxSpec(source=path, title=title, derived=tuple(derived), **built)
     _check_loaded(spec)
     return spec
@@ -335,7 +337,7 @@ def _apply_overrides(gearbox: GearboxSpec, overrides: Any, path: Path) -> Gearbo
             changes[table] = {**gearbox.components_geometry, **entries}
             continue
         current = getattr(gearbox, table, None)
-        if table == "source" or not dataclasses.is_dataclass(current) or not isinstance(values, dict):
+        if table in ("source", "published") or not dataclasses.is_dataclass(current) or not isinstance(values, dict):
             allowed = sorted(n for n, h in hints.items() if dataclasses.is_dataclass(h))
             raise SpecError(path, f"overrides.{table}", f"expected one of the tables {', '.join(allowed)}")
         merged = {f.name: getattr(current, f.name) for f in dataclasses.fields(current)}
@@ -426,11 +428,13 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
 
 
 def as_dict(obj: Any) -> Any:
-    """A spec (or any of its tables) as plain JSON-able data; file paths are left out, and so is an empty
-    ``components_geometry`` (a gearbox without it hashes as before the table existed)."""
+    """A spec (or any of its tables) as plain JSON-able data; file paths are left out, and so are an empty
+    ``components_geometry`` (a gearbox without it hashes as before the table existed) and ``published`` (report
+    data, not a model input)."""
     if dataclasses.is_dataclass(obj):
         return {f.name: as_dict(getattr(obj, f.name)) for f in dataclasses.fields(obj)
-                if f.name not in ("source", "derived") and (f.name != "components_geometry" or obj.components_geometry)}
+                if f.name not in ("source", "derived", "published")
+                and (f.name != "components_geometry" or obj.components_geometry)}
     if isinstance(obj, dict):
         return {k: as_dict(v) for k, v in sorted(obj.items())}
     if isinstance(obj, Path):

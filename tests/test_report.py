@@ -91,7 +91,7 @@ def test_report_pages_and_key_text(results, tmp_path):
     for i, page in enumerate(pages, start=1):
         assert f"page {i} / {len(pages)}" in page
     assert len(re.findall(r"page\s+\d+\s+\S", pages[1])) >= len(pages) - 2   # page 1 the verdict, 2 the contents
-    for key in ("Table 3", "Table 4", "Westgard decision diagram", "TEa = 1 %", "Table 6", "Table 7",
+    for key in ("Table 3", "published", "Westgard decision diagram", "TEa = 1 %", "Table 6", "Table 7",
                 "face_width_mm", "allowable_total_error_pct", "exudyn", "ADAMS", "Bias + 2", "lumped"):
         assert key in text, key
     # the fake runner: model3 (2 flexible components: composite Bias 0.2 %, CV 0.12 %) and model6 (3: 0.15 %,

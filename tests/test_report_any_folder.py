@@ -256,3 +256,13 @@ def test_the_report_screens_with_the_gearbox_file_saved_with_the_runs(tmp_path):
     assert data.gearbox.gears.arrangement == "planetary" and data.gearbox.gears.ring_teeth == 84
     own = load_gearbox(example / "gearbox.toml").screening
     assert data.settings.settle_block_mesh_cycles == own.settle_block_mesh_cycles != 17  # the study's: 136 / 8
+    # its report sets no other study's published values beside its runs (the study's are data of its own file)
+    from pypdf import PdfReader
+
+    from flexgear.report.pages import build_report
+
+    text = "\n".join(p.extract_text() for p in PdfReader(build_report(tmp_path, tmp_path / "r.pdf",
+                                                                        modal=False)).pages)
+    for study in ("published", "ADAMS", "798.1894", "You et al"):
+        assert study not in text, study
+    assert "Table 6" in text and "Run time per simulated second" in text

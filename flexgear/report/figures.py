@@ -8,15 +8,12 @@ flexgear.study.sweep.SweepResult); the pages (flexgear.report.pages) only lay th
 from __future__ import annotations
 
 import math
-import re
 import textwrap
 from collections.abc import Sequence
 
 import numpy as np
 import pandas as pd
 from matplotlib.axes import Axes
-
-from flexgear.study.reference import ADAMS_SIMULATED_S, ADAMS_TIME_S
 
 __all__ = ["fmt", "draw_table", "run_time_chart", "EMPTY_TABLE_TEXT"]
 
@@ -106,15 +103,11 @@ def draw_table(ax: Axes, table: pd.DataFrame, col_widths: Sequence[float] | None
     return top - total
 
 
-def _model_number(name: str) -> int | None:
-    m = re.fullmatch(r"model(\d+)", name)
-    return int(m.group(1)) if m else None
-
-
-def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run time to chart") -> None:
-    """Log-scale bars: our wall time per simulated second beside the study's ADAMS time per simulated
-    second (Table 4, 0.6 s simulated); columns variant, wall_time_s [s], t_end_s [s]. Without runs, a sentence
-    ``empty`` says why instead; a run without a positive simulated time has no bar."""
+def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run time to chart",
+                   published: str | None = None) -> None:
+    """Log-scale bars: our wall time per simulated second, beside a published one (column ``adams_per_s``
+    [s/s], labelled ``published``) where ``runs`` has it; columns variant, wall_time_s [s], t_end_s [s]. Without
+    runs, a sentence ``empty`` says why instead; a run without a positive simulated time has no bar."""
     if runs.empty or "variant" not in runs.columns:
         ax.axis("off")
         ax.text(0.5, 0.5, empty, ha="center", va="center", fontsize=10, style="italic", transform=ax.transAxes)
@@ -125,12 +118,13 @@ def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run t
     wall = pd.to_numeric(runs["wall_time_s"], errors="coerce").to_numpy(dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         ours = np.where(t_end > 0, wall / t_end, np.nan)
-    adams = np.array([ADAMS_TIME_S.get(_model_number(n) or 0, np.nan) for n in names]) / ADAMS_SIMULATED_S
+    adams = (pd.to_numeric(runs["adams_per_s"], errors="coerce").to_numpy(dtype=float) if "adams_per_s" in runs
+             else np.full(len(names), np.nan))
     w = 0.38
     ax.bar(x - w / 2, np.where(np.isfinite(ours), ours, 0), w, color="#1f4e99",
            label="flexgear (Exudyn), wall time per simulated second")
-    ax.bar(x + w / 2, np.where(np.isfinite(adams), adams, 0), w, color="#bbbbbb",
-           label=f"study, ADAMS GSTIFF (Table 4 / {ADAMS_SIMULATED_S:g} s simulated)")
+    if np.isfinite(adams).any():
+        ax.bar(x + w / 2, np.where(np.isfinite(adams), adams, 0), w, color="#bbbbbb", label=published or "published")
     for xi, v, a in zip(x, ours, adams, strict=True):
         if np.isfinite(v) and v > 0:
             ax.annotate(fmt(v, 3), (xi - w / 2, v), ha="center", va="bottom", fontsize=7, xytext=(0, 2),

@@ -6,10 +6,11 @@ see :mod:`flexgear.results`): Exudyn variants are screened (:mod:`flexgear.study
 mode and, when the matrix used one (``screening.json``) or the gearbox names one, against a reference
 variant; a run of the lumped-parameter backend (e.g. ``results/lumped``) joins the overlays, spectra
 and Tables 6 and 7; a sweep (``sweep.json``) adds its table and sensitivity figures. Pages, in order:
-title (selection, load case), gearbox data (study), assumptions, variant matrix (Table 3 as run), run
-time per simulated second against the study's ADAMS times (Table 4), Westgard decision diagrams,
-screening tables, one page per signal type with all variants overlaid, bearing spectra, Tables 6 and
-7, sweep pages, provenance. This module lays pages out; the figures are drawn by the objects'
+title (selection, load case), gearbox data, assumptions, variant matrix (Table 3 as run), run time per
+simulated second, Westgard decision diagrams, screening tables, one page per signal type with all variants
+overlaid, bearing spectra, Tables 6 and 7, sweep pages, provenance. Where the gearbox file gives a source study's
+results (``[published]``, flexgear.schema_published), the run times, Tables 6 and 7 and the spectra set them
+beside the runs'. This module lays pages out; the figures are drawn by the objects'
 ``plot(ax)`` (:mod:`flexgear.report.result_pages`).
 """
 
@@ -34,6 +35,7 @@ from flexgear.report.data import ReportData, documented_assumptions, gather, res
 from flexgear.report.figures import draw_table, fmt  # noqa: E402
 from flexgear.report.layout import Page, table_pages, text_block  # noqa: E402
 from flexgear.report.reading_pages import contact_reading_pages  # noqa: E402
+from flexgear.report.sweep_pages import sweep_pages  # noqa: E402
 from flexgear.report.verdict_page import verdict_page  # noqa: E402
 from flexgear.spec import COMPONENTS, OPTIONAL_COMPONENTS  # noqa: E402
 
@@ -43,7 +45,8 @@ A4_LANDSCAPE_IN = (11.69, 8.27)
 
 
 def _load_case_text(d: ReportData) -> list[str]:
-    """The load case as run (per distinct case), beside the study's Table 5."""
+    """The load case as run (per distinct case), beside the gearbox file's (and the published values', where the
+    file gives them: ``[published]``)."""
     lc = d.gearbox.load_case
     cases: dict[tuple, list[str]] = {}
     for n, r in d.runs.items():
@@ -53,8 +56,12 @@ def _load_case_text(d: ReportData) -> list[str]:
         cases.setdefault(key, []).append(n)
     lines = [f"Load case as run: input {fmt(k[0])} rpm, load torque {fmt(k[1], 6)} N·m, STEP ramps over {fmt(k[2])} s, "
              f"{fmt(k[3])} s simulated, step {fmt(k[4])} s ({', '.join(v)})" for k, v in cases.items()]
-    lines.append(f"Study, Table 5: input {fmt(lc.input_speed_rpm)} rpm, {fmt(lc.load_torque_nm, 6)} N·m, ramps over "
-                 f"{rp.STUDY_RAMP_S:g} s, {rp.STUDY_END_S:g} s simulated, step 1e-05 s.")
+    lines.append(f"Gearbox file [load_case]: input {fmt(lc.input_speed_rpm)} rpm, {fmt(lc.load_torque_nm, 6)} N·m, "
+                 f"ramps over {fmt(lc.ramp_time_s)} s, {fmt(lc.end_time_s)} s simulated, step {fmt(lc.step_size_s)} s.")
+    pub = d.gearbox.published
+    if pub is not None:
+        lines.append(f"Published values ({pub.source}): ramps over {fmt(pub.ramp_time_s)} s, "
+                     f"{fmt(pub.simulated_time_s)} s simulated.")
     return lines
 
 
@@ -158,27 +165,27 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
                            "normal module [mm]": [g.normal_module_mm] * 3,
                            "helix angle [°]": [g.helix_angle_deg] * 3,
                            "normal pressure angle [°]": [g.normal_pressure_angle_deg] * 3})
-        left.text(0, 1.0, "Table 1: gear parameters (study)", fontsize=9, weight="bold", transform=left.transAxes)
+        left.text(0, 1.0, "Gear parameters ([gears])", fontsize=9, weight="bold", transform=left.transAxes)
         y = draw_table(left, t1, top=0.97, wrap=14)
         b = d.gearbox.bearings
         t2 = pd.DataFrame([{"bearing": n, "radial [N/m]": x.radial_stiffness_n_per_m,
                             "axial [N/m]": x.axial_stiffness_n_per_m, "tilt [N·m/rad]": x.tilt_stiffness_nm_per_rad}
                            for n, x in (("input shaft", b.input_shaft), ("output shaft", b.output_shaft),
                                         ("planet", b.planet))])
-        left.text(0, y - 0.04, "Table 2: bearing stiffness (study)", fontsize=9, weight="bold",
+        left.text(0, y - 0.04, "Bearing stiffness ([bearings])", fontsize=9, weight="bold",
                   transform=left.transAxes)
         y = draw_table(left, t2, top=y - 0.07, wrap=16)
         t5 = pd.DataFrame({"quantity": ["input speed [rpm]", "load torque [N·m]", "STEP ramp time [s]",
                                         "simulated time [s]", "step size [s]"],
                            "value": [lc.input_speed_rpm, lc.load_torque_nm, lc.ramp_time_s, lc.end_time_s,
                                      lc.step_size_s]})
-        left.text(0, y - 0.04, "Table 5: load case (study)", fontsize=9, weight="bold", transform=left.transAxes)
+        left.text(0, y - 0.04, "Load case ([load_case])", fontsize=9, weight="bold", transform=left.transAxes)
         draw_table(left, t5.assign(value=[fmt(v, 8) for v in t5["value"]]), top=y - 0.07, wrap=30)
         contact = pd.DataFrame({"quantity": ["contact stiffness [N/m^e]", "exponent e", "damping / stiffness",
                                              "penetration depth [m]", "friction coefficient"],
                                 "value": [c.stiffness, c.exponent, c.damping_fraction_of_stiffness,
                                           c.penetration_depth_m, c.friction_coefficient]})
-        right.text(0, 1.0, "Gear contact, section 2.1 (study)", fontsize=9, weight="bold", transform=right.transAxes)
+        right.text(0, 1.0, "Gear contact ([contact])", fontsize=9, weight="bold", transform=right.transAxes)
         y = draw_table(right, contact, top=0.97, wrap=30)
         if th is not None:
             tv = pd.DataFrame({"theoretical value": ["input speed [°/s]", "output speed [°/s]", "ratio",
@@ -188,8 +195,12 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
                                          math.degrees(th["output_speed_rad_per_s"]), th["ratio"],
                                          th["input_torque_nm"], th["output_torque_nm"], th["mesh_force_n"],
                                          th["mesh_frequency_hz"]]})
-            right.text(0, y - 0.04, "Theory (flexgear.theory; study: 798.1894 N, -11647.0554 °/s)", fontsize=9,
-                       weight="bold", transform=right.transAxes)
+            pub = d.gearbox.published.table6 if d.gearbox.published is not None else {}
+            given = [f"{fmt(pub[k][0], 9)} {unit}" for k, unit in (("outer_mesh_force_n", "N"),
+                                                                    ("output_speed_deg_per_s", "°/s"))
+                     if k in pub and math.isfinite(pub[k][0])]
+            right.text(0, y - 0.04, "Theory (flexgear.theory" + (f"; published: {', '.join(given)})" if given else ")"),
+                       fontsize=9, weight="bold", transform=right.transAxes)
             draw_table(right, tv.assign(value=[fmt(v, 8) for v in tv["value"]]), top=y - 0.07, wrap=34)
     return draw
 
@@ -263,7 +274,7 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
         from flexgear.report.modal_pages import modal_pages
 
         body += modal_pages(d, others=others)
-    body += rp.sweep_pages(d)
+    body += sweep_pages(d)
     body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
     body += [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
     body += table_pages("Appendix: assumptions, every value the study does not give", assumptions,

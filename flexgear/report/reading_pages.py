@@ -12,8 +12,9 @@ side by side:
   (flexgear.laws.contact.static_deflection, effective_stiffness), with the meshes' share of the TE
   (flexgear.study.purposes.static_te_split);
 - Tables 6 and 7 as the report computes them (flexgear.report.result_pages.tables_6_7_pages: compare_results over
-  each run's settled window) for the study's multibody model (:data:`STUDY_MBD_VARIANT`) and the lumped run, beside
-  the study's ADAMS and lumped columns;
+  each run's settled window) for the study's multibody model (``[published] multibody_variant`` of the gearbox
+  file) and the lumped run, beside the study's published ADAMS and lumped columns (``[published]``: without it, no
+  page);
 - each reading's verdict per purpose (``verdict.csv`` of the results folder);
 - one sentence naming the reading whose Tables 6-7 lie closer to the study's, by the mean absolute decimal
   log-ratio of the values to the study's (:func:`log_distance`).
@@ -38,11 +39,10 @@ from flexgear.results import RunResult
 from flexgear.spec import Contact
 from flexgear.study.compare import TABLE7_HARMONICS, compare_results
 from flexgear.study.purposes import static_te_split
-from flexgear.study.reference import STUDY_TABLE6, STUDY_TABLE7
 
 __all__ = ["contact_reading_pages", "reading_of", "stiffness_n_per_m_exp", "damping_n_s_per_m", "log_distance",
            "ReadingValues", "reading_values", "READINGS", "READING_M", "READING_MM", "STUDY_STIFFNESS_NUMBER",
-           "STUDY_DAMPING_FRACTION", "STUDY_EXPONENT", "STUDY_MBD_VARIANT", "REFERENCE_VARIANT"]
+           "STUDY_DAMPING_FRACTION", "STUDY_EXPONENT"]
 
 STUDY_STIFFNESS_NUMBER = 1.0e8
 """Section 2.1: the contact stiffness's number, printed as "1.0×10^8 N·m" (unit of the model's length^exponent)."""
@@ -57,11 +57,6 @@ READING_M, READING_MM = "N/m^1.5", "N/mm^1.5"
 READINGS: dict[str, float] = {READING_M: 1.0, READING_MM: 1.0e-3}
 """Each reading of the study's stiffness unit -> the model's length unit [m] (metre, millimetre)."""
 
-STUDY_MBD_VARIANT = "model4"
-"""Section 3 (Fig. 4): model 4 is "selected as the subsequent analysis model", the multibody column of Tables 6-7."""
-
-REFERENCE_VARIANT = "model7"
-"""The reference variant when a results folder was not screened against one (Table 3: all five flexible)."""
 
 _REL_TOL = 1e-6   # a run's saved stiffness matches a reading within this relative tolerance
 _TE_UM, _F_N = "µm", "N"
@@ -130,6 +125,11 @@ class ReadingValues:
     verdicts: dict[str, str] = field(default_factory=dict)
     notes: list[str] = field(default_factory=list)
 
+    @property
+    def multibody(self) -> str:
+        """The variant the published multibody column belongs to (``[published] multibody_variant``)."""
+        return self.case.gearbox.published.multibody_variant
+
 
 def _window_mean(case: ReportData, r: RunResult, pattern: str) -> float:
     """Mean [signal unit] of the columns matching ``pattern`` over the run's settled window."""
@@ -141,7 +141,7 @@ def _window_mean(case: ReportData, r: RunResult, pattern: str) -> float:
 
 def _law_rows(case: ReportData, out: ReadingValues) -> None:
     """The law's parameters, the reference's static TE and the law's static deflection at its mean mesh forces."""
-    ref_name = case.reference.reference if case.reference is not None else REFERENCE_VARIANT
+    ref_name = case.reference.reference if case.reference is not None else case.gearbox.screening.reference
     ref = case.runs.get(ref_name)
     spec_contact = next(((r.meta.get("spec") or {}).get("contact") for r in case.runs.values()
                          if (r.meta.get("spec") or {}).get("contact")), None)
@@ -203,9 +203,11 @@ _T6_LABELS = {"input_speed_deg_per_s": "input speed [°/s]", "output_speed_deg_p
 
 
 def _table_rows(case: ReportData, out: ReadingValues) -> None:
-    """Tables 6-7 of :data:`STUDY_MBD_VARIANT` against the study's ADAMS column and of the lumped run against its
-    lumped column (Table 6: column 1 and 2; Table 7: columns 0-1 and 2-3)."""
-    runs = {STUDY_MBD_VARIANT: (case.runs.get(STUDY_MBD_VARIANT), 1, 0, "ADAMS"),
+    """Tables 6-7 of the published multibody variant (``[published] multibody_variant``) against the published
+    multibody column and of the lumped run against the lumped column (Table 6: column 1 and 2; Table 7: columns 0-1
+    and 2-3)."""
+    pub = case.gearbox.published
+    runs = {pub.multibody_variant: (case.runs.get(pub.multibody_variant), 1, 0, "ADAMS"),
             "lumped": (case.lumped, 2, 2, "lumped")}
     for name, (r, col6, col7, who) in runs.items():
         t6: dict[str, float] = {}
@@ -223,12 +225,12 @@ def _table_rows(case: ReportData, out: ReadingValues) -> None:
         for key, label in _T6_LABELS.items():
             row = f"T6 {name} vs study {who}: {label}"
             out.tables[row] = float(t6.get(key, math.nan))
-            out.study[row] = STUDY_TABLE6[key][col6]
+            out.study[row] = pub.table6[key][col6] if key in pub.table6 else math.nan
         for k in TABLE7_HARMONICS:
             for j, side in enumerate(("input", "output")):
                 row = f"T7 {name} vs study {who}: {side} bearing {k}× mesh [m/s²]"
                 out.tables[row] = t7.get((k, side), math.nan)
-                out.study[row] = STUDY_TABLE7[k][col7 + j]
+                out.study[row] = pub.table7[k][col7 + j] if k in pub.table7 else math.nan
 
 
 def _verdict_rows(case: ReportData, out: ReadingValues) -> None:
@@ -291,7 +293,7 @@ def _sentence(m: ReadingValues | None, mm: ReadingValues, keys: list[str]) -> st
     by_table = ", ".join(
         f"Table {n} alone {log_distance(m.tables, m.study, part):.3g} / {log_distance(mm.tables, mm.study, part):.3g}"
         for n in (6, 7) if (part := [k for k in keys if k.startswith(f"T{n} ")]))
-    return (f"Over the {len(keys)} Table 6-7 values both readings give ({STUDY_MBD_VARIANT} against the study's "
+    return (f"Over the {len(keys)} Table 6-7 values both readings give ({mm.multibody} against the study's "
             f"ADAMS column, the lumped run against its lumped column) the mean |log10(ours/study)| is {e_m:.3g} "
             f"decades under the {READING_M} reading and {e_mm:.3g} under the {READING_MM} reading: the {better} "
             f"reading reproduces the study better (its values a geometric-mean factor {10 ** lo:.3g} off the "
@@ -308,7 +310,7 @@ def contact_reading_pages(d: ReportData, others: list[ReportData]) -> list[Page]
     ``others`` is a millimetre-reading run (its runs' saved stiffness is 1e8 * 1000^1.5 N/m^1.5)."""
     cases = [d, *others]
     mm_case = _pick(cases, READING_MM, d if reading_of(d) != READING_MM else None)
-    if mm_case is None:
+    if mm_case is None or mm_case.gearbox.published is None:  # no published Tables 6-7 to set them beside
         return []
     m_case = _pick(cases, READING_M, mm_case)
     mm = reading_values(mm_case, READING_MM)
@@ -324,8 +326,9 @@ def contact_reading_pages(d: ReportData, others: list[ReportData]) -> list[Page]
         rows.append({"quantity": label, "study": mm.study[label], READING_M: mv.tables.get(label, math.nan),
                      READING_MM: mm.tables[label]})
     for purpose in dict.fromkeys([*mv.verdicts, *mm.verdicts]):
-        rows.append({"quantity": f"verdict: {purpose}", "study": "model4 (section 3)" if purpose == "all purposes"
-                     else "–", READING_M: mv.verdicts.get(purpose, "–"), READING_MM: mm.verdicts.get(purpose, "–")})
+        rows.append({"quantity": f"verdict: {purpose}", "study": f"{mm.multibody} (section 3)"
+                     if purpose == "all purposes" else "–", READING_M: mv.verdicts.get(purpose, "–"),
+                     READING_MM: mm.verdicts.get(purpose, "–")})
     keys = [k for k in mm.tables if np.isfinite(mm.tables[k]) and np.isfinite(mv.tables.get(k, math.nan))]
     if m is None:
         keys = [k for k in mm.tables if np.isfinite(mm.tables[k])]

@@ -7,6 +7,7 @@ no values gives its status and reason."""
 
 from __future__ import annotations
 
+import dataclasses
 import textwrap
 
 import numpy as np
@@ -17,15 +18,14 @@ from flexgear.report.data import ReportData, nothing_screened_reason, short_reas
 from flexgear.report.figures import draw_table, fmt, run_time_chart
 from flexgear.report.layout import Page, colours, components_text, text_block
 from flexgear.results import SIGNAL_TYPES, RunResult
+from flexgear.schema_published import TABLE6_ROWS
 from flexgear.study.compare import TABLE7_HARMONICS, BearingSpectrum, compare_results, mark_harmonics
 from flexgear.study.indicators import ALL_INDICATORS
-from flexgear.study.reference import ADAMS_SIMULATED_S, ADAMS_TIME_S, STUDY_TABLE6, STUDY_TABLE7
 from flexgear.study.screening import Screening
 
 __all__ = ["run_time_page", "diagram_pages", "screening_pages", "overlay_pages", "spectrum_pages",
-           "tables_6_7_pages", "sweep_pages", "shown_runs"]
+           "tables_6_7_pages", "shown_runs"]
 
-STUDY_RAMP_S, STUDY_END_S = 0.5, 0.6    # Table 5 and section 3.1: the study's load case
 _NOTE_WRAP = 110                        # characters per line of a note inside a figure
 NOT_RECORDED = "not recorded"           # an indicator a screened run has no signal for
 _RUN_TIME_REASON_CHARS = 100           # a failed run's reason in the run-time table (the variant matrix has it all)
@@ -50,12 +50,12 @@ def _number(meta: dict, key: str) -> float:
 
 
 def run_time_page(d: ReportData) -> Page:
-    """Run time per simulated second [s/s] of every run beside the study's ADAMS times; a run without a time says
-    its status and reason."""
+    """Run time per simulated second [s/s] of every run, beside the published wall times where the gearbox file
+    gives them (``[published] wall_time_s``); a run without a time says its status and reason."""
+    pub = d.gearbox.published
     rows = []
     for name, r in d.runs.items():
-        num = name[5:] if name.startswith("model") and name[5:].isdigit() else None
-        adams = ADAMS_TIME_S.get(int(num), np.nan) if num else np.nan
+        published = pub.wall_time_per_simulated_s(name) if pub is not None else np.nan
         t_end = _number(r.meta, "t_end_s")
         wall = _number(r.meta, "wall_time_s") if r.ok else np.nan
         cpu = _number(r.meta, "cpu_time_s") if r.ok else np.nan
@@ -63,23 +63,30 @@ def run_time_page(d: ReportData) -> Page:
         rows.append({"variant": name, "components": components_text(r.meta), "status": r.meta.get("status"),
                      "reason": "" if r.ok else short_reason(r.meta.get("reason"), chars=_RUN_TIME_REASON_CHARS),
                      "t_end_s": t_end, "wall_time_s": wall, "cpu_time_s": cpu, "per_s": wall / per,
-                     "cpu_per_s": cpu / per, "adams_per_s": adams / ADAMS_SIMULATED_S})
+                     "cpu_per_s": cpu / per, "adams_per_s": published})
     runs = pd.DataFrame(rows, columns=_RUN_TIME_COLUMNS)
     empty = f"no runs in {d.results_dir}: no run time to show"
 
+    if pub is None or not runs["adams_per_s"].notna().any():
+        runs = runs.drop(columns="adams_per_s")
+
     def draw(fig: Figure) -> None:
-        run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs, empty)
-        shown = runs.assign(speedup=runs["adams_per_s"] / runs["per_s"]).rename(columns={
+        run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs, empty,
+                       None if pub is None else f"{pub.source}, published ({fmt(pub.simulated_time_s)} s simulated)")
+        shown = runs.rename(columns={
             "t_end_s": "simulated [s]", "wall_time_s": "wall [s]", "cpu_time_s": "CPU [s]",
             "per_s": "wall per simulated s", "cpu_per_s": "CPU per simulated s",
-            "adams_per_s": "study ADAMS per simulated s",
-            "speedup": "ADAMS / flexgear"})
+            "adams_per_s": "published per simulated s"})
+        if "adams_per_s" in runs:
+            shown["published / flexgear"] = runs["adams_per_s"] / runs["per_s"]
         draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34, "reason": 34},
                    fontsize=7.5, empty=empty)
-        fig.text(0.04, 0.37, "Both per simulated second: the study's Table 4 times are for 0.6 s simulated (its own "
-                 "computer); ours for the simulated time shown (model build + simulation). Wall time includes waiting "
-                 "for a shared CPU; CPU time does not.", fontsize=7.5, wrap=True)
-    return ("Run time per simulated second against the study's ADAMS times (Table 4)", draw)
+        fig.text(0.04, 0.37, "Per simulated second: ours for the simulated time shown (model build + simulation); "
+                 + ("" if "adams_per_s" not in runs else f"the published times ({pub.source}) for "
+                    f"{fmt(pub.simulated_time_s)} s simulated on its own computer; ")
+                 + "wall time includes waiting for a shared CPU, CPU time does not.", fontsize=7.5, wrap=True)
+    title = "Run time per simulated second"
+    return (title + (f" against the published times ({pub.source})" if "adams_per_s" in runs else ""), draw)
 
 
 def _diagram_page(s: Screening, title: str, note: str, why: str = "") -> Page:
@@ -127,8 +134,10 @@ def _refused_page(d: ReportData) -> Page:
 
 def diagram_pages(d: ReportData) -> list[Page]:
     """The study mode's diagram, then the reference screening's (or why it was refused): the last is the verdict's."""
+    weights = dataclasses.asdict(d.settings.weights)
+    used = ", ".join(f"{name.replace('_', ' ')} {100 * w:g} %" for name, w in weights.items() if w > 0)
     pages = [_diagram_page(d.study, "Westgard decision diagram, the study's mode: Bias against theory (section "
-                           "2.2, Fig. 2)", f"The study's five indicators, 20 % each, TEa = "
+                           "2.2, Fig. 2)", f"Indicators weighted by [screening.weights] ({used}), TEa = "
                            f"{d.study.lines.tea_pct:g} %. They are fixed by kinematics and torque balance and barely "
                            "depend on flexibility.", nothing_screened_reason(d.results_dir, d.runs, d.study))]
     if d.reference is not None:
@@ -266,7 +275,9 @@ def overlay_pages(d: ReportData) -> list[Page]:
 
 
 def spectrum_pages(d: ReportData) -> list[Page]:
+    """Both bearings' acceleration spectra of every run overlaid, the published Table 7's harmonics marked."""
     runs = shown_runs(d)
+    pub = d.gearbox.published
     col = colours(list(runs))
     window = _settled_words(_unsettled(d, runs))
 
@@ -293,33 +304,40 @@ def spectrum_pages(d: ReportData) -> list[Page]:
                 present |= set(sp.present())
             f = spectra[0].mesh_frequency_hz
             ax.set_xlim(0, 10.5 * f / 1e3)
-            mark_harmonics(ax, f, sorted(present))
+            mark_harmonics(ax, f, sorted(present), () if pub is None else tuple(pub.table7))
             ax.set_xlabel(f"frequency [kHz] (mesh frequency {f:g} Hz)")
             ax.set_ylabel("amplitude of a_x [m/s²]")
             ax.set_title(f"{side}-shaft bearing, x acceleration, each run's {window}", fontsize=9, pad=14)
             ax.legend(fontsize=7, ncol=min(8, len(spectra)), loc="lower left", framealpha=0.85)
             ax.grid(alpha=0.3, which="major")
+        published = "" if pub is None or not pub.table7 else (
+            f", the published Table 7's {', '.join(map(str, pub.table7))}× ({pub.source}) in red")
         text_block(fig.add_axes([0.07, 0.01, 0.9, 0.04]), "Hann-windowed amplitude spectrum "
                    "(flexgear.study.compare). Markers at every harmonic of the mesh frequency that stands 20 dB above "
-                   "its neighbourhood in any run (grey), the study's 1, 2, 4, 6, 9× (Table 7) in red.", width=190,
-                   fontsize=7.5)
+                   f"its neighbourhood in any run (grey){published}.", width=190, fontsize=7.5)
     return [("Bearing acceleration spectra, all variants overlaid", draw)]
 
 
 def _load_case_note(d: ReportData) -> str:
+    """A caution where runs used another load case than the published values' (``[published]``)."""
+    pub = d.gearbox.published
+    if pub is None:
+        return ""
     cases = {(r.meta.get("ramp_time_s"), r.meta.get("t_end_s")) for r in shown_runs(d).values()}
-    differ = [c for c in cases if c != (STUDY_RAMP_S, STUDY_END_S)]
+    differ = [c for c in cases if c != (pub.ramp_time_s, pub.simulated_time_s)]
     if not differ:
         return ""
     text = ", ".join(f"ramps {fmt(a)} s / {fmt(b)} s simulated" for a, b in sorted(differ, key=str))
-    return (f"CAUTION: these runs used a load case other than the study's (ramps over {STUDY_RAMP_S:g} s, "
-            f"{STUDY_END_S:g} s simulated): {text}. The study's values are its own model's under its load case and "
-            "its unknown face width (see the eps_beta sensitivity): compare trends, not digits.")
+    return (f"CAUTION: these runs used a load case other than the published values' (ramps over "
+            f"{fmt(pub.ramp_time_s)} s, {fmt(pub.simulated_time_s)} s simulated): {text}. The published values are "
+            f"{pub.source}'s own model's under its load case: compare trends, not digits.")
 
 
 def tables_6_7_pages(d: ReportData) -> list[Page]:
-    """Tables 6 and 7 for every finished run and the lumped model beside the study's (marked as the study's)."""
+    """Tables 6 and 7 for every finished run and the lumped model, beside the published values where the gearbox
+    file gives them (``[published] table6`` and ``table7``, marked "published:")."""
     runs = shown_runs(d)
+    pub = d.gearbox.published
     t6 = {}
     t7 = []
     skipped = []
@@ -336,18 +354,24 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
             for k, v in zip(TABLE7_HARMONICS, b.iloc[:, 0 if side == "input" else 1], strict=True):
                 row[f"{side} {k}×"] = v
         t7.append(row)
-    table6 = pd.DataFrame(t6).reindex(list(STUDY_TABLE6))
-    for j, col in enumerate(("study: theory", "study: ADAMS (model 4)", "study: lumped")):
-        table6[col] = [STUDY_TABLE6[k][j] for k in table6.index]
+    table6 = pd.DataFrame(t6).reindex(list(TABLE6_ROWS))
+    if pub is not None and pub.table6:
+        multibody = f"published: multibody ({pub.multibody_variant})" if pub.multibody_variant else \
+            "published: multibody"
+        for j, col in enumerate(("published: theory", multibody, "published: lumped")):
+            table6[col] = [pub.table6[k][j] if k in pub.table6 else np.nan for k in table6.index]
     labels = {"input_speed_deg_per_s": "input speed [°/s]", "output_speed_deg_per_s": "output speed [°/s]",
               "outer_mesh_force_n": "outer mesh force, mean [N]", "inner_mesh_force_n": "inner mesh force, mean [N]",
               "input_bearing_peak_accel_m_per_s2": "input bearing peak accel. [m/s²]",
               "output_bearing_peak_accel_m_per_s2": "output bearing peak accel. [m/s²]"}
     table6 = table6.rename(index=labels).reset_index(names="Table 6")
-    for j, name in ((0, "study: ADAMS"), (2, "study: lumped")):
+    for j, name in ((0, "published: multibody"), (2, "published: lumped")):
+        if pub is None or not pub.table7:
+            break
         row = {"run": name}
         for side, off in (("input", 0), ("output", 1)):
-            row.update({f"{side} {k}×": STUDY_TABLE7[k][j + off] for k in TABLE7_HARMONICS})
+            row.update({f"{side} {k}×": pub.table7[k][j + off] if k in pub.table7 else np.nan
+                        for k in TABLE7_HARMONICS})
         t7.append(row)
     table7 = pd.DataFrame(t7)
     unsettled = _unsettled(d, runs)
@@ -359,102 +383,17 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
 
     def draw(fig: Figure) -> None:
         ax = fig.add_axes([0.03, 0.06, 0.94, 0.85])
-        ax.text(0, 1.0, "Table 6: time-domain indicators over each run's settled window; the study's columns are "
-                "the study's published values", fontsize=9, weight="bold", transform=ax.transAxes)
+        ax.text(0, 1.0, "Table 6: time-domain indicators over each run's settled window" + (
+            "" if pub is None else f"; 'published:' columns are {pub.source}'s"), fontsize=9, weight="bold",
+            transform=ax.transAxes)
         shown = table6.astype(object)
         for i, name in enumerate(shown.iloc[:, 0]):
             shown.iloc[i, 1:] = [fmt(v, 4 if "accel" in name else 9) for v in shown.iloc[i, 1:]]
         y = draw_table(ax, shown, top=0.97, fontsize=7, wrap=14)
         ax.text(0, y - 0.04, "Table 7: amplitude of the bearing x acceleration at multiples of the mesh frequency "
-                "[m/s²] (windowed DTFT); 'study:' rows are the study's", fontsize=9, weight="bold",
-                transform=ax.transAxes)
+                "[m/s²] (windowed DTFT)" + ("" if pub is None else f"; 'published:' rows are {pub.source}'s"),
+                fontsize=9, weight="bold", transform=ax.transAxes)
         y = draw_table(ax, table7.astype(object).map(lambda v: fmt(v, 3)), top=y - 0.07, fontsize=7, wrap=14)
         text_block(ax, note, width=190, fontsize=8, top=y - 0.03)
-    return [("Tables 6 and 7: every variant and the lumped model, beside the study's", draw)]
-
-
-def _peak(d: ReportData, folder, name: str, side: str) -> float:
-    """Largest radial bearing acceleration of a sweep run in its settled window (as Table 6)."""
-    from flexgear.results import load_result
-
-    r = d.runs.get(name)
-    if r is None and folder is not None and (folder / name / "run.json").exists():
-        r = load_result(folder / name)
-    if r is None or not r.ok:
-        return np.nan
-    w = d.window(r)
-    t = r.signals["time_s"].to_numpy()
-    y = r.signal(f"{side}_bearing_accel")
-    return float(y[(t >= w.start_s) & (t <= w.end_s)].max())
-
-
-def sweep_pages(d: ReportData) -> list[Page]:
-    if d.sweep is None:
-        return []
-    sw = d.sweep
-    table = sw.table.copy()
-    if sw.folder is not None:   # indicator means again from the runs, with the report's screening settings
-        from flexgear.study.sweep import indicator_means
-
-        def means(name: str) -> dict[str, float]:
-            try:
-                return indicator_means(sw.folder / name, d.settings)
-            except (ValueError, KeyError):   # a run too short for its samples: no means, its status says why
-                return {}
-
-        fresh = pd.DataFrame([means(n) for n in table["variant"]], index=table.index)
-        table[list(fresh.columns)] = fresh
-    table["input_bearing_peak"] = [_peak(d, sw.folder, n, "input") for n in table["variant"]]
-    table["output_bearing_peak"] = [_peak(d, sw.folder, n, "output") for n in table["variant"]]
-    params = sw.parameters
-    keep = ["variant", *params, "eps_beta", "status", "wall_time_s", "input_bearing_peak", "output_bearing_peak",
-            "input_bearing_rms", "outer_mesh_ripple", "dynamic_factor", "transmission_error"]
-    names = {"wall_time_s": "wall [s]", "input_bearing_peak": "input bearing peak [m/s²]",
-             "output_bearing_peak": "output bearing peak [m/s²]", "input_bearing_rms": "input bearing RMS [m/s²]",
-             "outer_mesh_ripple": "outer ripple [%]", "dynamic_factor": "K_v",
-             "transmission_error": "loaded TE [m]"}
-    shown = table[[c for c in keep if c in table.columns]].rename(columns=lambda c: names.get(c, c.split(".")[-1]))
-    from flexgear.study.sweep import SweepResult
-
-    plotted = SweepResult(sw.meta, table, sw.folder)
-
-    def draw_table_page(fig: Figure) -> None:
-        ax = fig.add_axes([0.03, 0.07, 0.94, 0.83])
-        text_block(ax, f"Sweep '{sw.meta['name']}' ({sw.meta['grid']} grid): " + "; ".join(
-            f"{k} = {', '.join(map(str, v))}" for k, v in sw.meta["parameters"].items()), width=180, fontsize=8.5)
-        draw_table(ax, shown, top=0.92, fontsize=7, wrap=26)
-
-    def draw_figures(fig: Figure) -> None:
-        x = "eps_beta" if width else numeric[0]
-        panels = (("input_bearing_peak", "input bearing, peak radial accel. [m/s²]"),
-                  ("output_bearing_peak", "output bearing, peak radial accel. [m/s²]"),
-                  ("input_bearing_rms", "input bearing accel. RMS [m/s²]"),
-                  ("outer_mesh_ripple", "outer mesh-force ripple [%]"))
-        for i, (y, label) in enumerate(panels):
-            ax = fig.add_axes([0.07 + 0.48 * (i % 2), 0.55 - 0.42 * (i // 2), 0.4, 0.32])
-            plotted.plot(ax, y, x)
-            if x == "eps_beta":
-                ax.axvline(1.0, color="#d62728", ls="--", lw=0.8, label="ε_β = 1")
-                if "peak" in y:
-                    study = STUDY_TABLE6[f"{y.split('_')[0]}_bearing_peak_accel_m_per_s2"][1]
-                    ax.axhline(study, color="#555555", ls=":", lw=0.9, label=f"study ADAMS {study:g} (face width "
-                               "not given)")
-            ax.set_yscale("log" if "peak" in y or "rms" in y else "linear")
-            ax.set_xlabel("overlap ratio ε_β of one helix half" if x == "eps_beta" else x)
-            ax.set_ylabel(label, fontsize=8)
-            ax.grid(alpha=0.3, which="both")
-            ax.legend(fontsize=6.5, loc="best")
-        text_block(fig.add_axes([0.07, 0.02, 0.9, 0.05]), "ε_β = (b/2) sin β / (π m_n) of one helix half (b: total "
-                   "face width, double-helical). Near integer ε_β the contact-line length, and so the mesh stiffness, "
-                   "hardly varies with mesh position: the mesh excitation and the bearing accelerations drop by orders "
-                   "of magnitude. The study does not give b, so its bearing accelerations cannot be a target by "
-                   "themselves. Peak: largest radial acceleration in the settled window (as Table 6).", width=190,
-                   fontsize=7.5)
-    width = any(p.endswith("face_width_mm") for p in params)
-    numeric = [p for p in params if len(sw.meta["parameters"][p]) > 1
-               and all(isinstance(v, (int, float)) for v in sw.meta["parameters"][p])]
-    pages = [(f"Sweep table: {sw.meta['name']}", draw_table_page)]
-    if numeric:     # a sensitivity figure needs a swept number
-        what = "the face width (ε_β)" if width else ", ".join(numeric)
-        pages.append((f"Sweep: sensitivity to {what}", draw_figures))
-    return pages
+    return [("Tables 6 and 7: every variant and the lumped model" + ("" if pub is None else ", beside the published "
+             "values"), draw)]

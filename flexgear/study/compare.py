@@ -233,12 +233,12 @@ class BearingSpectrum:
         ax.semilogy(self.frequency_hz[keep] / 1e3, self.amplitude[keep], label=self.name, **{"lw": 0.7, **style})
 
 
-def mark_harmonics(ax, mesh_frequency_hz: float, present: Sequence[int], study: Sequence[int] = TABLE7_HARMONICS
-                   ) -> None:
-    """Dashed markers at every harmonic in ``present`` and the study's (Table 7), the study's in red."""
+def mark_harmonics(ax, mesh_frequency_hz: float, present: Sequence[int], highlight: Sequence[int] = ()) -> None:
+    """Dashed markers at every harmonic in ``present`` and in ``highlight`` (e.g. a published table's), those in
+    red."""
     top = ax.get_ylim()[1]
-    for k in sorted(set(present) | set(study)):
-        red = k in study
+    for k in sorted(set(present) | set(highlight)):
+        red = k in highlight
         ax.axvline(k * mesh_frequency_hz / 1e3, color="#d62728" if red else "#555555", lw=0.8 if red else 0.6,
                    ls="--", alpha=0.8)
         ax.text(k * mesh_frequency_hz / 1e3, top, f"{k}×", color="#d62728" if red else "#555555", fontsize=7.5,
