@@ -233,8 +233,8 @@ def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, pro
         now = time.perf_counter()
         if (futures or side) and now - last_beat >= _HEARTBEAT_S:
             last_beat = now
-            pending = [_label(t, several) for t in futures.values()] + [":".join(map(str, (k[0], *k[2:])))
-                                                                       for k in side.values()]
+            pending = [_label(t, several) for t in futures.values()] + [
+                f"speed:{k[2]}" if k[0] == "speed" else str(k[0]) for k in side.values()]  # a speed curve's variant
             say_progress(progress, f"running or queued {len(pending)}: {', '.join(pending)} "
                                    f"({now - started:.0f} s elapsed)")
         if (futures or side) and not finished:
