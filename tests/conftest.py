@@ -17,6 +17,7 @@ thread pools get its share of the cores, and its allocator keeps freed memory (:
 
 import ast
 import dataclasses
+import os
 from pathlib import Path
 
 import pytest
@@ -258,10 +259,13 @@ def coarse_fe():
 
 
 @pytest.fixture(scope="module")
-def example_cache(request, tmp_path_factory):
-    """One private cache folder (``FLEXGEAR_CACHE_DIR``) for a test module of an example study: its runs and
-    checks share its bodies, and the project's cache stays untouched."""
-    path = tmp_path_factory.mktemp(f"{request.module.__name__}_cache")
+def example_cache(tmp_path_factory):
+    """The cache folder (``FLEXGEAR_CACHE_DIR``) of the example studies' test modules, one for the whole run and
+    shared by its workers (a body another module or worker is building is waited for, flexgear.cache.load_or_build):
+    the modules share the examples' bodies, and the project's cache stays untouched."""
+    base = tmp_path_factory.getbasetemp()
+    path = (base.parent if os.environ.get("PYTEST_XDIST_WORKER") else base) / "examples_cache"
+    path.mkdir(exist_ok=True)
     with pytest.MonkeyPatch.context() as mp:
         mp.setenv("FLEXGEAR_CACHE_DIR", str(path))
         yield path

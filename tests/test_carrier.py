@@ -9,7 +9,7 @@
   the pins under their own loads (the planets' bearing forces and moments, RBE3) within 2 %;
 - sizes that leave no posts between the planets are refused in one line naming the dimension.
 
-Every body is built in a private cache (about half a minute of CPU).
+The body is built in the examples' cache, which the example's own tests share (about half a minute of CPU).
 """
 
 from __future__ import annotations
@@ -34,14 +34,12 @@ K_MODES = 12
 
 
 @pytest.fixture(scope="module")
-def carrier(tmp_path_factory):
-    """(gearbox, sizes, full FE model, reduced body), the body in a private cache."""
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path_factory.mktemp("carrier_cache")))
-        gearbox = fg.load_gearbox(EXAMPLE)
-        sizes = carrier_sizes(gearbox)
-        fe = carrier_fe_model(gearbox, "coarse")
-        yield gearbox, sizes, fe, carrier_body(gearbox, "coarse", fe=fe)
+def carrier(example_cache):
+    """(gearbox, sizes, full FE model, reduced body), the body in the examples' cache (conftest.example_cache)."""
+    gearbox = fg.load_gearbox(EXAMPLE)
+    sizes = carrier_sizes(gearbox)
+    fe = carrier_fe_model(gearbox, "coarse")
+    return gearbox, sizes, fe, carrier_body(gearbox, "coarse", fe=fe)
 
 
 def test_exact_mass_properties_match_the_solid_and_the_mesh(carrier):

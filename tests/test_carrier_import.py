@@ -1,5 +1,5 @@
 """The planet carrier from the user's file (``[components_geometry] carrier``, flexgear.fe.carrier_part), on the spur
-planetary example (24/30/84, 3 planets, m 3 mm), coarse mesh, every body in a private cache:
+planetary example (24/30/84, 3 planets, m 3 mm), coarse mesh, the bodies in the examples' cache:
 
 - round trips of the built-in carrier through ``flexgear export-geometry``: its VTU gives the same FE model (nodes,
   K, M, the seat and pin regions with their area weights); its STEP, meshed again, the same reduced body within the
@@ -39,22 +39,23 @@ def _gearbox(folder: Path, entry: str | None) -> Path:
     if entry is not None:
         text += f"\n[components_geometry]\ncarrier = {entry}\n"
     (folder / "gearbox.toml").write_text(text)
-    for variant in ("rigid", "flexible"):
-        (folder / f"{variant}.toml").write_text((EXAMPLE / f"{variant}.toml").read_text())
+    rigid = (EXAMPLE / "rigid.toml").read_text()
+    (folder / "rigid.toml").write_text(rigid)
+    (folder / "carrier.toml").write_text(rigid.replace('name = "rigid"', 'name = "carrier"')
+                                         + 'carrier = "flexible"\n')  # the carrier alone flexible
     return folder / "gearbox.toml"
 
 
 @pytest.fixture(scope="module")
-def parts(tmp_path_factory):
-    """(folder, the built-in gearbox) with the built-in carrier exported to ``folder / "parts"``, a private cache."""
+def parts(tmp_path_factory, example_cache):
+    """(folder, the built-in gearbox) with the built-in carrier exported to ``folder / "parts"``; bodies in the
+    examples' cache (conftest.example_cache: the built-in carrier is the example's)."""
     from flexgear.cli import main
 
     folder = tmp_path_factory.mktemp("carrier_import")
-    with pytest.MonkeyPatch.context() as mp:
-        mp.setenv("FLEXGEAR_CACHE_DIR", str(tmp_path_factory.mktemp("carrier_import_cache")))
-        assert main(["export-geometry", str(EXAMPLE / "gearbox.toml"), "--component", "carrier",
-                     "--out", str(folder / "parts")]) == 0
-        yield folder, fg.load_gearbox(EXAMPLE / "gearbox.toml")
+    assert main(["export-geometry", str(EXAMPLE / "gearbox.toml"), "--component", "carrier",
+                 "--out", str(folder / "parts")]) == 0
+    return folder, fg.load_gearbox(EXAMPLE / "gearbox.toml")
 
 
 def _pin_compliance(body, planets: int) -> np.ndarray:
@@ -146,9 +147,9 @@ def test_a_lightened_carrier_from_step_against_its_full_fe_model(parts, tmp_path
     c_full, c_red = held.compliance(loads), _pin_compliance(body, 3)
     assert np.max(np.abs(c_red - c_full)) < 0.02 * np.max(np.abs(c_full))
     # the flexible carrier runs: the stage's ratio and each mesh's forces against the sun's torque
-    assert main(["run", str(folder / "lightened" / "flexible.toml"), "--t-end", "0.06", "--out",
+    assert main(["run", str(folder / "lightened" / "carrier.toml"), "--t-end", "0.06", "--out",
                  str(tmp_path)]) == 0
-    s = load_result(tmp_path / "flexible").signals
+    s = load_result(tmp_path / "carrier").signals
     late = s[s.time_s >= 0.04]
     assert late.transmission_ratio.mean() == pytest.approx(24 / 108, rel=1e-3)
     t_sun = gearbox.load_case.load_torque_nm * 24 / 108

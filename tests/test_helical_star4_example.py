@@ -18,7 +18,7 @@ slide against their axial bearings, 278 and 373 Hz, damping ratio about 1 %): th
 reactions move by a few tenths of a percent with the window, hence 1 %.
 
 The all-flexible variant (the ring and output shaft reduced together, about four minutes of CPU to build) is
-checked the same way under ``make test-heavy``. Every body is built in a private cache, coarse meshes (the CI
+checked the same way under ``make test-heavy``. Every body is built in the examples' cache, coarse meshes (the CI
 part: about half a minute of CPU).
 """
 

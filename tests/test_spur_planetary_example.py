@@ -18,8 +18,8 @@ discs, and the flexible output shaft is bolted to the carrier at its own. The fl
 bearings on its pins' nodes (flexgear.mbs.carrier.CarrierPins): its pins' deflection is checked against its static
 compliance under the run's own bearing loads, its linear model against the reference formulation, its harmonic
 response against its time run. The production formulation is checked against the reference formulation (Exudyn's
-nonlinear floating frame) on the turning carrier as well. Every body is built in a private cache from coarse meshes
-(about two minutes of CPU).
+nonlinear floating frame) on the turning carrier as well. Every body is built in the examples' cache
+(conftest.example_cache) from coarse meshes (about two minutes of CPU).
 """
 
 from __future__ import annotations

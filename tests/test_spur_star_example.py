@@ -9,7 +9,7 @@ gear data, bearings and load case, every other value following the gear set (fle
   full FE model: every clamped mode below 3x the mesh frequency within 1 %, the compliance under the mesh loads
   (the contact kernel's loads at every contact of the ring) within 2 %.
 
-Every body is built in a private cache, coarse meshes (about two minutes of CPU in all).
+Every body is built in the examples' cache (conftest.example_cache), coarse meshes (about two minutes of CPU in all).
 """
 
 from __future__ import annotations
