@@ -384,15 +384,15 @@ def tables_6_7_pages(d: ReportData) -> list[Page]:
     def draw(fig: Figure) -> None:
         ax = fig.add_axes([0.03, 0.06, 0.94, 0.85])
         ax.text(0, 1.0, "Table 6: time-domain indicators over each run's settled window" + (
-            "" if pub is None else f"; 'published:' columns are {pub.source}'s"), fontsize=9, weight="bold",
+            "" if pub is None else f"; 'published:' columns: {pub.source}"), fontsize=9, weight="bold",
             transform=ax.transAxes)
         shown = table6.astype(object)
         for i, name in enumerate(shown.iloc[:, 0]):
             shown.iloc[i, 1:] = [fmt(v, 4 if "accel" in name else 9) for v in shown.iloc[i, 1:]]
         y = draw_table(ax, shown, top=0.97, fontsize=7, wrap=14)
-        ax.text(0, y - 0.04, "Table 7: amplitude of the bearing x acceleration at multiples of the mesh frequency "
-                "[m/s²] (windowed DTFT)" + ("" if pub is None else f"; 'published:' rows are {pub.source}'s"),
-                fontsize=9, weight="bold", transform=ax.transAxes)
+        ax.text(0, y - 0.04, "Table 7: bearing x acceleration at multiples of the mesh frequency [m/s²] (windowed "
+                "DTFT)" + ("" if pub is None else f"; 'published:' rows: {pub.source}"), fontsize=9, weight="bold",
+                transform=ax.transAxes)
         y = draw_table(ax, table7.astype(object).map(lambda v: fmt(v, 3)), top=y - 0.07, fontsize=7, wrap=14)
         text_block(ax, note, width=190, fontsize=8, top=y - 0.03)
     return [("Tables 6 and 7: every variant and the lumped model" + ("" if pub is None else ", beside the published "
