@@ -1,1 +1,1 @@
-"""Variant studies: the matrix runner, screening (Westgard), comparisons, the study's reference values."""
+"""Variant studies: the matrix runner, screening (Westgard), comparisons, sweeps, run-up maps."""
