@@ -71,6 +71,7 @@ def test_the_example_is_the_study_gearbox_with_its_ring_from_a_file(example, gea
                                                                                  coarse["body_size_mm"])
     for name in ("ring_tooth_size_mm", "ring_body_size_mm"):
         study["meshing_assumed"]["coarse"].pop(name)
+    study.pop("published")  # the study's results are for its own ring, not the lightened one: not the example's
     assert {k: v for k, v in raw.items() if k != "title"} == {k: v for k, v in study.items() if k != "title"}
     assert "SI_UNIT(.MILLI.,.METRE.)" in (example / "parts" / "ring_lightened.step").read_text(errors="replace")
 
