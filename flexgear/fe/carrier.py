@@ -21,7 +21,7 @@ from dataclasses import replace
 
 import numpy as np
 
-from flexgear.fe.carrier_part import imported_carrier_mesh, level_mesh
+from flexgear.fe.carrier_part import imported_carrier_mesh, level_mesh, pin_bore_faces
 from flexgear.fe.cms import ReducedBody, interface, reduce
 from flexgear.fe.fem import FEModel, fe_model
 from flexgear.fe.imported import IMPORT_VERSION
@@ -58,14 +58,11 @@ def _named_solid(sizes: CarrierSizes, pin_size: float):
     plate's bore named ``seat``."""
     solid = carrier_solid(sizes)
     half = sizes.gap / 2
-    pins = sizes.pin_centres()[:, :2]
+    for k, face in pin_bore_faces(solid, sizes.pin_centres()[:, :2]):
+        face.name, face.maxh = pin_interface(k), pin_size
     for face in solid.faces:  # a full cylindrical face's centre lies on its axis
         c = face.center
-        off = np.hypot(pins[:, 0] - c.x, pins[:, 1] - c.y)
-        k = int(np.argmin(off))
-        if off[k] < _FACE_TOL and abs(c.z) > half:
-            face.name, face.maxh = pin_interface(k), pin_size
-        elif np.hypot(c.x, c.y) < _FACE_TOL and c.z > half and abs(_radius(face) - sizes.bore_radius) < _FACE_TOL:
+        if np.hypot(c.x, c.y) < _FACE_TOL and c.z > half and abs(_radius(face) - sizes.bore_radius) < _FACE_TOL:
             face.name = SEAT
     return solid
 

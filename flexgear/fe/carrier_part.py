@@ -37,7 +37,7 @@ from flexgear.schema import CARRIER
 from flexgear.schema_geometry import ComponentGeometry
 from flexgear.spec import GearboxSpec
 
-__all__ = ["imported_carrier_mesh", "carrier_regions", "level_mesh", "REGION_TOL", "MAX_BORE_GAP"]
+__all__ = ["imported_carrier_mesh", "carrier_regions", "level_mesh", "pin_bore_faces", "REGION_TOL", "MAX_BORE_GAP"]
 
 REGION_TOL = 1e-6
 """Distance [m] within which a boundary node lies at a region's radius (the file's own rounding is far smaller)."""
@@ -139,24 +139,28 @@ def level_mesh(solid, settings):
     return OCCGeometry(solid).GenerateMesh(mp=mp)
 
 
-def _meshed(solid, settings, sizes: CarrierSizes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(nodes, tetrahedra, boundary triangles) of ``solid`` meshed at the level ``settings`` as the built-in carrier
-    (flexgear.fe.carrier): the level's tooth size on the faces centred on a pin's axis at the smallest radius about
-    it (the pin bores), raised to the level's element order on the solid's surfaces."""
-    centres = sizes.pin_centres()[:, :2]
+def pin_bore_faces(solid, centres: np.ndarray) -> list[tuple[int, object]]:
+    """(k, face) of every face of ``solid`` centred on pin k's axis (``centres`` (N, 2) [m]) at the smallest radius
+    about it: the pin bores, in every plate that holds the pin (a window round the planet is centred there too, at a
+    larger radius)."""
     on_axis = []
-    for face in solid.faces:
+    for face in solid.faces:  # a full cylindrical face's centre lies on its axis
         c = face.center
         off = np.hypot(centres[:, 0] - c.x, centres[:, 1] - c.y)
         k = int(np.argmin(off))
         if off[k] < _FACE_TOL:
             radius = max(float(np.hypot(v.p.x - centres[k, 0], v.p.y - centres[k, 1])) for v in face.vertices)
             on_axis.append((k, radius, face))
-    for k in {k for k, _, _ in on_axis}:
-        smallest = min(r for j, r, _ in on_axis if j == k)
-        for _, r, face in (item for item in on_axis if item[0] == k):
-            if r < smallest + REGION_TOL:
-                face.maxh = settings.tooth_size_mm * 1e-3
+    smallest = {k: min(r for j, r, _ in on_axis if j == k) for k, _, _ in on_axis}
+    return [(k, face) for k, r, face in on_axis if r < smallest[k] + REGION_TOL]
+
+
+def _meshed(solid, settings, sizes: CarrierSizes) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(nodes, tetrahedra, boundary triangles) of ``solid`` meshed at the level ``settings`` as the built-in carrier
+    (flexgear.fe.carrier): the level's tooth size on the pin bores (:func:`pin_bore_faces`), raised to the level's
+    element order on the solid's surfaces."""
+    for _, face in pin_bore_faces(solid, sizes.pin_centres()[:, :2]):
+        face.maxh = settings.tooth_size_mm * 1e-3
     mesh = level_mesh(solid, settings)
     if settings.element_order == 2:
         mesh.SecondOrder()

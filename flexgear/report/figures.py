@@ -105,7 +105,7 @@ def draw_table(ax: Axes, table: pd.DataFrame, col_widths: Sequence[float] | None
 
 def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run time to chart",
                    published: str | None = None) -> None:
-    """Log-scale bars: our wall time per simulated second, beside a published one (column ``adams_per_s``
+    """Log-scale bars: our wall time per simulated second, beside a published one (column ``published_per_s``
     [s/s], labelled ``published``) where ``runs`` has it; columns variant, wall_time_s [s], t_end_s [s]. Without
     runs, a sentence ``empty`` says why instead; a run without a positive simulated time has no bar."""
     if runs.empty or "variant" not in runs.columns:
@@ -118,14 +118,14 @@ def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run t
     wall = pd.to_numeric(runs["wall_time_s"], errors="coerce").to_numpy(dtype=float)
     with np.errstate(divide="ignore", invalid="ignore"):
         ours = np.where(t_end > 0, wall / t_end, np.nan)
-    adams = (pd.to_numeric(runs["adams_per_s"], errors="coerce").to_numpy(dtype=float) if "adams_per_s" in runs
-             else np.full(len(names), np.nan))
+    theirs = (pd.to_numeric(runs["published_per_s"], errors="coerce").to_numpy(dtype=float) if "published_per_s" in runs
+              else np.full(len(names), np.nan))
     w = 0.38
     ax.bar(x - w / 2, np.where(np.isfinite(ours), ours, 0), w, color="#1f4e99",
            label="flexgear (Exudyn), wall time per simulated second")
-    if np.isfinite(adams).any():
-        ax.bar(x + w / 2, np.where(np.isfinite(adams), adams, 0), w, color="#bbbbbb", label=published or "published")
-    for xi, v, a in zip(x, ours, adams, strict=True):
+    if np.isfinite(theirs).any():
+        ax.bar(x + w / 2, np.where(np.isfinite(theirs), theirs, 0), w, color="#bbbbbb", label=published or "published")
+    for xi, v, a in zip(x, ours, theirs, strict=True):
         if np.isfinite(v) and v > 0:
             ax.annotate(fmt(v, 3), (xi - w / 2, v), ha="center", va="bottom", fontsize=7, xytext=(0, 2),
                         textcoords="offset points")
@@ -135,11 +135,11 @@ def run_time_chart(ax: Axes, runs: pd.DataFrame, empty: str = "no runs: no run t
         if np.isfinite(a):
             ax.annotate(fmt(a, 3), (xi + w / 2, a), ha="center", va="bottom", fontsize=7, xytext=(0, 2),
                         textcoords="offset points", color="#555555")
-    if np.any(np.isfinite(ours) & (ours > 0)) or np.any(np.isfinite(adams)):
+    if np.any(np.isfinite(ours) & (ours > 0)) or np.any(np.isfinite(theirs)):
         ax.set_yscale("log")
     ax.set_xticks(x, names, rotation=30 if len(names) > 9 else 0, fontsize=8)
     ax.set_ylabel("wall time per simulated second [s/s] (log scale)")
-    finite = np.concatenate([ours[np.isfinite(ours) & (ours > 0)], adams[np.isfinite(adams)]])
+    finite = np.concatenate([ours[np.isfinite(ours) & (ours > 0)], theirs[np.isfinite(theirs)]])
     if finite.size:
         ax.set_ylim(finite.min() / 5, finite.max() * 20)
     ax.legend(loc="upper left", fontsize=8, framealpha=0.9)

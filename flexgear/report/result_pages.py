@@ -30,7 +30,7 @@ _NOTE_WRAP = 110                        # characters per line of a note inside a
 NOT_RECORDED = "not recorded"           # an indicator a screened run has no signal for
 _RUN_TIME_REASON_CHARS = 100           # a failed run's reason in the run-time table (the variant matrix has it all)
 _RUN_TIME_COLUMNS = ["variant", "components", "status", "reason", "t_end_s", "wall_time_s", "cpu_time_s", "per_s",
-                     "cpu_per_s", "adams_per_s"]
+                     "cpu_per_s", "published_per_s"]
 
 
 def shown_runs(d: ReportData) -> dict[str, RunResult]:
@@ -63,12 +63,12 @@ def run_time_page(d: ReportData) -> Page:
         rows.append({"variant": name, "components": components_text(r.meta), "status": r.meta.get("status"),
                      "reason": "" if r.ok else short_reason(r.meta.get("reason"), chars=_RUN_TIME_REASON_CHARS),
                      "t_end_s": t_end, "wall_time_s": wall, "cpu_time_s": cpu, "per_s": wall / per,
-                     "cpu_per_s": cpu / per, "adams_per_s": published})
+                     "cpu_per_s": cpu / per, "published_per_s": published})
     runs = pd.DataFrame(rows, columns=_RUN_TIME_COLUMNS)
     empty = f"no runs in {d.results_dir}: no run time to show"
 
-    if pub is None or not runs["adams_per_s"].notna().any():
-        runs = runs.drop(columns="adams_per_s")
+    if pub is None or not runs["published_per_s"].notna().any():
+        runs = runs.drop(columns="published_per_s")
 
     def draw(fig: Figure) -> None:
         run_time_chart(fig.add_axes([0.07, 0.45, 0.88, 0.44]), runs, empty,
@@ -76,17 +76,17 @@ def run_time_page(d: ReportData) -> Page:
         shown = runs.rename(columns={
             "t_end_s": "simulated [s]", "wall_time_s": "wall [s]", "cpu_time_s": "CPU [s]",
             "per_s": "wall per simulated s", "cpu_per_s": "CPU per simulated s",
-            "adams_per_s": "published per simulated s"})
-        if "adams_per_s" in runs:
-            shown["published / flexgear"] = runs["adams_per_s"] / runs["per_s"]
+            "published_per_s": "published per simulated s"})
+        if "published_per_s" in runs:
+            shown["published / flexgear"] = runs["published_per_s"] / runs["per_s"]
         draw_table(fig.add_axes([0.04, 0.07, 0.92, 0.28]), shown, wrap={"components": 34, "reason": 34},
                    fontsize=7.5, empty=empty)
         fig.text(0.04, 0.37, "Per simulated second: ours for the simulated time shown (model build + simulation); "
-                 + ("" if "adams_per_s" not in runs else f"the published times ({pub.source}) for "
+                 + ("" if "published_per_s" not in runs else f"the published times ({pub.source}) for "
                     f"{fmt(pub.simulated_time_s)} s simulated on its own computer; ")
                  + "wall time includes waiting for a shared CPU, CPU time does not.", fontsize=7.5, wrap=True)
     title = "Run time per simulated second"
-    return (title + (f" against the published times ({pub.source})" if "adams_per_s" in runs else ""), draw)
+    return (title + (f" against the published times ({pub.source})" if "published_per_s" in runs else ""), draw)
 
 
 def _diagram_page(s: Screening, title: str, note: str, why: str = "") -> Page:
