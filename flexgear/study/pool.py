@@ -254,7 +254,7 @@ def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: R
     """Run ``first`` (local pools only), ``tasks``, ``ahead`` and ``jobs`` in one pool (module docstring,
     :func:`_run_pool`); ``ahead``: jobs queued before the tasks whose key is in ``waiting`` (runs that wait for a
     cold body of ``first``). Returns the runs' metas by key and the jobs' results by key."""
-    if not tasks and not jobs:
+    if not tasks and not jobs and not ahead:
         return {}, {}
     # on a terminal a bar; in a log the per-run lines of _say are the progress
     bar = Progress(len(tasks), "matrix", "runs", enabled=progress and sys.stderr.isatty(), fmt="{:.0f}")
@@ -270,8 +270,9 @@ def execute(tasks: list[RunTask], workers: int, scheduler: str | None, runner: R
 
             metas, died, done = _run_pool(tasks, submit, runner, progress, bar, [*ahead, *jobs])
     else:
-        say_progress(progress, f"{len(tasks)} runs" + (f" and {len(jobs)} screening jobs" if jobs else "")
-             + f" on {workers} local worker process(es)")
+        n_jobs = len(jobs) + len(ahead)
+        say_progress(progress, f"{len(tasks)} runs" + (f" and {n_jobs} screening jobs" if n_jobs else "")
+                     + f" on {workers} local worker process(es)")
         ctx = get_context("spawn")
         with ProcessPoolExecutor(max_workers=max(1, workers), mp_context=ctx) as pool:
             metas, died, done = _run_pool(tasks, pool.submit, runner, progress, bar, jobs, first, ahead, waiting)
