@@ -99,3 +99,7 @@ def test_the_matrix_screens_each_variants_speed_curves_in_its_pool(tmp_path):
     for column in ("reference_value", "difference"):
         np.testing.assert_allclose(pooled[column].to_numpy(), alone[column].to_numpy(), rtol=1e-9, atol=1e-12)
     assert (tmp_path / "out" / "speed_screening.txt").read_text().startswith("base: the reference")
+    (tmp_path / "out" / "speed_screening.csv").unlink()  # every run resumed: the pool holds the curves alone
+    run_matrix(paths, tmp_path / "out", t_end_s=0.002, reference="base", speeds_rpm=speeds, progress=False)
+    np.testing.assert_allclose(pd.read_csv(tmp_path / "out" / "speed_screening.csv")["difference"].to_numpy(),
+                               alone["difference"].to_numpy(), rtol=1e-9, atol=1e-12)
