@@ -276,7 +276,7 @@ def build_report(results_dir: str | Path, output: str | Path = Path("reports/scr
         body += modal_pages(d, others=others)
     body += sweep_pages(d)
     body += table_pages("Variant matrix (Table 3 as run)", _variant_table(d), {"reason": 60}, None)
-    body += [("Gearbox data from the study and theoretical values", _gearbox_page(d))]
+    body += [("Gearbox data (the gearbox file) and theoretical values", _gearbox_page(d))]
     body += table_pages("Appendix: assumptions, every value the study does not give", assumptions,
                         {"table": 18, "key": 30, "value": 14, "note": 100}, [0.13, 0.2, 0.1, 0.57],
                         f"From {d.gearbox_file.name} ({d.gearbox_note}).", fontsize=7)
