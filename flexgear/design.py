@@ -29,7 +29,7 @@ from flexgear.geometry.layout import (
 from flexgear.geometry.massprops import MassProperties
 from flexgear.geometry.profile import ToothProfile
 from flexgear.geometry.supports import seat_supports
-from flexgear.spec import CARRIER, GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
+from flexgear.spec import CARRIER, GearboxSpec, spec_hash, stage_geometries
 from flexgear.theory import Theory, gear_set_theory
 
 __all__ = ["Design", "design", "as_design", "register_part_masses"]
@@ -67,6 +67,16 @@ file too); ``supports``: the
         """The exact mass properties of ``component`` (``masses[component]``: kg, m, kg m^2)."""
         return self.masses[component]
 
+    @property
+    def output_radius(self) -> float:
+        """The radius [m] that turns the output's spin into a displacement along the line of action (the
+        transmission error's lever): the ring's base radius (star), the planets' centre distance on the carrier
+        (planetary), the wheel's base radius (the parallel-axis pair)."""
+        arrangement = self.spec.gears.arrangement
+        if arrangement == "planetary":
+            return self.gears.centre_distance
+        return (self.gears.ring if arrangement == "star" else self.gears.planet).base_radius
+
     def carrier_disc(self) -> tuple[float, float]:
         """(mass [kg], polar inertia [kg m^2]) of a planetary stage's carrier as its rigid body and the lumped model
         take it (a centred disc): ``[lumped_assumed] carrier_mass_kg`` and ``carrier_inertia_kg_m2``, but where the
@@ -100,16 +110,18 @@ def design(spec: GearboxSpec) -> Design:
         geo = gear_set_geometry(spec)
         th = gear_set_theory(spec, geo)
         profiles = tooth_profiles(geo, spec.gears_assumed.root_fillet_coefficient)
-        layouts = {c: gear_set_layout(spec, geo, c) for c in GEOMETRY_COMPONENTS}
+        components = stage_geometries(spec.gears)
+        layouts = {c: gear_set_layout(spec, geo, c) for c in components}
         rho = spec.material_assumed.density_kg_m3
-        imported = [c for c in (*GEOMETRY_COMPONENTS, CARRIER) if c in spec.components_geometry]
+        imported = [c for c in (*components, CARRIER) if c in spec.components_geometry]
         masses = {c: cached_mass_properties(spec, c, lambda c=c: layout_mass_properties(layouts[c], profiles, rho))
-                  for c in GEOMETRY_COMPONENTS if c not in imported}
+                  for c in components if c not in imported}
         supports = seat_supports(spec, layouts["input_shaft"], layouts["output_shaft"])
         harmonics = spec.contact_assumed.stiffness_harmonics
         meshes = {kind: mesh_contact_geometry(mesh, geo.helix_layout, geo.helix_face_width, geo.half_gap, hand,
                                               harmonics)
-                  for kind, mesh, hand in (("outer", geo.sun_planet, 1), ("inner", geo.planet_ring, -1))}
+                  for kind, mesh, hand in (("outer", geo.sun_planet, 1), ("inner", geo.planet_ring, -1))
+                  if mesh is not None}
         made = Design(spec, geo, th, profiles, layouts, masses, supports, meshes)
         if len(_DESIGNS) >= _MAX_DESIGNS:
             _DESIGNS.pop(next(iter(_DESIGNS)))

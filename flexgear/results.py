@@ -42,7 +42,7 @@ SIGNAL_TYPES: dict[str, tuple[str, str]] = {
 """Signal types a run can plot (:meth:`RunResult.plot`): key -> (title, axis label with unit)."""
 
 
-def signal_columns(planet_count: int) -> list[str]:
+def signal_columns(planet_count: int, inner: bool = True) -> list[str]:
     """Column names of the signal table, in order (units in the names).
 
     - ``time_s``
@@ -50,7 +50,8 @@ def signal_columns(planet_count: int) -> list[str]:
     - ``transmission_ratio``: output / input speed
     - ``input_torque_nm``: drive torque on the input shaft
     - ``outer_mesh_force_{i}_n``: normal force of the sun-planet mesh of planet i (1-based)
-    - ``inner_mesh_force_{i}_n``: normal force of the planet-ring mesh of planet i
+    - ``inner_mesh_force_{i}_n``: normal force of the planet-ring mesh of planet i (``inner``: the stage has a ring;
+      not the parallel-axis pair, whose one planet is the wheel)
     - ``{input,output}_bearing_accel_{x,y}_m_per_s2``: radial acceleration of the member carrying the input/output
       bearing, taken at its gear centre (the frame node of sun/ring or their shaft; the lumped model's node), not
       at the bearing seat
@@ -65,7 +66,7 @@ def signal_columns(planet_count: int) -> list[str]:
     """
     cols = ["time_s", "input_speed_rad_per_s", "output_speed_rad_per_s", "transmission_ratio", "input_torque_nm"]
     cols += [f"outer_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
-    cols += [f"inner_mesh_force_{i}_n" for i in range(1, planet_count + 1)]
+    cols += [f"inner_mesh_force_{i}_n" for i in range(1, planet_count + 1) if inner]
     cols += [f"{s}_bearing_accel_{a}_m_per_s2" for s in ("input", "output") for a in ("x", "y")]
     return cols
 
@@ -90,6 +91,8 @@ class RunResult:
         """Whether the run recorded signal type ``kind`` (:data:`SIGNAL_TYPES`)."""
         if self.signals is None:
             return False
+        if kind == "inner_mesh_force":  # none in the parallel-axis pair
+            return "inner_mesh_force_1_n" in self.signals.columns
         return kind != "transmission_error" or "transmission_error_m" in self.signals.columns
 
     def signal(self, kind: str) -> np.ndarray:

@@ -10,8 +10,9 @@ field and wins.
 
 With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`flexgear.geometry.involute`):
 
-- gears: face width 0.6 d_sun (reference diameter) in all, split over the halves of a double helix (study 61.8 vs
-  60 mm); half gap between the halves 4 m (8.5 vs 8); normal backlash 0.05 m (0.106 vs 0.10);
+- gears (the parallel-axis pair): no ring (``ring_teeth`` 0) and one planet, the wheel;
+- gears_assumed: face width 0.6 d_sun (reference diameter) in all, split over the halves of a double helix (study
+  61.8 vs 60 mm); half gap between the halves 4 m (8.5 vs 8); normal backlash 0.05 m (0.106 vs 0.10);
 - bores: sun and planet 0.5 d_f (48.6 and 49.9 vs 50); relief groove 0.5 m (1.06 vs 1.0);
 - ring: rim 4 m below the root (8.5 vs 8); bolt holes 4 m (8.5 vs 8); flange outer diameter the rim's diameter
   plus four bolt holes (376 vs 370); flange 4 m thick (8.5 vs 8); the bolt count is a fixed default (12);
@@ -19,6 +20,9 @@ With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`f
 - shafts: input shaft outer diameter the sun's bore, inner 0.6 of it, length 3 sun bores (48.6/29.2/146 vs
   50/30/150); output shaft outer diameter a quarter of the ring flange's, inner 0.78 of it, length as the input
   shaft's (94/73/146 vs 90/70/150); bearing seats 0.4 sun bores wide (19.5 vs 20);
+- the parallel-axis pair: the output shaft in the wheel's bore as the input shaft in the pinion's (outer diameter
+  the wheel's bore, inner 0.6 of it, length as the input shaft's); the ring's sizes (no ring: unused) as if the
+  wheel's tip circle plus two modules were the ring's root circle;
 - mesh levels: ``coarse`` teeth 1.9 m, body 3.8 m but no coarser than the teeth allow 6 elements across the
   input shaft (4.03/8.06 vs 4/8); ``default`` teeth 0.95 m, body 2.8 m, 8 across the shaft (2.0/5.9 vs 2/6);
   the ring's own: teeth 1.2 m (``coarse``) or 0.95 m (``default``), never coarser than the level's teeth, and
@@ -26,7 +30,8 @@ With m = m_n the normal module, d_f the root diameters (profile-shifted, :mod:`f
   Netgen's curvature refinement and optimisation passes as the study's levels;
 - reduction: fixed-interface cutoff 3.5 mesh orders at the load case's input speed (15.4 kHz, as the study's);
 - load case: step 1/24 of the mesh period (9.5 vs 10 us);
-- screening: settled-window blocks of z_ring / settle_final_blocks mesh cycles, rounded (17, as the study's);
+- screening: settled-window blocks of z_ring / settle_final_blocks mesh cycles, rounded (17, as the study's; the
+  parallel-axis pair's wheel z_p instead of z_ring);
   a fixed window from the ramps' end to the load case's end;
 - the carrier's mass and polar inertia (``[lumped_assumed]``: the lumped and the multibody model's rigid carrier,
   turning in the planetary arrangement only): in the planetary arrangement those of the carrier's solid with its
@@ -96,6 +101,10 @@ def _given(given: dict[str, Any], name: str, default: float) -> float:
 def _root_diameters_mm(g: GearSet, a: GearSetAssumed) -> tuple[float, float, float]:
     """Root diameters [mm] of sun, planet and ring, profile-shifted to the operating centre distance; unshifted
     sun and ring where that distance cannot be reached (the feasibility check then refuses the set by name)."""
+    if not g.has_ring:  # the parallel-axis pair: the ring's sizes (unused) follow the wheel as if it were a ring
+        gs = gear_set_geometry_of(g, a)
+        return (2 * gs.sun.root_radius / _MM, 2 * gs.planet.root_radius / _MM,
+                2 * (gs.planet.tip_radius + 2 * g.normal_module_m) / _MM)
     try:
         gs = gear_set_geometry_of(g, a)
     except ValueError:
@@ -117,15 +126,17 @@ def _component_sizes(g: GearSet, a: GearSetAssumed, given: dict[str, Any]) -> di
     flange = _given(given, "ring_flange_outer_diameter_mm", df_ring + 2 * rim + 4 * hole)
     sun_bore = _given(given, "sun_bore_diameter_mm", 0.5 * df_sun)
     shaft_in = _given(given, "input_shaft_outer_diameter_mm", sun_bore)
-    shaft_out = _given(given, "output_shaft_outer_diameter_mm", 0.25 * flange)
+    planet_bore = _given(given, "planet_bore_diameter_mm", 0.5 * df_planet)
+    shaft_out = _given(given, "output_shaft_outer_diameter_mm", 0.25 * flange if g.has_ring else planet_bore)
     length = _given(given, "input_shaft_length_mm", 3.0 * sun_bore)
     return {
-        "sun_bore_diameter_mm": sun_bore, "planet_bore_diameter_mm": 0.5 * df_planet,
+        "sun_bore_diameter_mm": sun_bore, "planet_bore_diameter_mm": planet_bore,
         "ring_rim_thickness_mm": rim, "ring_flange_outer_diameter_mm": flange, "ring_flange_thickness_mm": 4.0 * m,
         "ring_bolt_hole_diameter_mm": hole,
         "input_shaft_outer_diameter_mm": shaft_in, "input_shaft_inner_diameter_mm": 0.6 * shaft_in,
         "input_shaft_length_mm": length,
-        "output_shaft_outer_diameter_mm": shaft_out, "output_shaft_inner_diameter_mm": 0.78 * shaft_out,
+        "output_shaft_outer_diameter_mm": shaft_out,
+        "output_shaft_inner_diameter_mm": (0.78 if g.has_ring else 0.6) * shaft_out,
         "output_shaft_length_mm": _given(given, "output_shaft_length_mm", length),
         "relief_groove_depth_mm": 0.5 * m, "bearing_seat_width_mm": 0.4 * sun_bore,
     }
@@ -152,6 +163,8 @@ def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -
     """The derived defaults of ``table`` from the tables already ``built`` (flexgear.spec's loading order: gears,
     gears_assumed, load_case, material_assumed, then the rest) and the values ``given`` in the table itself (raw:
     a value of the wrong type is left to the field's check); {} for a table without any."""
+    if table == "gears":  # the parallel-axis pair: no ring, one wheel; the other stages give both
+        return {"ring_teeth": 0, "planet_count": 1} if given.get("arrangement") == "parallel" else {}
     g: GearSet = built["gears"]
     if table == "gears_assumed":
         return _gear_sizes(g, 2 if given.get("helix_layout") == "double" else 1)
@@ -191,7 +204,8 @@ def derived_defaults(table: str, built: dict[str, Any], given: dict[str, Any]) -
     if table == "screening":
         blocks = given.get("settle_final_blocks", 8)
         blocks = blocks if isinstance(blocks, int) and blocks > 0 else 8
-        return {"settle_block_mesh_cycles": max(1, round(g.ring_teeth / blocks)),
+        output_teeth = g.ring_teeth if g.has_ring else g.planet_teeth  # mesh cycles per output revolution
+        return {"settle_block_mesh_cycles": max(1, round(output_teeth / blocks)),
                 "window_start_s": lc.ramp_time_s, "window_end_s": lc.end_time_s}
     return {}
 

@@ -19,7 +19,7 @@ import math
 import tomllib
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, get_type_hints
+from typing import Any, get_args, get_type_hints
 
 from flexgear.derived import FIRST_TABLES, REQUIRED_TABLES, rederive, register_derived_defaults, with_derived
 from flexgear.schema import (
@@ -52,6 +52,8 @@ from flexgear.schema import (
     SolverSettings,
     SpecError,
     Variant,
+    stage_components,
+    stage_geometries,
 )
 from flexgear.schema_geometry import components_geometry_table
 from flexgear.schema_published import published_table
@@ -81,6 +83,8 @@ __all__ = [
     "GearboxSpec",
     "Variant",
     "COMPONENTS",
+    "stage_components",
+    "stage_geometries",
     "OPTIONAL_COMPONENTS",
     "CARRIER",
     "GEAR_COMPONENTS",
@@ -182,7 +186,7 @@ def _build(cls: type, data: Any, path: Path, prefix: str) -> Any:
             if f.default is not dataclasses.MISSING or f.default_factory is not dataclasses.MISSING:
                 continue
             raise SpecError(path, full, "missing (required)")
-        hint = hints[name]
+        hint = next((a for a in get_args(hints[name]) if dataclasses.is_dataclass(a)), hints[name])
         if f.metadata.get("purposes"):
             values[name] = _check_purposes(path, full, data[name])
         elif dataclasses.is_dataclass(hint):
@@ -284,11 +288,16 @@ def _check_loaded(spec: GearboxSpec) -> None:
 
 def _check_consistency(spec: GearboxSpec) -> None:
     g, p = spec.gears, spec.source
-    if g.ring_teeth <= g.planet_teeth + g.sun_teeth // 2:
+    if not g.has_ring:
+        if (problem := g.pair_problem(spec.bearings.planet is not None)) is not None:
+            raise SpecError(p, problem[0], problem[1], problem[2])
+    elif spec.bearings.planet is None:
+        raise SpecError(p, "bearings.planet", f"missing (required in the {g.arrangement} arrangement)")
+    elif g.ring_teeth <= g.planet_teeth + g.sun_teeth // 2:
         raise SpecError(p, "gears.ring_teeth", "expected ring_teeth > sun_teeth/2 + planet_teeth", g.ring_teeth)
     if g.planet_positions_deg and (problem := g.position_problem()):
         raise SpecError(p, "gears.planet_positions_deg", problem, list(g.planet_positions_deg))
-    if not g.planet_positions_deg and (g.sun_teeth + g.ring_teeth) % g.planet_count:
+    if g.has_ring and not g.planet_positions_deg and (g.sun_teeth + g.ring_teeth) % g.planet_count:
         raise SpecError(
             p, "gears.planet_count",
             "equally spaced planets need (sun_teeth + ring_teeth) divisible by planet_count "
@@ -403,10 +412,11 @@ def load_variant(path: str | Path, text: str | None = None, gearbox_text: str | 
     comps = raw["components"]
     if not isinstance(comps, dict):
         raise SpecError(path, "components", "expected a table")
-    known = COMPONENTS + OPTIONAL_COMPONENTS
+    known = stage_components(gearbox.gears) + OPTIONAL_COMPONENTS
     for name in comps:
         if name not in known:
-            raise SpecError(path, f"components.{name}", f"unknown component; allowed: {', '.join(known)}")
+            raise SpecError(path, f"components.{name}", f"unknown component in the {gearbox.gears.arrangement} "
+                            f"arrangement; allowed: {', '.join(known)}")
     components = {}
     for name in known:
         if name not in comps:

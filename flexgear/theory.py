@@ -4,6 +4,8 @@ All in SI (rad/s, N, N·m, Hz); ``deg_per_s`` appears only in function names tha
 
 - Star arrangement (carrier fixed):  omega_ring / omega_sun = -z_s / z_r
 - Planetary arrangement (ring fixed): omega_carrier / omega_sun = z_s / (z_s + z_r)
+- Parallel-axis pair (no ring):       omega_wheel / omega_pinion = -z_s / z_p (the sun the pinion, the planet the
+  wheel)
 - Power balance (loss-free):          T_in = T_out * |omega_out / omega_in|
 - Normal mesh force per planet:       F_n = T_sun / (N r_b,sun cos(beta_b))
 - Mesh frequency (carrier frame):     f_m = z_s |omega_sun - omega_carrier| / (2 pi)
@@ -23,10 +25,10 @@ __all__ = ["Theory", "theory", "gear_set_theory", "mesh_frequency_hz"]
 
 @dataclass(frozen=True)
 class Theory:
-    """Steady-state theoretical values of a single-stage star or planetary gearbox (SI)."""
+    """Steady-state theoretical values of a single-stage star or planetary gearbox or a parallel-axis pair (SI)."""
 
     input_speed: float  # rad/s (sun)
-    output_speed: float  # rad/s (ring for star, carrier for planetary)
+    output_speed: float  # rad/s (ring for star, carrier for planetary, wheel for the parallel-axis pair)
     ratio: float  # output / input speed
     input_torque: float  # N·m on the sun
     output_torque: float  # N·m load at the output
@@ -53,7 +55,7 @@ def mesh_frequency_hz(spec: GearboxSpec | GearSet, speed_rpm: float) -> float:
     fixed for the star, turning at z_s / (z_s + z_r) of the input for the planetary arrangement. ``spec``: the
     gearbox or its gear set."""
     g = spec if isinstance(spec, GearSet) else spec.gears
-    r_c = 0.0 if g.arrangement == "star" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    r_c = 0.0 if g.arrangement != "planetary" else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
     return g.sun_teeth * abs(speed_rpm) * (1.0 - r_c) / 60.0
 
 
@@ -64,6 +66,9 @@ def gear_set_theory(spec: GearboxSpec, geo: GearSetGeometry) -> Theory:
     zs, zp, zr = g.sun_teeth, g.planet_teeth, g.ring_teeth
     if g.arrangement == "star":
         ratio = -zs / zr
+        w_carrier = 0.0
+    elif g.arrangement == "parallel":
+        ratio = -zs / zp
         w_carrier = 0.0
     else:
         ratio = zs / (zs + zr)

@@ -6,6 +6,9 @@ Interfaces (where a component is connected):
   all bolts on the flange face (flexgear.fe.bolted) moving together as one rigid body (RBE2): the joint to a
   rigid output shaft, which holds every disc in one rigid motion;
 - input shaft: "sun_seat", its outer surface inside the sun's bore, and "bearing_seat";
+- the parallel-axis pair's output shaft: "planet_seat", its outer surface inside the wheel's bore, and
+  "bearing_seat" at the far (+z) end of the tube; each of the pair's shafts also "bearing_seat_near", its second
+  bearing's seat beyond the gear's other face (flexgear.geometry.supports);
 - output shaft: "bolt_patches" on its web likewise (the joint to a rigid ring), and "bearing_seat"
   (``bearing_seat_width_mm`` at the far end of the tube).
 When both are flexible they are one body, reduced together (flexgear.fe.ring_shaft).
@@ -39,6 +42,7 @@ from flexgear.fe.cms import Interface, ReducedBody, interface, reduce
 from flexgear.geometry.contact_lines import MeshContactGeometry
 from flexgear.geometry.layout import geometry_hash
 from flexgear.geometry.massprops import MassProperties
+from flexgear.geometry.supports import NEAR
 from flexgear.progress import say
 from flexgear.schema_geometry import CONTACT_BAND
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec
@@ -81,18 +85,23 @@ def component_interfaces(fe, spec: GearboxSpec | Design, component: str) -> list
     tube = [p for p in d.layouts[component].prisms if p.name == "tube"][0]
     seat = c.bearing_seat_width_mm * 1e-3
     on_tube = np.abs(r - tube.section.outer) < _TOL
-    if component == "input_shaft":
-        sun = d.layouts["sun"].prisms
-        z0, z1 = min(p.z0 for p in sun), max(p.z1 for p in sun)
-        joints = [_interface(fe, d, component, on_tube & (z > z0 - _TOL) & (z < z1 + _TOL), "sun_seat")]
-        far = (z < tube.z0 + seat + _TOL)
+    if component == "input_shaft" or not spec.gears.has_ring:  # a shaft in its gear's bore (the pair's wheel too)
+        gear = "sun" if component == "input_shaft" else "planet"
+        prisms = d.layouts[gear].prisms
+        z0, z1 = min(p.z0 for p in prisms), max(p.z1 for p in prisms)
+        joints = [_interface(fe, d, component, on_tube & (z > z0 - _TOL) & (z < z1 + _TOL), f"{gear}_seat")]
+        low, high = (z < tube.z0 + seat + _TOL), (z > tube.z1 - seat - _TOL)
+        far, near = (low, high) if gear == "sun" else (high, low)
+        if not spec.gears.has_ring:  # the parallel-axis pair's second bearing, beyond the gear's other face
+            joints.append(_interface(fe, d, component, on_tube & near, "bearing_seat" + NEAR))
     else:
         joints = [patch_union(fe, d, BOLT_PATCHES, component)]
         far = (z > tube.z1 - seat - _TOL)
     return [*joints, _interface(fe, d, component, on_tube & far, "bearing_seat")]
 
 
-SELECTED_INTERFACES = {"bore": "bore", "bearing_seat": "bearing_seat", "sun_seat": "gear_seat"}
+SELECTED_INTERFACES = {"bore": "bore", "bearing_seat": "bearing_seat", "sun_seat": "gear_seat",
+                       "planet_seat": "gear_seat", "bearing_seat" + NEAR: "bearing_seat" + NEAR}
 """Interface -> the region of ``[components_geometry] <component>.regions`` that places it on an imported part
 (flexgear.schema_geometry.RegionSelector). The bolt patches are the clamped discs a ``bolt_discs`` selector picks,
 else those of the bolt circle (flexgear.fe.bolted.clamped_patches); the contact bands stay on the gear data's
@@ -140,11 +149,12 @@ def _contact_bands(d: Design, component: str) -> list[tuple[LoadCircle, np.ndarr
     geo, spec = d.gears, d.spec
     sigma = int(math.copysign(1.0, spec.load_case.input_speed_rad_s))
     planets = np.asarray(geo.planet_angles, float)
-    outer, inner = d.meshes["outer"], d.meshes["inner"]
+    outer, inner = d.meshes["outer"], d.meshes.get("inner")
     # (mesh contact geometry, drive sign, is this component gear 1, contact angles on this component)
     meshes = {"sun": [(outer, sigma, True, planets)],
               "planet": [(outer, sigma, False, np.array([math.pi])), (inner, -sigma, True, np.array([0.0]))],
               "ring": [(inner, -sigma, False, planets)]}[component]
+    meshes = [m for m in meshes if m[0] is not None]  # the parallel-axis pair: no planet-ring mesh
     out = []
     for contact, drive, first, angles in meshes:
         out += [(circle, angles) for circle in band_circles(contact, drive, first, spec.gears.normal_module_m)]
@@ -232,29 +242,32 @@ def component_contacts(spec: GearboxSpec | Design, component: str) -> tuple[np.n
 def joint_point(spec: GearboxSpec | Design, gear: str) -> np.ndarray:
     """Point [m] (component frame = gearbox frame) where ``gear`` ("sun" or "ring") is joined to its shaft.
 
-    Sun-input shaft: on the axis, mid-way along the sun. Ring-output shaft: on the axis, in the plane
+    Sun-input shaft (the parallel-axis pair's wheel and output shaft): on the axis, mid-way along the gear, in its
+    frame. Ring-output shaft: on the axis, in the plane
     where the ring's flange meets the shaft's web.
     """
     prisms = as_design(spec).layouts[gear].prisms
-    if gear == "sun":
+    if gear in ("sun", "planet"):  # the planet: the parallel-axis pair's wheel on the output shaft
         return np.array([0.0, 0.0, 0.5 * (min(p.z0 for p in prisms) + max(p.z1 for p in prisms))])
     if gear == "ring":
         return np.array([0.0, 0.0, [p for p in prisms if p.section.holes][0].z1])
-    raise ValueError(f"joint_point: gear must be 'sun' or 'ring', got {gear!r}")
+    raise ValueError(f"joint_point: gear must be 'sun', 'planet' or 'ring', got {gear!r}")
 
 
 def gear_shaft_joints(spec: GearboxSpec | Design, gear: str) -> list[tuple[str, str, np.ndarray]]:
-    """The fixed joint of ``gear`` ("sun" or "ring") and its shaft: [(gear interface, shaft interface, point [m])].
+    """The fixed joint of ``gear`` ("sun", "ring"; "planet": the parallel-axis pair's wheel) and its shaft: [(gear
+    interface, shaft interface, point [m], the gear's frame)].
 
-    Sun-input shaft: at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat". Ring-output
+    Sun-input shaft: at :func:`joint_point` between the sun's "bore" and the shaft's "sun_seat" (the wheel and its
+    output shaft likewise, "bore" and "planet_seat"). Ring-output
     shaft (one of them rigid; both flexible they are one body, flexgear.fe.ring_shaft): at :func:`joint_point`
     between the two "bolt_patches" interfaces (every clamped disc in the rigid part's motion).
     """
     if gear == "ring":
         return [(BOLT_PATCHES, BOLT_PATCHES, joint_point(spec, gear))]
-    if gear == "sun":
-        return [("bore", "sun_seat", joint_point(spec, gear))]
-    raise ValueError(f"gear_shaft_joints: gear must be 'sun' or 'ring', got {gear!r}")
+    if gear in ("sun", "planet"):
+        return [("bore", f"{gear}_seat", joint_point(spec, gear))]
+    raise ValueError(f"gear_shaft_joints: gear must be 'sun', 'planet' or 'ring', got {gear!r}")
 
 
 def is_tied(body: ReducedBody) -> bool:

@@ -151,6 +151,14 @@ class BearingElement:
         if self.body != body or self.other is not None:
             raise ValueError(f"bearing on {self.body!r} (other side {self.other!r}) placed on body {body!r} to ground")
 
+    @property
+    def tag(self) -> str:
+        """What the bearing's objects' names add to its body's name: "" for a body's one bearing (at its
+        "bearing_seat" or "bore"), else the rest of its interface's name (``_near``: the parallel-axis pair's second
+        bearing on a shaft, flexgear.geometry.supports)."""
+        name = self.interface or ""
+        return name.removeprefix("bearing_seat") if name.startswith("bearing_seat") else ""
+
     def condensed_radial_stiffness(self, gear_z: float = 0.0) -> float:
         """In-plane stiffness [N/m] at the point (0, 0, ``gear_z``) [m] of a rigid shaft on this bearing: a force F
         there, no moment; the bearing takes F and the moment F L (L = gear_z - z_c), so the point moves

@@ -68,9 +68,10 @@ def _reachable_centre_distance(spec: GearboxSpec) -> None:
     g, a = spec.gears, spec.gears_assumed
     alpha_t = transverse_pressure_angle(g.normal_pressure_angle_rad, g.helix_angle_rad)
     mt_mm = g.normal_module_mm / math.cos(g.helix_angle_rad)
-    lower = max(abs(mt_mm * (g.planet_teeth + z) / 2) * math.cos(alpha_t) for z in (g.sun_teeth, -g.ring_teeth))
-    if a.operating_centre_distance_mm == 0.0:  # 0: the mean of the two standard centre distances
-        mean = mt_mm * (g.sun_teeth + g.ring_teeth) / 4
+    others = (g.sun_teeth, -g.ring_teeth) if g.has_ring else (g.sun_teeth,)
+    lower = max(abs(mt_mm * (g.planet_teeth + z) / 2) * math.cos(alpha_t) for z in others)
+    if a.operating_centre_distance_mm == 0.0:  # 0: the mean of the two standard centre distances (a pair's own)
+        mean = mt_mm * ((g.sun_teeth + g.ring_teeth) / 4 if g.has_ring else (g.sun_teeth + g.planet_teeth) / 2)
         if mean <= lower:
             raise SpecError(spec.source, "gears_assumed.operating_centre_distance_mm",
                             f"0 selects the mean standard centre distance {mean:.3f} mm, which profile shifts "
@@ -140,7 +141,7 @@ def _tip_inside_field(spec: GearboxSpec, name: str, gear: Gear) -> str:
 def _teeth(spec: GearboxSpec) -> None:
     gs = gear_set_geometry(spec)
     g = spec.gears
-    for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
+    for name, gear in gs.named_gears:
         if gear.tip_radius <= gear.base_radius:  # external r_a = r + m_n (h_a + x) <= r_b; the ring's tips inwards
             field = _tip_inside_field(spec, name, gear)
             raise SpecError(spec.source, field,
@@ -182,7 +183,7 @@ def _interference(spec: GearboxSpec) -> None:
     tangent point T (beyond it the mate has no involute): external pair sqrt(r_a^2 - r_b^2) <= a_w sin(alpha_wt)
     for each gear; internal pair the ring's tip sqrt(r_a2^2 - r_b2^2) >= a_w sin(alpha_wt)."""
     gs = gear_set_geometry(spec)
-    for names, mesh in ((("sun", "planet"), gs.sun_planet), (("planet", "ring"), gs.planet_ring)):
+    for names, mesh in gs.named_meshes:
         gw = mesh.centre_distance * math.sin(mesh.operating_pressure_angle)
         label = "-".join(names)
         for (name, other), gear in ((names, mesh.gear1), (names[::-1], mesh.gear2)):
@@ -257,7 +258,7 @@ def _profiles(spec: GearboxSpec) -> None:
     i.e. the root point's polar angle < pi / z; without a fillet the flanks must not meet above the root circle."""
     gs, a = gear_set_geometry(spec), spec.gears_assumed
     coefficient = a.root_fillet_coefficient
-    for name, gear in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)):
+    for name, gear in gs.named_gears:
         if _profile_fits(gear, coefficient * gear.normal_module):
             _short_curves(spec, name, gear, tooth_profile(gear, coefficient * gear.normal_module))
             continue
@@ -304,7 +305,11 @@ def _components(spec: GearboxSpec) -> None:
         raise SpecError(p, "components_assumed.input_shaft_outer_diameter_mm",
                         f"expected <= sun_bore_diameter_mm ({c.sun_bore_diameter_mm} mm): the shaft sits in the "
                         "sun's bore", c.input_shaft_outer_diameter_mm)
-    if c.output_shaft_length_mm <= c.ring_flange_thickness_mm:
+    if not gs.ring and c.output_shaft_outer_diameter_mm > c.planet_bore_diameter_mm:
+        raise SpecError(p, "components_assumed.output_shaft_outer_diameter_mm",
+                        f"expected <= planet_bore_diameter_mm ({c.planet_bore_diameter_mm} mm): in the parallel-axis "
+                        "pair the shaft sits in the wheel's bore", c.output_shaft_outer_diameter_mm)
+    if gs.ring and c.output_shaft_length_mm <= c.ring_flange_thickness_mm:
         raise SpecError(p, "components_assumed.output_shaft_length_mm",
                         f"expected > ring_flange_thickness_mm ({c.ring_flange_thickness_mm} mm)",
                         c.output_shaft_length_mm)
@@ -317,6 +322,8 @@ def _components(spec: GearboxSpec) -> None:
             raise SpecError(p, "components_assumed.bearing_seat_width_mm",
                             f"expected < {shaft}_length_mm ({getattr(c, f'{shaft}_length_mm')} mm)",
                             c.bearing_seat_width_mm)
+    if not gs.ring:  # the parallel-axis pair: no ring, no flange, no bolts
+        return
     if groove >= c.ring_rim_thickness_mm:
         raise SpecError(p, "components_assumed.relief_groove_depth_mm",
                         f"expected < ring_rim_thickness_mm ({c.ring_rim_thickness_mm} mm): the groove is cut into "

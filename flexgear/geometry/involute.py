@@ -30,6 +30,7 @@ from flexgear.spec import GearboxSpec, GearSet, GearSetAssumed
 __all__ = [
     "inv",
     "inv_inverse",
+    "pair_profile_shifts",
     "transverse_pressure_angle",
     "base_helix_angle",
     "Gear",
@@ -256,18 +257,31 @@ def helix_halves(layout: str, helix_face_width: float, half_gap: float, hand: in
 
 @dataclass(frozen=True)
 class GearSetGeometry:
-    """Sun, planet, ring and the two meshes of a single-stage planetary/star set."""
+    """Sun, planet, ring and the two meshes of a single-stage planetary/star set; of a parallel-axis pair the sun
+    (pinion), the one planet (wheel) and their mesh, ``ring`` and ``planet_ring`` None."""
 
     sun: Gear
     planet: Gear
-    ring: Gear
+    ring: Gear | None
     sun_planet: GearMesh
-    planet_ring: GearMesh
+    planet_ring: GearMesh | None
     centre_distance: float
     planet_count: int
     helix_layout: str
     half_gap: float
     planet_positions: tuple[float, ...] = ()  # each planet's polar angle [rad]; () = equally spaced from 0
+
+    @property
+    def named_gears(self) -> tuple[tuple[str, Gear], ...]:
+        """(name, gear) of each gear of the set: sun, planet and, where there is one, ring."""
+        return tuple((n, g) for n, g in (("sun", self.sun), ("planet", self.planet), ("ring", self.ring))
+                     if g is not None)
+
+    @property
+    def named_meshes(self) -> tuple[tuple[tuple[str, str], GearMesh], ...]:
+        """((gear 1, gear 2), mesh) of each mesh of the set: sun-planet and, where there is a ring, planet-ring."""
+        return tuple((n, m) for n, m in ((("sun", "planet"), self.sun_planet), (("planet", "ring"), self.planet_ring))
+                     if m is not None)
 
     @property
     def helix_face_width(self) -> float:
@@ -325,6 +339,21 @@ def solve_profile_shifts(
     return shifts[0], planet_shift, shifts[1], angles[0], angles[1]
 
 
+def pair_profile_shifts(z_pinion: int, z_wheel: int, normal_module: float, helix_angle: float,
+                        normal_pressure_angle: float, centre_distance: float, wheel_shift: float,
+                        ) -> tuple[float, float, float]:
+    """Profile shifts of an external pair at ``centre_distance`` [m] with no backlash: the wheel's chosen, the
+    pinion's from the no-backlash mesh equation; returns ``(x_pinion, x_wheel, alpha_wt)``."""
+    alpha_t = transverse_pressure_angle(normal_pressure_angle, helix_angle)
+    a0 = normal_module / math.cos(helix_angle) * (z_pinion + z_wheel) / 2
+    cos_w = a0 * math.cos(alpha_t) / centre_distance
+    if not 0.0 < cos_w < 1.0:
+        raise ValueError(f"centre distance {centre_distance} m cannot be reached (a0 = {a0} m)")
+    alpha_w = math.acos(cos_w)
+    x_sum = (inv(alpha_w) - inv(alpha_t)) * (z_pinion + z_wheel) / (2 * math.tan(normal_pressure_angle))
+    return x_sum - wheel_shift, wheel_shift, alpha_w
+
+
 def gear_set_geometry(spec: GearboxSpec) -> GearSetGeometry:
     """Gears and meshes of the spec, profile-shifted to one operating centre distance.
 
@@ -345,18 +374,23 @@ def gear_set_geometry_of(gears: GearSet, assumed: GearSetAssumed) -> GearSetGeom
 def _gear_set_geometry(g, a) -> GearSetGeometry:
     mn, beta, an = g.normal_module_m, g.helix_angle_rad, g.normal_pressure_angle_rad
     aw = a.operating_centre_distance_m
-    if aw == 0.0:  # 0 selects the mean of the two standard centre distances
-        mt = mn / math.cos(beta)
-        aw = 0.25 * mt * (g.sun_teeth + g.ring_teeth)
-    xs, xp, xr, aw_sp, aw_pr = solve_profile_shifts(
-        g.sun_teeth, g.planet_teeth, g.ring_teeth, mn, beta, an, aw, a.planet_shift_coefficient
-    )
+    mt = mn / math.cos(beta)
+    if aw == 0.0:  # 0 selects the mean of the two standard centre distances (the pair's own standard one)
+        aw = 0.25 * mt * (g.sun_teeth + g.ring_teeth) if g.has_ring else 0.5 * mt * (g.sun_teeth + g.planet_teeth)
     thinning = a.normal_backlash_m / (2 * math.cos(an))
 
     def gear(z: int, x: float, internal: bool) -> Gear:
         return Gear(z, internal, mn, beta, an, x, thinning, a.addendum_coefficient,
                     a.dedendum_coefficient, a.face_width_m)
 
+    if not g.has_ring:  # the parallel-axis pair: the wheel's shift chosen, the pinion's from the centre distance
+        xs, xp, aw_sp = pair_profile_shifts(g.sun_teeth, g.planet_teeth, mn, beta, an, aw, a.planet_shift_coefficient)
+        sun, planet = gear(g.sun_teeth, xs, False), gear(g.planet_teeth, xp, False)
+        return GearSetGeometry(sun, planet, None, GearMesh(sun, planet, aw, aw_sp), None, aw, 1, a.helix_layout,
+                               a.half_gap_m)
+    xs, xp, xr, aw_sp, aw_pr = solve_profile_shifts(
+        g.sun_teeth, g.planet_teeth, g.ring_teeth, mn, beta, an, aw, a.planet_shift_coefficient
+    )
     sun, planet, ring = gear(g.sun_teeth, xs, False), gear(g.planet_teeth, xp, False), gear(g.ring_teeth, xr, True)
     return GearSetGeometry(
         sun, planet, ring, GearMesh(sun, planet, aw, aw_sp), GearMesh(planet, ring, aw, aw_pr),

@@ -46,7 +46,7 @@ from flexgear.cache import atomic_write_bytes, cache_dir
 from flexgear.geometry.involute import Gear, GearSetGeometry, gear_set_geometry
 from flexgear.geometry.massprops import MassProperties
 from flexgear.geometry.profile import ToothProfile, tooth_profile
-from flexgear.spec import GEAR_COMPONENTS, GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
+from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, spec_hash
 
 __all__ = [
     "Section",
@@ -127,7 +127,7 @@ def helix_sweep(twist: float, length: float, profile: ToothProfile) -> HelixSwee
 
 
 def _helix_sweeps(spec: GearboxSpec) -> tuple[HelixSweep, ...]:
-    """:func:`helix_sweep` of the toothed prisms of sun, planet and ring (as :func:`_gear_prisms` lays them);
+    """:func:`helix_sweep` of the toothed prisms of sun, planet and ring if any (as :func:`_gear_prisms` lays them);
     plain for spur gears (extruded) and for a gear set whose profiles cannot be built (nothing is swept)."""
     gs, a = gear_set_geometry(spec), spec.gears_assumed
     if gs.sun.helix_angle == 0.0:
@@ -138,7 +138,7 @@ def _helix_sweeps(spec: GearboxSpec) -> tuple[HelixSweep, ...]:
     except ValueError:
         return (HelixSweep(),) * 3
     return tuple(helix_sweep(math.tan(g.helix_angle) / g.reference_radius, length, profiles[name])
-                 for name, g in (("sun", gs.sun), ("planet", gs.planet), ("ring", gs.ring)))
+                 for name, g in gs.named_gears)
 
 
 def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
@@ -224,13 +224,17 @@ class ComponentLayout:
 @lru_cache(maxsize=16)
 def tooth_profiles(gs: GearSetGeometry, fillet_coefficient: float) -> dict[str, ToothProfile]:
     """Tooth profiles of the gear set's sun, planet and ring (root fillet radius = ``fillet_coefficient`` * m_n)."""
-    return {name: tooth_profile(getattr(gs, name), fillet_coefficient * getattr(gs, name).normal_module)
-            for name in GEAR_COMPONENTS}
+    return {name: tooth_profile(gear, fillet_coefficient * gear.normal_module) for name, gear in gs.named_gears}
 
 
 def gear_profiles(spec: GearboxSpec) -> dict[str, ToothProfile]:
     """Tooth profiles of sun, planet and ring (root fillet radius = root_fillet_coefficient * m_n)."""
     return tooth_profiles(gear_set_geometry(spec), spec.gears_assumed.root_fillet_coefficient)
+
+
+NEAR_SEAT_GAP_PER_WIDTH = 0.5
+"""The parallel-axis pair's near bearing seat lies this many seat widths beyond the gear's face (its nodes apart from
+the gear seat's)."""
 
 
 def _gear_half_length(spec: GearboxSpec) -> float:
@@ -290,7 +294,23 @@ def gear_set_layout(spec: GearboxSpec, gs: GearSetGeometry, component: str) -> C
             raise ValueError(f"{component} bore diameter {2 * bore} m does not fit inside the root/groove circle")
         return ComponentLayout(component, tuple(_gear_prisms(spec, component, gear, bore, 0.0)), gear,
                                profiles[component])
+    # the parallel-axis pair's shafts reach past the gear's other face to their near bearing seat (straddle mount)
+    near = 0.0 if gs.ring is not None else (1.0 + NEAR_SEAT_GAP_PER_WIDTH) * c.bearing_seat_width_mm * mm
+    if component == "input_shaft":
+        ri, ro = c.input_shaft_inner_diameter_mm * mm / 2, c.input_shaft_outer_diameter_mm * mm / 2
+        if ri >= ro:
+            raise ValueError("input_shaft_inner_diameter_mm must be smaller than the outer diameter")
+        return ComponentLayout(component, (Prism("tube", h - c.input_shaft_length_mm * mm, h + near,
+                                                 Section(ri, ro)),))
     ring = gs.ring
+    if ring is None:  # the parallel-axis pair: the output shaft in the wheel's bore, as the input shaft in the pinion's
+        if component != "output_shaft":
+            raise ValueError(f"a parallel-axis pair has no {component}")
+        ri, ro = c.output_shaft_inner_diameter_mm * mm / 2, c.output_shaft_outer_diameter_mm * mm / 2
+        if ri >= ro:
+            raise ValueError("output_shaft_inner_diameter_mm must be smaller than the outer diameter")
+        return ComponentLayout(component, (Prism("tube", -h - near, c.output_shaft_length_mm * mm - h,
+                                                 Section(ri, ro)),))
     rim = ring.root_radius + c.ring_rim_thickness_mm * mm
     flange_out = c.ring_flange_outer_diameter_mm * mm / 2
     flange_in = ring.root_radius + c.relief_groove_depth_mm * mm
@@ -303,11 +323,6 @@ def gear_set_layout(spec: GearboxSpec, gs: GearSetGeometry, component: str) -> C
         prisms = _gear_prisms(spec, "ring", ring, 0.0, rim)
         prisms.append(Prism("flange", h, h + tf, Section(flange_in, flange_out, **holes)))
         return ComponentLayout("ring", tuple(prisms), ring, profiles["ring"])
-    if component == "input_shaft":
-        ri, ro = c.input_shaft_inner_diameter_mm * mm / 2, c.input_shaft_outer_diameter_mm * mm / 2
-        if ri >= ro:
-            raise ValueError("input_shaft_inner_diameter_mm must be smaller than the outer diameter")
-        return ComponentLayout(component, (Prism("tube", h - c.input_shaft_length_mm * mm, h, Section(ri, ro)),))
     ri, ro = c.output_shaft_inner_diameter_mm * mm / 2, c.output_shaft_outer_diameter_mm * mm / 2
     length = c.output_shaft_length_mm * mm
     if ri >= ro or length <= tf:

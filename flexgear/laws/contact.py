@@ -78,7 +78,8 @@ def mesh_damping(stiffness_n_per_m: float, mass1_kg: float, mass2_kg: float, dam
 
 
 def mesh_laws(spec: GearboxSpec | Design) -> dict[str, ContactLaw]:
-    """The whole-face-width law of the sun-planet ("outer") and planet-ring ("inner") meshes.
+    """The whole-face-width law of the sun-planet ("outer") and planet-ring ("inner", none in the parallel-axis pair)
+    meshes.
 
     ``[contact] law = "impact"``: the study's law for both. ``"iso6336"``: k = c_gamma_alpha b / cos^2(beta_b)
     along the tooth normal (flexgear.laws.iso6336, b = total active face width, line load from the
@@ -98,10 +99,9 @@ def mesh_laws(spec: GearboxSpec | Design) -> dict[str, ContactLaw]:
     b = ga.face_width_m
     f_t = abs(d.theory.input_torque) / (geo.planet_count * geo.sun.reference_radius)  # either flank
     line_load = ca.application_factor * f_t / (b * 1e3)
-    mass = {c: d.masses[c].mass for c in ("sun", "planet", "ring")}
+    mass = {c: d.masses[c].mass for c, _ in geo.named_gears}
     out = {}
-    for kind, mesh, g1, g2 in (("outer", geo.sun_planet, "sun", "planet"),
-                               ("inner", geo.planet_ring, "planet", "ring")):
+    for kind, ((g1, g2), mesh) in zip(("outer", "inner"), geo.named_meshes, strict=False):
         gear1, gear2 = mesh.gear1, mesh.gear2
         iso = tooth_stiffness(gear1.teeth, gear2.teeth, gear1.shift, gear2.shift, gear1.helix_angle,
                               gear1.base_helix_angle, gear1.normal_pressure_angle, ga.dedendum_coefficient,

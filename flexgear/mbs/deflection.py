@@ -4,7 +4,8 @@ Post-processing of the stored sensors (no Python per step), optional signal colu
 flexgear.results.signal_columns:
 
 - ``transmission_error_m``: loaded transmission error along the line of action at the output,
-  TE = r_b,out (theta_out,kin - theta_out) sign(omega_out), theta_out,kin = i theta_in (i = omega_out/omega_in
+  TE = r_out (theta_out,kin - theta_out) sign(omega_out) (r_out: flexgear.design.Design.output_radius),
+  theta_out,kin = i theta_in (i = omega_out/omega_in
   of the theory), theta_in the prescribed drive angle at the input seat, theta_out the output's spin where the
   load acts (its seat interface for a flexible output shaft): rigid and elastic, positive when the output lags.
   Its mean at steady speed is the loaded static transmission error.
@@ -39,8 +40,7 @@ def transmission_error(model, time_s: np.ndarray, output_angle: np.ndarray) -> n
     spec, th = model.spec, model.theory
     lc = spec.load_case
     theta_in = np.asarray(drive_angle(np.asarray(time_s), lc.ramp_time_s, lc.input_speed_rad_s), float)
-    geo = model.design.gears
-    r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
+    r_out = model.design.output_radius
     sign = math.copysign(1.0, th.output_speed)
     return r_out * (th.ratio * theta_in - np.asarray(output_angle, float)) * sign
 

@@ -123,7 +123,7 @@ def add_support(mbs, body: Body, bearing: BearingElement, other: Body | None = N
             base = mbs.AddMarker(MarkerBodyPosition(bodyNumber=other.obj,
                                                     localPosition=[float(v) for v in place - other.position]))
         out.append(mbs.AddObject(ObjectConnectorCartesianSpringDamper(
-            name=f"bearing_{body.name}_{k}", markerNumbers=[base, marker],
+            name=f"bearing_{body.name}{bearing.tag}_{k}", markerNumbers=[base, marker],
             stiffness=[float(v) for v in spring.stiffness], damping=[float(v) for v in spring.damping],
             visualization=VObjectConnectorCartesianSpringDamper(show=False))))
     return out

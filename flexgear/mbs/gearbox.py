@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
-from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -29,61 +28,15 @@ from flexgear.geometry.massprops import MassProperties, combine_mass_properties
 from flexgear.geometry.pair import helix_halves as pair_helix_halves
 from flexgear.laws.contact import half_laws, mesh_laws
 from flexgear.mbs.bodies import Body, add_rigid_body
-from flexgear.mbs.contacts import GearContact, MeshFriction, mesh_pair_contacts
+from flexgear.mbs.connections import GearboxModel, connect_stage, joint_axes
+from flexgear.mbs.contacts import GearContact, mesh_pair_contacts
 from flexgear.mbs.elements import (
-    add_interface_joint,
-    add_load_torque,
-    add_speed_drive,
-    add_support,
-    interface_spin_marker,
     support_points,
 )
-from flexgear.mbs.train import add_gear_train
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
-from flexgear.theory import Theory
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
            "run_cost", "add_component", "component_sources", "joint_axes", "linear_frame_tolerance"]
-
-
-@dataclass
-class GearboxModel:
-    """Handles of an assembled gearbox in an Exudyn system."""
-
-    design: Design  # the gearbox's spec, gear set and theory (flexgear.design)
-    bodies: dict[str, Body]
-    outer_contacts: list[list[int]]  # [planet][half] spring-damper objects, sun-planet
-    inner_contacts: list[list[int]]  # [planet][half] spring-damper objects, planet-ring
-    drive: int
-    load: int
-    contacts: list[GearContact] = field(default_factory=list)
-    friction: MeshFriction | None = None
-    kinematics: object | None = None  # flexgear.mbs.contact_kinematics.ContactKinematics for flexible gears
-    aux_nodes: tuple[int, ...] = ()  # nodes of the contacts' deflection coordinates (one per gear pair, in order)
-    input_body: str = "sun"  # body carrying the input bearing and the drive (the input shaft if separate)
-    output_body: str = "ring"  # body carrying the output bearing and the load (the output shaft if separate)
-    # gear -> its fixed joints to its shaft (separate bodies): (joint, joint point [m] in the gear's frame)
-    joints: dict[str, list[tuple[int, np.ndarray]]] = field(default_factory=dict)
-    output_spin: tuple[int, int] = (-1, 5)  # (node, coordinate) of the output's spin angle where the load acts
-    residual_node: int = -1  # node of the contacts' residual deflections (flexgear.mbs.residual), -1: none
-    residual: object | None = None  # flexgear.mbs.residual.ResidualCompliance of the node's contacts (rows)
-    # gears whose joints are flexgear.mbs.joints constraints (Force output: force, moment in ground axes, or in the
-    # gear's body axes for the gears in body_axes_joints: those on a flexible shaft)
-    linear_joints: tuple[str, ...] = ()
-    body_axes_joints: tuple[str, ...] = ()
-    seat_residual_nodes: tuple[int, ...] = ()  # e_s node of each of residual.seat_bodies (flexgear.mbs.residual)
-    # planet -> the rigid-body node of its seat on a turning carrier (flexgear.mbs.joints.LinearSeat): it orbits
-    carrier_seat_nodes: dict[str, int] = field(default_factory=dict)
-    # pin interface -> the rigid-body node of the carrier's pin (flexgear.mbs.carrier.CarrierPins): it orbits
-    carrier_pin_nodes: dict[str, int] = field(default_factory=dict)
-
-    @property
-    def spec(self) -> GearboxSpec:
-        return self.design.spec
-
-    @property
-    def theory(self) -> Theory:
-        return self.design.theory
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -113,10 +66,10 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
             "ring": th.ratio if carrier == 0.0 else 0.0}
     common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, carrier_spin=carrier,
                   phase_per_drive_angle=zs * (1.0 - carrier) / (2 * math.pi))
-    outer, inner = d.meshes["outer"], d.meshes["inner"]
+    outer, inner = d.meshes["outer"], d.meshes.get("inner")  # no inner mesh in the parallel-axis pair
     laws = mesh_laws(d)  # whole face width, then each helix half's share
     outer_laws = half_laws(outer, spec.contact, laws["outer"])
-    inner_laws = half_laws(inner, spec.contact, laws["inner"])
+    inner_laws = half_laws(inner, spec.contact, laws["inner"]) if inner is not None else None
     contacts = []
     for i, psi in enumerate(geo.planet_angles):
         c_planet = aw * np.array([math.cos(psi), math.sin(psi), 0.0])
@@ -124,6 +77,8 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
         contacts += mesh_pair_contacts(f"outer_mesh_{i + 1}", "sun", f"planet{i + 1}", outer, np.zeros(3), c_planet,
                                        laws=outer_laws, drive_sign=sigma, spins=(spin["sun"], spin["planet"]),
                                        phase_offset=phase, **common)
+        if inner is None:
+            continue
         contacts += mesh_pair_contacts(f"inner_mesh_{i + 1}", f"planet{i + 1}", "ring", inner, c_planet, np.zeros(3),
                                        laws=inner_laws, drive_sign=-sigma, spins=(spin["planet"], spin["ring"]),
                                        phase_offset=phase + spec.gears_assumed.outer_inner_mesh_phase, **common)
@@ -210,26 +165,6 @@ def run_cost(variant: Variant) -> float | None:
         count = spec.gears.planet_count if component == "planets" else 1
         cost += count * float(dynamic_modes(geometry, frequencies, cutoff)) ** 2
     return cost
-
-
-def joint_axes(shaft: Body) -> str:
-    """The axes of a linear gear-shaft joint's equations (flexgear.mbs.joints): body axes where the ``shaft`` is
-    flexible, ground axes where it is rigid."""
-    return "body" if shaft.flexible else "ground"
-
-
-def _seat_loads_carried(body: Body) -> bool:
-    """Whether ``body`` has dropped modes, which then answer its seat's own reaction (a linear joint's or
-    bearing's; flexgear.mbs.residual)."""
-    return getattr(body, "dropped", None) is not None
-
-
-def _is_gear_seat(body: Body, interface: str) -> bool:
-    """Whether ``interface`` of ``body`` is the seat its residual is measured from (flexgear.fe.reduced.gear_seat:
-    the bore; the ring's bolt patches)."""
-    from flexgear.fe.reduced import gear_seat
-
-    return gear_seat(body.reduced, body.name).name == interface
 
 
 def linear_frame_tolerance(spec: GearboxSpec) -> float | None:
@@ -342,7 +277,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     form = variant.components
     th, geo = d.theory, d.gears
     level = variant.mesh_level
-    reference = spec.solver_assumed.reference
     lc = spec.load_case
     cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
@@ -378,72 +312,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                      props, reduced, support=supports["planet"],
                                      cutoff_hz=cutoff, dropped=dropped, spin_rad_s=th.planet_speed,
                                      superelement=superelements, contacts=contacts))
-    by_body = {bd.name: bd for bd in bodies}
-    joints, extra, turning = {}, [], []  # turning: blocks of linear joints and seats (flexgear.mbs.joints)
-    seat_residuals = {}  # gears whose seat's joint or bearing carries their dropped modes' seat motion (residual)
-    linear_gears, body_axes = [], []  # gears whose joints are linear constraints; those written in body axes
-    for lead, other, found, ratio in pairs:  # one joint per interface pair (the ring: per bolt with bolt patches)
-        label = f"joint_{lead.name}_{other.name}"
-        if not reference:
-            from flexgear.mbs.joints import LinearInterfaceJoint
-
-            # the gear's dropped modes answer the joint's reaction (flexgear.mbs.residual): one joint at its seat
-            carried = (_seat_loads_carried(lead) and len(found) == 1
-                       and _is_gear_seat(lead, found[0].interface))
-            axes = joint_axes(other)
-            made = [LinearInterfaceJoint(mbs, lead, other, j, ratio, label + (f"_{k}" if k else ""),
-                                         residual=carried, axes=axes) for k, j in enumerate(found)]
-            if axes == "body":
-                body_axes.append(lead.name)
-            if carried:
-                seat_residuals[lead.name] = (made[0].residual_node, made[0].centre)
-            linear_gears.append(lead.name)
-            turning += [e for j in made for e in j.turning()]
-            joints[lead.name] = [(j.obj, np.array(e.point)) for j, e in zip(made, found, strict=True)]
-            continue
-        joints[lead.name] = [(add_interface_joint(mbs, lead, other, j, label + (f"_{k}" if k else "")),
-                              np.array(j.point)) for k, j in enumerate(found)]
     planets = [f"planet{i + 1}" for i in range(geo.planet_count)]
     placed = [(ends["sun"], "input_shaft"), (ends["ring"], "output_shaft"), *((p, "planet") for p in planets)]
-    for body, key in placed:  # bearings at their seats (flexgear.geometry.supports)
-        if by_body[body].flexible and not reference:
-            from flexgear.mbs.joints import LinearSeat
-
-            spin = by_body[body].nominal_spin_rad_s / th.input_speed  # per drive angle
-            carried = _seat_loads_carried(by_body[body])
-            seat = LinearSeat(mbs, by_body[body], supports[key].on(body), spin, residual=carried)
-            turning += seat.turning()
-            if carried:
-                seat_residuals[body] = (seat.residual_node, seat.centre)
-            continue
-        add_support(mbs, by_body[body], supports[key].on(body))
-    if turning:
-        from flexgear.mbs.joints import TurningBlocks
-
-        extra.append(TurningBlocks(turning, lc.ramp_time_s, lc.input_speed_rad_s))
-    linear = [bd for bd in bodies if getattr(bd, "spin", None) is not None]
-    frames = [bd.frame for bd in bodies if bd.frame is not None]
-    if linear or frames:
-        from flexgear.mbs.spin import SpinSchedule
-
-        extra.append(SpinSchedule(mbs, linear, lc.ramp_time_s, spec.solver_assumed.spin_update_interval_s, frames))
-    # nodes within one normal module of the contact radius (about half the tooth height) enter the fit
-    train = add_gear_train(mbs, bodies, [], contacts, lc.ramp_time_s, lc.input_speed_rad_s, extra_pre_steps=extra,
-                           friction=spec.contact.friction_coefficient > 0.0,
-                           contact_fourier_order=spec.reduction_assumed.contact_fourier_order,
-                           radial_band=spec.gears.normal_module_m, seat_residuals=seat_residuals)
-    springs = train.springs
-    seat = "bearing_seat"  # drive and load at the shafts' seats (spline, flange)
-    spin_in = interface_spin_marker(mbs, by_body[ends["sun"]], seat)
-    spin_out = interface_spin_marker(mbs, by_body[ends["ring"]], seat)
-    drive = add_speed_drive(mbs, by_body[ends["sun"]], lc.ramp_time_s, lc.input_speed_rad_s, spin_in[0])
-    load = add_load_torque(mbs, by_body[ends["ring"]], -math.copysign(lc.load_torque_nm, th.output_speed),
-                           lc.ramp_time_s, spin_out[0])
-    halves = len(helix_halves(geo))
-    per_planet = 2 * halves
-    outer = [springs[i * per_planet:i * per_planet + halves] for i in range(geo.planet_count)]
-    inner = [springs[i * per_planet + halves:(i + 1) * per_planet] for i in range(geo.planet_count)]
-    return GearboxModel(d, by_body, outer, inner, drive, load, contacts, train.friction, train.kinematics,
-                        tuple(train.aux_nodes), ends["sun"], ends["ring"], joints, spin_out[1:], train.residual_node,
-                        train.residual, linear_joints=tuple(linear_gears), body_axes_joints=tuple(body_axes),
-                        seat_residual_nodes=train.seat_residual_nodes)
+    return connect_stage(mbs, d, bodies, pairs, placed, contacts, ends["sun"], ends["ring"], meshes_per_planet=2)

@@ -135,7 +135,8 @@ def add_frame_bearing(mbs, body: Body, bearing: BearingElement) -> int:
     the frame origin (:meth:`BearingElement.at`, T^T K T with T = [I, -p~; 0, I], exact to first order in the
     tilts)."""
     at_frame = bearing.at(np.zeros(3))
-    return linear_bearing(mbs, f"bearing_{body.name}", body.node, at_frame.stiffness, at_frame.damping)
+    return linear_bearing(mbs, f"bearing_{body.name}{bearing.tag}", body.node, at_frame.stiffness,
+                          at_frame.damping)
 
 
 class LinearInterfaceJoint:
@@ -248,6 +249,7 @@ class LinearSeat:
                              f"{carrier.name!r}{' with a residual' if residual else ''}"
                              f"{' without its pin node' if pin_node is None else ''}")
         self.spin = float(spin_per_drive_angle)
+        label = body.name + bearing.tag
         centre = np.array(bearing.centre)
         modal_nodes, self.rows = body.span(interface_rows(body, bearing.interface, centre))
         frame = frame_rows(centre)
@@ -256,26 +258,26 @@ class LinearSeat:
         seat_ref = np.zeros(6)  # the seat node's reference coordinates (the markers measure reference + coordinates)
         if carrier is not None:
             seat_ref[:3] = body.position + centre
-            self.node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{body.name}_seat", referenceCoordinates=seat_ref))
-            linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
+            self.node = mbs.AddNode(NodeRigidBodyRxyz(name=f"{label}_seat", referenceCoordinates=seat_ref))
+            linear_bearing(mbs, f"bearing_{label}", self.node, bearing.stiffness, bearing.damping,
                            other_node=pin_node)
         else:
-            self.node = resting_node(mbs, f"{body.name}_seat", 6)
+            self.node = resting_node(mbs, f"{label}_seat", 6)
             if residual:  # the bearing acts on s + e_s: its force loads the dropped modes' seat coordinates as well
-                self.residual_node = resting_node(mbs, f"{body.name}_seat_residual", 6)
-            linear_bearing(mbs, f"bearing_{body.name}", self.node, bearing.stiffness, bearing.damping,
+                self.residual_node = resting_node(mbs, f"{label}_seat_residual", 6)
+            linear_bearing(mbs, f"bearing_{label}", self.node, bearing.stiffness, bearing.damping,
                            series_node=self.residual_node if residual else None)
-        span = mbs.AddObject(ObjectGenericODE2(name=f"{body.name}_seat_span", nodeNumbers=[self.node, body.node],
+        span = mbs.AddObject(ObjectGenericODE2(name=f"{label}_seat_span", nodeNumbers=[self.node, body.node],
                                                jacobianUserFunction=zero_user_jacobian(12)))
         # Exudyn's equation: scalingMarker1 q - scalingMarker0 (s, frame) - offset = 0, i.e.
         # R_n Psi q + J_f (frame - reference) - s = 0
         q_ref = np.concatenate([body.position, np.zeros(3)])
         modal = (MarkerNodeCoordinates(nodeNumber=modal_nodes[0]) if len(modal_nodes) == 1 else
                  MarkerObjectODE2Coordinates(objectNumber=mbs.AddObject(ObjectGenericODE2(
-                     name=f"{body.name}_seat_modes", nodeNumbers=modal_nodes,
+                     name=f"{label}_seat_modes", nodeNumbers=modal_nodes,
                      jacobianUserFunction=zero_user_jacobian(self.rows.shape[1])))))
         self.obj = mbs.AddObject(ObjectConnectorCoordinateVector(
-            name=f"{body.name}_seat_tie",
+            name=f"{label}_seat_tie",
             markerNumbers=[mbs.AddMarker(MarkerObjectODE2Coordinates(objectNumber=span)), mbs.AddMarker(modal)],
             scalingMarker0=np.hstack([np.eye(6), -frame]), scalingMarker1=self.rows, offset=frame @ q_ref - seat_ref))
 

@@ -74,7 +74,8 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
     with np.errstate(divide="ignore", invalid="ignore"):
         cols["transmission_ratio"] = np.where(speed_in[:, 3] != 0, speed_out[:, 3] / speed_in[:, 3], np.nan)
     cols["input_torque_nm"] = -data("input_torque")[:, 1]  # constraint reaction -> torque applied by the drive
-    for kind in ("outer", "inner"):
+    inner = model.spec.gears.has_ring
+    for kind in ("outer", "inner") if inner else ("outer",):
         for i in range(1, n + 1):
             halves = [k for k in sensors if k.startswith(f"{kind}_{i}_")]
             cols[f"{kind}_mesh_force_{i}_n"] = sum(data(k)[:, 1] for k in halves)
@@ -82,7 +83,7 @@ def _signals(mbs, model: GearboxModel, sensors: dict[str, int]) -> pd.DataFrame:
         acc = data(key)
         cols[f"{side}_bearing_accel_x_m_per_s2"] = acc[:, 1]
         cols[f"{side}_bearing_accel_y_m_per_s2"] = acc[:, 2]
-    frame = pd.DataFrame({c: cols[c] for c in signal_columns(n)})
+    frame = pd.DataFrame({c: cols[c] for c in signal_columns(n, inner)})
     # optional columns (flexgear.mbs.deflection): loaded transmission error, flexible gears' mesh deflections
     time = cols["time_s"]
     extra = {"transmission_error_m": transmission_error(model, time, data("output_spin")[:, 1 + model.output_spin[1]])}
