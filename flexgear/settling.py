@@ -33,7 +33,7 @@ import numpy as np
 import pandas as pd
 
 __all__ = ["SETTLING_SIGNALS", "Settling", "SettleRule", "segment_slices", "mesh_forces", "ripple_pct",
-           "radial_rms", "settling_values", "settled_start"]
+           "radial_rms", "settling_values", "settled_start", "mesh_kinds"]
 
 SETTLING_SIGNALS = {"mean": ("input_speed", "output_speed", "outer_mesh_force", "inner_mesh_force"),
                     "amplitude": ("outer_mesh_ripple", "inner_mesh_ripple", "input_bearing_rms",
@@ -95,6 +95,11 @@ def mesh_forces(signals: pd.DataFrame, mesh: str) -> np.ndarray:
     return signals[cols].to_numpy()
 
 
+def mesh_kinds(signals: pd.DataFrame) -> tuple[str, ...]:
+    """The mesh kinds a signal table holds: "outer" and "inner", or "outer" alone (the parallel-axis pair)."""
+    return tuple(m for m in ("outer", "inner") if f"{m}_mesh_force_1_n" in signals.columns)
+
+
 def ripple_pct(f: np.ndarray) -> float:
     """Mesh-force ripple [% of the mean mesh force]: 100 mean_i(std_t F_i / mean_t F_i) over the planets i."""
     return float(np.mean(f.std(axis=0) / f.mean(axis=0)) * 100.0)
@@ -109,7 +114,7 @@ def settling_values(signals: pd.DataFrame, slices: list[slice]) -> dict[str, np.
     """Each settling signal's value in each segment (module docstring): key -> array over ``slices``."""
     speed = {"input_speed": signals["input_speed_rad_per_s"].to_numpy(),
              "output_speed": signals["output_speed_rad_per_s"].to_numpy()}
-    forces = {"outer": mesh_forces(signals, "outer"), "inner": mesh_forces(signals, "inner")}
+    forces = {mesh: mesh_forces(signals, mesh) for mesh in mesh_kinds(signals)}
     acc = {side: (signals[f"{side}_bearing_accel_x_m_per_s2"].to_numpy(),
                   signals[f"{side}_bearing_accel_y_m_per_s2"].to_numpy()) for side in ("input", "output")}
     out: dict[str, np.ndarray] = {}
@@ -156,6 +161,8 @@ def settled_start(signals: pd.DataFrame, after_s: float, mesh_frequency_hz: floa
     first_ok, slowest = 0, ""
     for kind, tol_pct in (("mean", rule.mean_tolerance_pct), ("amplitude", rule.amplitude_tolerance_pct)):
         for key in SETTLING_SIGNALS[kind]:
+            if key not in values:  # a mesh the stage does not have (the parallel-axis pair's inner mesh)
+                continue
             v = values[key]
             final = v[-rule.final_blocks:].mean()
             tol = tol_pct / 100.0 * abs(final)

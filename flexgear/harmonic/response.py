@@ -243,7 +243,7 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
                    modal_cutoff_ratio: float | None = None) -> Any:
     """The linear problem at any speed [rpm] (a callable returning flexgear.harmonic.base.Operating) from the
     linearisations ``models`` at ``nodes`` [rpm] (Lagrange interpolation, or the spin fit where ``spin``)."""
-    from flexgear.geometry.involute import gear_set_geometry
+    from flexgear.design import design
     from flexgear.harmonic.friction import friction_harmonics, friction_rows
     from flexgear.laws.contact import normal_force
     from flexgear.mbs.gearbox import mesh_contacts
@@ -288,18 +288,20 @@ def _mbs_operating(variant: Any, nodes: np.ndarray, models: list[Any], harmonics
                 delta0[j] -= lm.static_residuals[nm]
         full = [c.component for c in lm.full_coordinates if c.kind == "frame"]
         in_comp = ("input_shaft", "sun") if "input_shaft" in full else ("sun",)
-        # the output member: the star's ring (its shaft where separate), the planetary stage's carrier
+        # the output member: the star's ring (its shaft where separate), the planetary stage's carrier, the
+        # parallel-axis pair's wheel (its shaft where separate)
         if "carrier" in full:
             out_comp = ("carrier",)
+        elif not spec.gears.has_ring:
+            out_comp = ("output_shaft", "planet_1") if "output_shaft" in full else ("planet_1",)
         else:
             out_comp = ("output_shaft", "ring") if "output_shaft" in full else ("ring",)
         accel_rows = [_frame_row(lm, comp, a) for comp in (in_comp, out_comp) for a in ("u_x", "u_y")]
         out_row = _frame_row(lm, out_comp, "phi_z")
         return law_rows, lm.basis[accel_rows], te_scale * lm.basis[out_row], delta0
 
-    geo = gear_set_geometry(spec)
     th = theory(spec)
-    r_out = geo.ring.base_radius if spec.gears.arrangement == "star" else geo.centre_distance
+    r_out = design(spec).output_radius
     te_scale = -r_out * math.copysign(1.0, th.output_speed)
 
     def law_terms(delta0: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:

@@ -109,7 +109,7 @@ def elastic_share(mbs, model: GearboxModel, sensors: dict[str, int], signals: pd
     total = defl[defl[:, 0] >= window_start, 1:]
     w = signals[signals.time_s >= window_start]
     out = {}
-    for kind in ("outer", "inner"):
+    for kind in ("outer", "inner") if model.spec.gears.has_ring else ("outer",):
         rows = [i for i, c in enumerate(model.contacts) if c.name.startswith(kind)]
         for part, key in (("load", "elastic_share"), ("centrifugal", "centrifugal_share")):
             cols = [c for c in w.columns if c.startswith(f"{kind}_deflection_{part}_")]

@@ -160,18 +160,20 @@ def _gearbox_page(d: ReportData) -> Callable[[Figure], None]:
         right = fig.add_axes([0.53, 0.08, 0.42, 0.8])
         where = ("" if g.equally_spaced else
                  " at " + ", ".join(f"{math.degrees(a):.4g}" for a in g.planet_positions_rad) + "°")
-        t1 = pd.DataFrame({"gear": ["sun", f"planet (x{g.planet_count}{where})", "ring"],
-                           "teeth": [g.sun_teeth, g.planet_teeth, g.ring_teeth],
-                           "normal module [mm]": [g.normal_module_mm] * 3,
-                           "helix angle [°]": [g.helix_angle_deg] * 3,
-                           "normal pressure angle [°]": [g.normal_pressure_angle_deg] * 3})
+        gears = ([("sun", g.sun_teeth), (f"planet (x{g.planet_count}{where})", g.planet_teeth), ("ring", g.ring_teeth)]
+                 if g.has_ring else [("pinion (sun)", g.sun_teeth), ("wheel (planet)", g.planet_teeth)])
+        t1 = pd.DataFrame({"gear": [n for n, _ in gears], "teeth": [z for _, z in gears],
+                           "normal module [mm]": [g.normal_module_mm] * len(gears),
+                           "helix angle [°]": [g.helix_angle_deg] * len(gears),
+                           "normal pressure angle [°]": [g.normal_pressure_angle_deg] * len(gears)})
         left.text(0, 1.0, "Gear parameters ([gears])", fontsize=9, weight="bold", transform=left.transAxes)
         y = draw_table(left, t1, top=0.97, wrap=14)
         b = d.gearbox.bearings
         t2 = pd.DataFrame([{"bearing": n, "radial [N/m]": x.radial_stiffness_n_per_m,
                             "axial [N/m]": x.axial_stiffness_n_per_m, "tilt [N·m/rad]": x.tilt_stiffness_nm_per_rad}
-                           for n, x in (("input shaft", b.input_shaft), ("output shaft", b.output_shaft),
-                                        ("planet", b.planet))])
+                           for n, x in (("input shaft" + (" (each of 2)" if not g.has_ring else ""), b.input_shaft),
+                                        ("output shaft" + (" (each of 2)" if not g.has_ring else ""), b.output_shaft),
+                                        ("planet", b.planet)) if x is not None])
         left.text(0, y - 0.04, "Bearing stiffness ([bearings])", fontsize=9, weight="bold",
                   transform=left.transAxes)
         y = draw_table(left, t2, top=y - 0.07, wrap=16)

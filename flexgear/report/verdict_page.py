@@ -215,7 +215,7 @@ def mesh_law_lines(d: ReportData) -> list[str]:
         return [f"Mesh law at the load not evaluated: {type(exc).__name__}: {exc}"]
     ind = s.indicators[s.indicators["variant"] == ref.name].set_index("indicator")
     force = {m: float(ind.loc[f"{m}_mesh_force", "mean"]) if f"{m}_mesh_force" in ind.index
-             else des.theory.mesh_force for m in ("outer", "inner")}
+             else des.theory.mesh_force for m in laws if m in des.meshes}  # the parallel-axis pair: outer only
     delta = {m: static_deflection(force[m], laws[m]) for m in force}
     law = spec.contact.law
     head = ("impact law F = k delta^e, k = " + fmt(spec.contact.stiffness, 3) + f" N/m^{fmt(spec.contact.exponent)}"
@@ -228,7 +228,8 @@ def mesh_law_lines(d: ReportData) -> list[str]:
                          for m in force) + "."]
     if "transmission_error" in ind.index:   # the reference's mean loaded TE over its screening window [m]
         total = float(ind.loc["transmission_error", "mean"])
-        split = static_te_split(total, delta["outer"], delta["inner"], des.gears.sun_planet.gear1.base_helix_angle)
+        split = static_te_split(total, delta["outer"], delta.get("inner", 0.0),
+                                des.gears.sun_planet.gear1.base_helix_angle)
         backlash = des.gears.sun_planet.normal_backlash
         lines.append(f"{ref.name}'s mean loaded transmission error {1e6 * total:.4g} um = the meshes' static "
                      f"deflection {1e6 * split.meshes_m:.4g} um + wind-up of shafts, bearings and supports "

@@ -159,7 +159,7 @@ def compare_results(a: RunResult, b: RunResult, window: tuple[float, float] | No
         peaks = [float(np.hypot(_accel(sel, side, "x"), _accel(sel, side, "y")).max()) for side in ("input", "output")]
         table6[label] = [np.degrees(sel["input_speed_rad_per_s"].mean()),
                          np.degrees(sel["output_speed_rad_per_s"].mean()),
-                         outer.mean(), inner.mean(), *peaks]
+                         outer.mean(), inner.mean() if inner.size else np.nan, *peaks]  # no inner: a pair
         dt = float(np.median(np.diff(sel["time_s"].to_numpy())))
         for side in ("input", "output"):
             axes = ("x", "y") if axis == "max" else (axis,)

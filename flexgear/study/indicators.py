@@ -34,7 +34,7 @@ from collections.abc import Callable
 import numpy as np
 import pandas as pd
 
-from flexgear.settling import mesh_forces, radial_rms, ripple_pct, segment_slices
+from flexgear.settling import mesh_forces, mesh_kinds, radial_rms, ripple_pct, segment_slices
 from flexgear.study.compare import harmonic_amplitudes
 
 __all__ = ["STUDY_INDICATORS", "DYNAMIC_INDICATORS", "ALL_INDICATORS", "LEVEL_FLOOR_M_PER_S2", "segment_slices",
@@ -66,14 +66,16 @@ DYNAMIC_INDICATORS: dict[str, str] = {
 
 ALL_INDICATORS = {**STUDY_INDICATORS, **DYNAMIC_INDICATORS}
 
-def _sharing(fo: np.ndarray, fi: np.ndarray) -> float:
-    """K_gamma: the largest planet's mean mesh force over the mean of all planets, the larger of the two meshes."""
-    return float(max((f.mean(axis=0).max() / f.mean()) for f in (fo, fi)))
+def _sharing(*meshes: np.ndarray) -> float:
+    """K_gamma: the largest planet's mean mesh force over the mean of all planets, the largest over the meshes
+    (each an array, one column per planet)."""
+    return float(max((f.mean(axis=0).max() / f.mean()) for f in meshes))
 
 
-def dynamic_factor(fo: np.ndarray, fi: np.ndarray) -> float:
-    """K_v: a planet's peak mesh force over its own mean, the largest over planets and both meshes."""
-    return float(max((f.max(axis=0) / f.mean(axis=0)).max() for f in (fo, fi)))
+def dynamic_factor(*meshes: np.ndarray) -> float:
+    """K_v: a planet's peak mesh force over its own mean, the largest over planets and the meshes (the sun-planet
+    and planet-ring forces; the parallel-axis pair's one mesh)."""
+    return float(max((f.max(axis=0) / f.mean(axis=0)).max() for f in meshes))
 
 
 def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequency_hz: float,
@@ -88,7 +90,8 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     cols = {k: signals[c].to_numpy() for k, c in (("input_speed", "input_speed_rad_per_s"),
                                                    ("output_speed", "output_speed_rad_per_s"),
                                                    ("transmission_ratio", "transmission_ratio"))}
-    fo, fi = mesh_forces(signals, "outer"), mesh_forces(signals, "inner")
+    meshes = {m: mesh_forces(signals, m) for m in mesh_kinds(signals)}  # no inner mesh in the parallel-axis pair
+    fo, fi = meshes["outer"], meshes.get("inner")
     acc = {side: (signals[f"{side}_bearing_accel_x_m_per_s2"].to_numpy(),
                   signals[f"{side}_bearing_accel_y_m_per_s2"].to_numpy()) for side in ("input", "output")}
     t = signals["time_s"].to_numpy()
@@ -103,16 +106,17 @@ def indicator_segments(signals: pd.DataFrame, slices: list[slice], mesh_frequenc
     funcs: dict[str, Callable[[slice], float]] = {
         **{k: (lambda s, y=y: float(y[s].mean())) for k, y in cols.items()},
         "outer_mesh_force": lambda s: float(fo[s].mean()),
-        "inner_mesh_force": lambda s: float(fi[s].mean()),
         "outer_mesh_ripple": lambda s: ripple_pct(fo[s]),
-        "inner_mesh_ripple": lambda s: ripple_pct(fi[s]),
-        "load_sharing": lambda s: _sharing(fo[s], fi[s]),
-        "dynamic_factor": lambda s: dynamic_factor(fo[s], fi[s]),
+        "load_sharing": lambda s: _sharing(*(f[s] for f in meshes.values())),
+        "dynamic_factor": lambda s: dynamic_factor(*(f[s] for f in meshes.values())),
         "input_bearing_rms": lambda s: radial_rms(acc["input"][0][s], acc["input"][1][s]),
         "output_bearing_rms": lambda s: radial_rms(acc["output"][0][s], acc["output"][1][s]),
         "input_bearing_mesh1x": one_x("input"),
         "output_bearing_mesh1x": one_x("output"),
     }
+    if fi is not None:
+        funcs["inner_mesh_force"] = lambda s: float(fi[s].mean())
+        funcs["inner_mesh_ripple"] = lambda s: ripple_pct(fi[s])
     if te is not None:
         funcs["transmission_error"] = lambda s: float(te[s].mean())
         for order in (1, 2):

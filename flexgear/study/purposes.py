@@ -245,7 +245,8 @@ def static_te_split(total_m: float, outer_deflection_m: float, inner_deflection_
                     base_helix_angle_rad: float) -> StaticTeSplit:
     """Split a mean loaded TE [m]: the meshes' share is (delta_n,outer + delta_n,inner) / cos(beta_b), each mesh's
     normal static deflection taken to the transverse line of action (the sun's and the ring's base-circle arcs
-    differ by the transverse approach of both meshes in series, the carrier held); the rest is wind-up."""
+    differ by the transverse approach of both meshes in series, the carrier held; the parallel-axis pair's one mesh:
+    ``inner_deflection_m`` 0); the rest is wind-up."""
     meshes = (outer_deflection_m + inner_deflection_m) / math.cos(base_helix_angle_rad)
     return StaticTeSplit(float(total_m), float(meshes))
 
