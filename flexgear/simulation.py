@@ -22,7 +22,6 @@ from typing import Any
 
 from flexgear.spec import (
     CARRIER,
-    COMPONENTS,
     OPTIONAL_COMPONENTS,
     GearboxSpec,
     SpecError,
@@ -30,6 +29,7 @@ from flexgear.spec import (
     check_carrier,
     load_gearbox,
     load_variant,
+    stage_components,
 )
 from flexgear.theory import Theory, theory
 
@@ -51,12 +51,12 @@ class Simulation:
     def from_gearbox(cls, gearbox: str | Path | GearboxSpec, flexible: Iterable[str] = (), *, name: str = "",
                      mesh_level: str = "coarse", rigid_mass_properties: str = "mesh") -> Simulation:
         """From a gearbox file (or a loaded spec): the components named in ``flexible`` flexible (any of
-        flexgear.spec.COMPONENTS, and the planetary stage's ``carrier``), the others rigid.
+        flexgear.spec.stage_components of its arrangement, and the planetary stage's ``carrier``), the others rigid.
         ``rigid_mass_properties``: "mesh" (the reduced bodies', rigid and flexible twins identical) or "exact" (the
         exact geometry's: no meshing for a rigid variant)."""
         spec = gearbox if isinstance(gearbox, GearboxSpec) else load_gearbox(gearbox)
         flexible = tuple(flexible)
-        known = COMPONENTS + OPTIONAL_COMPONENTS
+        known = stage_components(spec.gears) + OPTIONAL_COMPONENTS
         for component in flexible:
             if component not in known:
                 raise SpecError(spec.source, f"components.{component}", f"unknown component; allowed: "
@@ -66,7 +66,7 @@ class Simulation:
         if rigid_mass_properties not in ("mesh", "exact"):
             raise SpecError(spec.source, "rigid_mass_properties", "expected one of 'mesh', 'exact'",
                             rigid_mass_properties)
-        components = {c: ("flexible" if c in flexible else "rigid") for c in COMPONENTS}
+        components = {c: ("flexible" if c in flexible else "rigid") for c in stage_components(spec.gears)}
         if CARRIER in flexible:
             components[CARRIER] = "flexible"
         check_carrier(spec.source, components, spec)

@@ -34,8 +34,10 @@ the tied pair's task has made by then. Only the schedule depends on it; a task m
 def build_items(reduce: bool = True, arrangement: str = "star") -> tuple[str, ...]:
     """The tasks of :func:`build_components`: every component, and with ``reduce`` in the star arrangement the tied
     ring and output shaft (the planetary stage holds its ring by the housing and joins its output shaft to the
-    carrier: no tied body)."""
-    return (*GEOMETRY_COMPONENTS, *((TIED_PAIR,) if reduce and arrangement == "star" else ()))
+    carrier: no tied body; the parallel-axis pair has no ring)."""
+    components = GEOMETRY_COMPONENTS if arrangement != "parallel" else tuple(c for c in GEOMETRY_COMPONENTS
+                                                                            if c != "ring")
+    return (*components, *((TIED_PAIR,) if reduce and arrangement == "star" else ()))
 
 
 def variant_build_items(spec: GearboxSpec, components: dict[str, str]) -> tuple[str, ...]:

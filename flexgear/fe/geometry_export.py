@@ -27,7 +27,7 @@ import numpy as np
 from flexgear.design import as_design
 from flexgear.fe.mesh import component_brep, component_mesh
 from flexgear.fe.mesh_io import write_vtu
-from flexgear.spec import CARRIER, GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.spec import CARRIER, GearboxSpec, stage_geometries
 
 __all__ = ["export_geometry", "exported_components", "write_step", "STEP_UNIT_MM"]
 
@@ -64,7 +64,7 @@ def _point_sets(spec: GearboxSpec, component: str, nodes: np.ndarray, regions: d
 def exported_components(spec: GearboxSpec) -> tuple[str, ...]:
     """The components ``flexgear export-geometry`` writes for ``spec``: every geometry component, and in the
     planetary arrangement the carrier."""
-    return (*GEOMETRY_COMPONENTS, *((CARRIER,) if spec.gears.arrangement == "planetary" else ()))
+    return (*stage_geometries(spec.gears), *((CARRIER,) if spec.gears.arrangement == "planetary" else ()))
 
 
 def _carrier_files(spec: GearboxSpec, level: str, folder: Path) -> list[Path]:

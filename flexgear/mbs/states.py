@@ -29,12 +29,16 @@ _MERGED = {"sun": "input_shaft", "ring": "output_shaft"}
 
 def state_bodies(model: GearboxModel) -> dict[str, dict]:
     """Per body: the component geometries it carries (a rigid gear merged with its rigid shaft carries
-    both; the flexible ring and output shaft, tied, the tied pair's body; a planetary stage's carrier its merged
-    output shaft's, or none), whether it is flexible, its mode count and probe node."""
+    both, the parallel-axis pair's rigid wheel and output shaft likewise; the flexible ring and output shaft, tied, the
+    tied pair's body; a planetary stage's carrier its merged output shaft's, or none), whether it is flexible, its
+    mode count and probe node."""
     out = {}
     planetary = model.design.spec.gears.arrangement == "planetary"
+    pair = not model.design.spec.gears.has_ring
     for name, body in model.bodies.items():
-        if name.startswith("planet"):
+        if pair and name.startswith("planet") and not body.flexible and "output_shaft" not in model.bodies:
+            geometries = ["planet", "output_shaft"]  # the parallel-axis pair's wheel merged with its rigid shaft
+        elif name.startswith("planet"):
             geometries = ["planet"]
         elif name == "carrier" and body.flexible:
             geometries = ["carrier"]

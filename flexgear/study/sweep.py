@@ -134,12 +134,14 @@ def toml_text(data: dict[str, Any]) -> str:
 
 
 def _forms(base: dict[str, Any], all_combinations: bool) -> list[tuple[str, dict[str, str]]]:
-    """(suffix, components) of a base variant: itself, or all 2^5 rigid/flexible forms ("rrfrf")."""
+    """(suffix, components) of a base variant: itself, or all 2^n rigid/flexible forms of its n components
+    ("rrfrf")."""
     if not all_combinations:
         return [("", dict(base["components"]))]
+    names = [c for c in COMPONENTS if c in base["components"]]  # the arrangement's (no ring in a parallel pair)
     out = []
-    for bits in itertools.product("rf", repeat=len(COMPONENTS)):
-        comps = {c: ("flexible" if b == "f" else "rigid") for c, b in zip(COMPONENTS, bits, strict=True)}
+    for bits in itertools.product("rf", repeat=len(names)):
+        comps = {c: ("flexible" if b == "f" else "rigid") for c, b in zip(names, bits, strict=True)}
         out.append(("_" + "".join(bits), comps))
     return out
 
