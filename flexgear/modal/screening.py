@@ -45,7 +45,7 @@ import numpy as np
 import pandas as pd
 
 from flexgear.modal import LinearModel, Modes
-from flexgear.schema import OPTIONAL_COMPONENTS, Variant
+from flexgear.schema import OPTIONAL_COMPONENTS, Variant, stage_components
 
 __all__ = ["ModalScreening", "modal_screening", "amplification", "folder_variants", "flexible_components", "THRESHOLD",
            "TABLE3_COMPONENTS"]
@@ -189,8 +189,10 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     f, zeta = found.frequencies_hz[keep], found.damping_ratios[keep]
     weights = amplification(f, np.maximum(zeta, 0.0), f_mesh)
     weights = weights / weights.sum() if weights.size else weights
-    # Table 3's components, and an optional one (the planetary stage's carrier) where the model has it
-    shares = dict.fromkeys((*TABLE3_COMPONENTS, *(c for c in OPTIONAL_COMPONENTS if c in model.components)), 0.0)
+    # Table 3's components of the arrangement (no ring in a pair), and an optional one (the planetary stage's
+    # carrier) where the model has it
+    shares = dict.fromkeys((*(c for c in TABLE3_COMPONENTS if c in stage_components(variant.gearbox.gears)),
+                            *(c for c in OPTIONAL_COMPONENTS if c in model.components)), 0.0)
     for c in model.components:
         column = f"strain_{c}_elastic"
         if column in found.energy:
