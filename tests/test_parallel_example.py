@@ -140,7 +140,7 @@ def test_a_pairs_variant_has_no_ring(tmp_path):
 
 
 @pytest.mark.slow  # a rigid run with states: a few seconds
-def test_rigid_pair_meets_hand_theory_and_its_bearings_carry_the_mesh_force(tmp_path, gearbox):
+def test_rigid_pair_meets_hand_theory_and_its_bearings_carry_the_mesh_force(tmp_path, example_cache, gearbox):
     from flexgear.cli import main
     from flexgear.design import design
     from flexgear.results import load_result
@@ -173,3 +173,35 @@ def test_all_flexible_pair_meets_hand_theory(tmp_path, example_cache, gearbox):
     result = load_result(out / "flexible")
     assert result.meta["status"] == "ok", result.meta["reason"]
     _check_ratio_and_force(result, gearbox, "flexible")
+
+
+@pytest.mark.slow  # the matrix of both variants to their settled end, its screenings and the report: about a minute
+def test_the_workflow_takes_the_pair(tmp_path, example_cache, gearbox):
+    """``flexgear matrix`` (settled runs, the Westgard screening against the flexible pair, the modal screening of the
+    pair's components), ``flexgear lpm`` and ``flexgear report``; the mean mesh force of both variants and of the
+    lumped model within 1 % of hand theory."""
+    import pandas as pd
+
+    from flexgear.cli import main
+
+    out = tmp_path / "m"
+    assert main(["matrix", str(EXAMPLE / "rigid.toml"), str(EXAMPLE / "flexible.toml"), "--t-end", "settled",
+                 "--reference", "flexible", "--out", str(out)]) == 0
+    runs = pd.read_csv(out / "matrix_results.csv")
+    assert list(runs.status) == ["ok", "ok"] and runs.ring.isna().all()
+    means = pd.read_csv(out / "screening_indicators.csv")
+    _, f_n, _ = _hand(gearbox)
+    force = means[means.indicator == "outer_mesh_force"]
+    assert len(force) == 2 and np.allclose(force["mean"], f_n, rtol=0.01)  # tooth friction: a few 0.1 %
+    assert "inner_mesh_force" not in set(means.indicator)
+    assert len(pd.read_csv(out / "verdict.csv")) == 5  # four purposes and all
+    modal = pd.read_csv(out / "modal_screening.csv")
+    assert "ring" not in set(modal.component)
+    assert main(["lpm", str(EXAMPLE / "rigid.toml"), "--out", str(out)]) == 0  # the lumped model beside the runs
+    from flexgear.results import load_result
+
+    lumped = load_result(out / "lumped").signals
+    late = lumped[lumped.time_s >= 0.5 * (gearbox.load_case.ramp_time_s + gearbox.load_case.end_time_s)]
+    assert late.outer_mesh_force_1_n.mean() == pytest.approx(f_n, rel=0.01)
+    assert main(["report", str(out), "--output", str(tmp_path / "report.pdf")]) == 0
+    assert (tmp_path / "report.pdf").stat().st_size > 0

@@ -23,6 +23,7 @@ spring k_a at z_c; the dampers sit at the same points (the same spread needs d_t
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, replace
 from typing import NamedTuple
 
@@ -30,7 +31,8 @@ import numpy as np
 
 from flexgear.spec import Bearing
 
-__all__ = ["AxisSpring", "BearingElement", "FixedJointElement", "lever_rows"]
+__all__ = ["AxisSpring", "BearingElement", "FixedJointElement", "condensed_radial_damping_of",
+           "condensed_radial_stiffness_of", "lever_rows"]
 
 _AXISYMMETRIC_RTOL = 1e-12
 """Relative tolerance [-] of the checks that a bearing's matrices have the axisymmetric diagonal form about its
@@ -178,6 +180,41 @@ def _condensed(radial: float, _axial: float, tilt: float, lever: float) -> float
             return 0.0
         compliance += lever**2 / tilt
     return 1.0 / compliance
+
+
+def condensed_radial_stiffness_of(bearings: Sequence[BearingElement], gear_z: float = 0.0) -> float:
+    """In-plane stiffness [N/m] at the point (0, 0, ``gear_z``) [m] of a rigid shaft on all ``bearings`` together
+    (e.g. the parallel-axis pair's two bearings straddling a gear): a force F there, no moment.
+
+    Bearing i (radial k_r,i [N/m], tilt k_t,i [N m/rad] about its centre z_i) seen from the point, with the lever
+    L_i = z_i - gear_z [m], adds [[k_r,i, k_r,i L_i], [k_r,i L_i, k_r,i L_i^2 + k_t,i]] on (translation u, tilt phi);
+    summed to K and the tilt statically condensed (no moment at the point):
+
+        k = K_uu - K_uphi^2 / K_phiphi   (k = K_uu where K_phiphi = 0: no lever and no tilt stiffness).
+
+    One bearing: k = 1 / (1/k_r + L^2/k_t), :meth:`BearingElement.condensed_radial_stiffness`."""
+    return _condensed_sum([(*b.axisymmetric_entries(), float(b.centre[2]) - gear_z) for b in bearings])
+
+
+def condensed_radial_damping_of(bearings: Sequence[BearingElement], gear_z: float = 0.0) -> float:
+    """In-plane damping [N s/m] at (0, 0, ``gear_z``) [m] of a rigid shaft on all ``bearings``: the condensation of
+    :func:`condensed_radial_stiffness_of` on the damping entries (radial d_r, tilt d_t); exact for
+    stiffness-proportional damping of one ratio c [s] for all bearings, where it is c times the condensed stiffness.
+    One bearing: :meth:`BearingElement.condensed_radial_damping`."""
+    return _condensed_sum([(*b.axisymmetric_entries(b.damping), float(b.centre[2]) - gear_z) for b in bearings])
+
+
+def _condensed_sum(entries: list[tuple[float, float, float, float]]) -> float:
+    """k = K_uu - K_uphi^2 / K_phiphi of the summed (translation, tilt) matrices of (radial, axial, tilt, lever)
+    entries (:func:`condensed_radial_stiffness_of`); never negative (rounding where K is singular)."""
+    if not entries:
+        raise ValueError("condensed stiffness: expected at least one bearing")
+    k_uu = sum(radial for radial, _, _, _ in entries)
+    k_up = sum(radial * lever for radial, _, _, lever in entries)
+    k_pp = sum(radial * lever**2 + tilt for radial, _, tilt, lever in entries)
+    if k_pp == 0.0:
+        return k_uu
+    return max((k_uu * k_pp - k_up**2) / k_pp, 0.0)
 
 
 @dataclass(frozen=True, eq=False)

@@ -68,9 +68,12 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     (h = 1..``harmonics``) are eq. 11-12's from the contact lines; mesh i is phased as in the time model, whose
     phase follows the gear's angle coordinate: the nominal spin plus the static deflection's rotation. A
     rotating carrier (planetary arrangement) adds its Coriolis, centripetal and bearing-damping terms; then the
-    bearing accelerations are in the carrier frame. With mu > 0 the tooth friction at the static mesh forces adds
-    its first-order excitation (flexgear.harmonic.lumped_friction), phased as the stiffness excitation.
+    bearing accelerations are in the carrier frame. The parallel-axis pair has its one mesh (no planet-ring rows), the
+    output on the wheel; the transmission error's lever is flexgear.design.Design.output_radius. With mu > 0 the
+    tooth friction at the static mesh forces adds its first-order excitation (flexgear.harmonic.lumped_friction),
+    phased as the stiffness excitation.
     """
+    from flexgear.design import as_design
     from flexgear.lumped.kernel_layout import DEPTH, EXPONENT, IMPACT, IN_BODY, LOAD_SIGN, OUT_BODY, OUT_SPIN, T_LOAD
     from flexgear.lumped.run import build_lumped_model
     from flexgear.theory import theory
@@ -80,8 +83,7 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
     s = model.system
     p = s.params
     g = spec.gears
-    star = g.arrangement == "star"
-    r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)
+    r_c = g.sun_teeth / (g.sun_teeth + g.ring_teeth) if g.arrangement == "planetary" else 0.0
     free = model.free
     nf = free.size
     rows = s.mesh_G[:, free]
@@ -118,7 +120,9 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
 
     # mesh phases: phase_m = coef_m q[index_m] + offset_m, the spin's nominal rate relative to the carrier frame
     zs, zr = g.sun_teeth, g.ring_teeth
-    rel = {2: 1.0 - r_c, 5: -(zs / zr) * (1.0 - r_c)}  # sun and ring spin per input angle, carrier frame
+    rel = {2: 1.0 - r_c}  # sun and (where the stage has one) ring spin per input angle, carrier frame
+    if p.ring_meshes:
+        rel[5] = -(zs / zr) * (1.0 - r_c)
     rate = np.array([model.phase_coef[m] * rel[int(model.phase_index[m])] for m in range(nmesh)])
     # the static deflection turns the gears too: a mesh's phase at the operating point includes coef_m q0[index_m]
     q_static = np.zeros(s.n)
@@ -130,7 +134,7 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
 
     n_pl = p.planet_count
     names = tuple([mesh_force_name("outer", i + 1) for i in range(n_pl)]
-                  + [mesh_force_name("inner", i + 1) for i in range(n_pl)])
+                  + [mesh_force_name("inner", i + 1) for i in range(n_pl) if p.ring_meshes])
     pos = {int(j): k for k, j in enumerate(free)}
     accel = np.zeros((4, nf))
     for k, b in enumerate((int(model.ip[IN_BODY]), int(model.ip[OUT_BODY]))):
@@ -138,7 +142,7 @@ def lumped_linear(spec: Any, harmonics: int = DEFAULT_HARMONICS) -> LumpedLinear
             if 3 * b + a in pos:
                 accel[2 * k + a, pos[3 * b + a]] = 1.0
     th = theory(spec)
-    r_out = p.ring.radius_m if star else p.carrier.radius_m
+    r_out = as_design(spec).output_radius  # ring base radius, planet centre distance, wheel base radius
     te = np.zeros(nf)
     out_spin = int(model.ip[OUT_SPIN])
     if out_spin in pos:

@@ -10,6 +10,10 @@ shape, energy share e = m phi^2 per coordinate):
 - ``rotational``: central members only spin (single modes)
 - ``translational``: central members only translate (pairs of equal frequency)
 - ``mixed``: anything else (e.g. unequally spaced planets)
+
+The parallel-axis pair (flexgear.lumped.model: the pinion on the sun, the wheel on planet 1, ring and carrier held,
+one mesh) reads the same way: ``planet`` is a mode of the wheel alone, ``rotational`` and ``translational`` those in
+which the pinion only spins or only translates.
 """
 
 from __future__ import annotations

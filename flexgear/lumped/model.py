@@ -18,27 +18,35 @@ J = rotation by +90 deg, the sun driving counter-clockwise):
   the mesh stiffness k_m = C_gamma b of eq. 10 is taken along the normal.
 - planet bearings connect the planet centre to its pin on the carrier, a e_i + (x_c, y_c) + a theta_c J e_i.
 
+The parallel-axis pair (``[gears] arrangement = "parallel"``) is the star's sun-planet mesh of one planet: the sun is
+the pinion (input), planet 1 the wheel (output) at a e_1 = (a, 0) on its own shaft; the carrier is held, so the
+wheel's "planet bearing" (its two shaft bearings condensed) ties it to the ground; the ring is detached (held, no
+mass, no mesh: :attr:`LumpedParameters.ring_meshes` is False and :func:`assemble` leaves its mesh rows out).
+
 :class:`LumpedParameters` holds plain per-member values as the literature gives them (mass, I/r^2,
 radius, bearing stiffness, torsional support stiffness in N/m = k_theta / r^2), the two mesh
 stiffnesses, pressure angles, planet count and the members whose spin is held;
 :meth:`LumpedParameters.from_spec` builds them from a :class:`~flexgear.spec.GearboxSpec`.
 :func:`assemble` turns them into mass, support stiffness/damping and mesh-deflection matrices
-shared by the modal analysis (flexgear.lumped.modal) and the time integration (flexgear.lumped.run).
+shared by the modal analysis (flexgear.lumped.modal) and the time integration (flexgear.lumped.run). The tooth
+friction tables live in flexgear.lumped.friction (re-exported here).
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.contact_lines import contact_line_integrals
-from flexgear.geometry.involute import GearSetGeometry
+from flexgear.geometry.elements import condensed_radial_damping_of, condensed_radial_stiffness_of
 from flexgear.geometry.massprops import combine_mass_properties
+from flexgear.geometry.supports import NEAR
 from flexgear.laws.contact import mesh_damping, mesh_laws
-from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec
+from flexgear.lumped.friction import FrictionTables, friction_tables, mesh_friction_tables
+from flexgear.spec import GearboxSpec
 
 __all__ = [
     "CENTRAL_MEMBERS",
@@ -49,6 +57,7 @@ __all__ = [
     "mesh_damping",
     "FrictionTables",
     "friction_tables",
+    "mesh_friction_tables",
 ]
 
 CENTRAL_MEMBERS = ("sun", "ring", "carrier")
@@ -90,9 +99,10 @@ class MemberParameters:
 class LumpedParameters:
     """Plain lumped parameters of any single-stage planetary set (SI, angles in rad).
 
-    ``fixed``: members (of sun, ring, carrier) whose spin is held (star: carrier; planetary: ring).
-    Mesh stiffnesses are mean values along the tooth normal (eq. 10); mesh damping per mesh (eq. 13)
-    is optional (modal analysis ignores damping). ``planet_angles_rad`` defaults to equal spacing.
+    ``fixed``: members (of sun, ring, carrier) whose spin is held (star: carrier; planetary: ring; the parallel-axis
+    pair: carrier and ring). Mesh stiffnesses are mean values along the tooth normal (eq. 10); mesh damping per mesh
+    (eq. 13) is optional (modal analysis ignores damping). ``planet_angles_rad`` defaults to equal spacing. Planet-ring
+    meshes of zero stiffness and zero damping carry no force: the set has none (:attr:`ring_meshes`).
     """
 
     sun: MemberParameters
@@ -125,6 +135,17 @@ class LumpedParameters:
                 raise ValueError(f"{name}: expected radius > 0, mass >= 0 and I/r^2 >= 0")
 
     @property
+    def ring_meshes(self) -> bool:
+        """Whether the set has planet-ring meshes: False where both their stiffness and damping are zero (the
+        parallel-axis pair's detached ring), whose force F = k delta + c delta' is then zero whatever the motion."""
+        return self.ring_mesh_stiffness_n_per_m != 0.0 or self.ring_mesh_damping_n_s_per_m != 0.0
+
+    @property
+    def mesh_count(self) -> int:
+        """Number of meshes: N sun-planet meshes, and N planet-ring meshes where the set has them."""
+        return self.planet_count * (2 if self.ring_meshes else 1)
+
+    @property
     def angles(self) -> np.ndarray:
         if self.planet_angles_rad is None:
             return 2.0 * math.pi * np.arange(self.planet_count) / self.planet_count
@@ -138,10 +159,13 @@ class LumpedParameters:
         - masses and spin inertias: flexgear.geometry.layout.component_mass_properties (sun + input shaft,
           the in-plane mass the apparent mass at the gear centre of the joined parts, see ``mi``;
           ring + output shaft for the star arrangement; for the planetary arrangement the output
-          shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*)
+          shaft belongs to the carrier, whose own mass is ``[lumped_assumed]`` carrier_*; for the parallel-axis
+          pair wheel + output shaft on the planet, the ring detached and the carrier held, module docstring)
         - bearing stiffness: the Table 2 bearing at its seat (flexgear.geometry.supports)
           condensed to the gear centre, 1/k = 1/k_r + L^2/k_t (L: gear to bearing centre; the tilt statically
-          condensed); damping condensed likewise (c = k * damping_per_stiffness_s)
+          condensed); damping condensed likewise (c = k * damping_per_stiffness_s); the parallel-axis pair's shafts
+          on their two bearings condensed together, k = K_uu - K_uphi^2 / K_phiphi
+          (flexgear.geometry.elements.condensed_radial_stiffness_of)
         - mesh stiffness: eq. 10, k_m = C_gamma b with b the total active face width
         - mesh damping: eq. 13, c = 2 xi sqrt(k_m m_1 m_2 / (m_1 + m_2)) with the gear masses
           (the study prints k in place of sqrt(k), a dimensional slip: c must be in N s/m)
@@ -151,14 +175,19 @@ class LumpedParameters:
         d = as_design(spec)
         spec, geo = d.spec, d.gears
         la = spec.lumped_assumed
-        names = GEOMETRY_COMPONENTS
-        props = {c: d.masses[c] for c in names}
-        star = spec.gears.arrangement == "star"
+        props = d.masses
+        arrangement = spec.gears.arrangement
+        star = arrangement == "star"
         supports = d.supports
 
-        def member(mass: float, inertia: float, radius: float, bearing, held: bool = False) -> MemberParameters:
+        def member(mass: float, inertia: float, radius: float, bearing: str | tuple[str, ...] | None,
+                   held: bool = False) -> MemberParameters:
             if held:
                 return MemberParameters.from_inertia(max(mass, 0.0), inertia, radius, math.inf)
+            if isinstance(bearing, tuple):  # a shaft on several bearings (the parallel-axis pair), condensed together
+                seats = [supports[b] for b in bearing]
+                return MemberParameters.from_inertia(mass, inertia, radius, condensed_radial_stiffness_of(seats),
+                                                     bearing_damping_n_s_per_m=condensed_radial_damping_of(seats))
             # the bearing at its seat condensed to the gear centre (flexgear.geometry.supports)
             k = supports[bearing].condensed_radial_stiffness()
             return MemberParameters.from_inertia(mass, inertia, radius, k,
@@ -177,6 +206,8 @@ class LumpedParameters:
             apparent = body.mass if d == 0.0 else 1.0 / (1.0 / body.mass + d**2 / tilt)
             return apparent, sum(props[n].inertia[2, 2] for n in names)
 
+        if arrangement == "parallel":
+            return cls._parallel(d, member, mi, hold_input)
         sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, "input_shaft")
         planet = member(*mi("planet"), geo.planet.base_radius, "planet")
         if star:
@@ -211,6 +242,37 @@ class LumpedParameters:
             source=str(spec.source),
         )
 
+    @classmethod
+    def _parallel(cls, d: Design, member: Callable[..., MemberParameters],
+                  mi: Callable[..., tuple[float, float]], hold_input: bool) -> LumpedParameters:
+        """:meth:`from_spec` of the parallel-axis pair (module docstring): the pinion + input shaft on the sun, the
+        wheel + output shaft on planet 1, each on its shaft's two bearings condensed to its gear centre; the carrier
+        held (the wheel's axis fixed at the centre distance); the ring detached: held, massless, its meshes of zero
+        stiffness and damping (any positive radius: no mesh reads it, the wheel's base radius is taken). The one
+        mesh as the star's sun-planet meshes (its law's stiffness and damping, or eq. 10 and 13)."""
+        spec, geo = d.spec, d.gears
+        la = spec.lumped_assumed
+        sun = member(*mi("sun", "input_shaft"), geo.sun.base_radius, ("input_shaft", "input_shaft" + NEAR))
+        planet = member(*mi("planet", "output_shaft"), geo.planet.base_radius, ("output_shaft", "output_shaft" + NEAR))
+        ring = member(0.0, 0.0, geo.planet.base_radius, None, held=True)
+        carrier = member(0.0, 0.0, geo.centre_distance, None, held=True)
+        if spec.contact.law == "iso6336":
+            law = mesh_laws(d)["outer"]
+            k_s, c_s = law.stiffness, law.damping_max
+        else:
+            k_s = la.mesh_stiffness_per_width_n_per_m2 * spec.gears_assumed.face_width_m
+            c_s = mesh_damping(k_s, d.masses["sun"].mass, d.masses["planet"].mass, la.mesh_damping_ratio)
+        alpha = geo.sun_planet.operating_pressure_angle
+        return cls(
+            sun=sun, ring=ring, carrier=carrier, planet=planet, planet_count=geo.planet_count,
+            sun_mesh_stiffness_n_per_m=k_s, ring_mesh_stiffness_n_per_m=0.0,
+            sun_pressure_angle_rad=alpha, ring_pressure_angle_rad=alpha,  # the ring's: unused (no ring mesh)
+            fixed=("carrier", "ring", "sun") if hold_input else ("carrier", "ring"),
+            base_helix_angle_rad=geo.sun.base_helix_angle,
+            planet_angles_rad=tuple(float(a) for a in geo.planet_angles),
+            sun_mesh_damping_n_s_per_m=c_s, ring_mesh_damping_n_s_per_m=0.0, source=str(spec.source),
+        )
+
 
 @dataclass(frozen=True)
 class LumpedSystem:
@@ -218,7 +280,8 @@ class LumpedSystem:
 
     Coordinates: body b in (sun, ring, carrier, planet 1..N) owns indices 3b (x), 3b+1 (y), 3b+2 (theta).
     ``free``: coordinates that move; a held spin (``fixed``) is prescribed, a held translation is zero.
-    Mesh m (sun meshes 0..N-1, ring meshes N..2N-1): normal deflection delta_n = G[m] . q.
+    Mesh m (sun meshes 0..N-1, ring meshes N..2N-1 where the set has them, :attr:`LumpedParameters.ring_meshes`;
+    M = :attr:`LumpedParameters.mesh_count` meshes): normal deflection delta_n = G[m] . q.
     """
 
     params: LumpedParameters
@@ -228,11 +291,11 @@ class LumpedSystem:
     support_damping: np.ndarray  # (n, n)
     ground_damping: np.ndarray  # (n, n) bearing damping of members supported on the ground (rotating-frame term)
     ground_spin_stiffness: np.ndarray  # (n,) torsional supports to the ground (act on the absolute spin)
-    mesh_G: np.ndarray  # (2N, n) normal deflection per unit coordinate (cos(beta_b) included)
-    mesh_stiffness: np.ndarray  # (2N,) mean, along the normal
-    mesh_damping: np.ndarray  # (2N,)
-    mesh_direction: np.ndarray  # (2N, 2) transverse line of action n (force on gear 2)
-    mesh_bodies: np.ndarray  # (2N, 2) int: body of gear 1 (driving side) and gear 2
+    mesh_G: np.ndarray  # (M, n) normal deflection per unit coordinate (cos(beta_b) included)
+    mesh_stiffness: np.ndarray  # (M,) mean, along the normal
+    mesh_damping: np.ndarray  # (M,)
+    mesh_direction: np.ndarray  # (M, 2) transverse line of action n (force on gear 2)
+    mesh_bodies: np.ndarray  # (M, 2) int: body of gear 1 (driving side) and gear 2
     free: np.ndarray  # (n,) bool
     held_spin: np.ndarray  # (n,) bool: spins held (prescribed)
     nominal_position: np.ndarray  # (bodies, 2) nominal centre in the carrier frame [m]
@@ -339,73 +402,7 @@ def assemble(params: LumpedParameters, translations: bool = True) -> LumpedSyste
                np.full(p.planet_count, p.ring_mesh_stiffness_n_per_m)]
     cm = np.r_[np.full(p.planet_count, p.sun_mesh_damping_n_s_per_m),
                np.full(p.planet_count, p.ring_mesh_damping_n_s_per_m)]
+    if not p.ring_meshes:  # no planet-ring meshes (a detached ring): their rows left out
+        keep = slice(0, p.mesh_count)
+        G, km, cm, direction, bodies = G[keep], km[keep], cm[keep], direction[keep], bodies[keep]
     return LumpedSystem(p, labels, mass, ks, cs, cg, kspin, G, km, cm, direction, bodies, free, held, nominal)
-
-
-# --------------------------------------------------------------------------- tooth friction
-@dataclass(frozen=True)
-class FrictionTables:
-    """Tooth-friction resultants of one mesh per unit normal force, over one mesh cycle.
-
-    Phase phi in [0, 1) (mesh cycles), the convention of flexgear.geometry.contact_lines.mesh_stiffness_harmonics:
-    a tooth with phase u = phi + k has its contact line from transverse position s = u (one face end)
-    to s = u - eps_beta (other end), s in base pitches from the start of active contact A, and is
-    in contact on 0 <= s <= eps_alpha. The normal load is spread uniformly over all contact-line
-    length; friction mu*w acts along tau = J n, opposing the sliding of gear 1 on gear 2, whose
-    sign flips at the pitch point.
-
-    - ``length``: total contact-line length / its mean (the mesh stiffness shape)
-    - ``force``: (1/L) int sg dl  (friction force on gear 2 along tau, per mu F_n, for forward running)
-    - ``arm1``, ``arm2`` [m]: (1/L) int sg d_j dl, d_j = (C - O_j) . n the signed arm about gear j's centre;
-      the friction moment on gear 1 is -mu F_n arm1, on gear 2 +mu F_n arm2.
-    """
-
-    phase: np.ndarray
-    length: np.ndarray
-    force: np.ndarray
-    arm1: np.ndarray
-    arm2: np.ndarray
-
-
-def friction_tables(d1_start: float, d1_end: float, d1_pitch: float, d2_offset: float, base_pitch: float,
-                    eps_beta: float, sign_slope: float, points: int) -> FrictionTables:
-    """Tabulate :class:`FrictionTables` of one mesh from the integrals along its contact lines
-    (flexgear.geometry.contact_lines.contact_line_integrals, the multibody model's friction series too).
-
-    ``d1_start``, ``d1_end``, ``d1_pitch``: arm d1 = (C - O_1) . n [m] at the start and end of active
-    contact and at the pitch point; ``d2_offset`` = (O_1 - O_2) . n, so d2 = d1 + d2_offset;
-    ``sign_slope`` = +1 if the sliding velocity of gear 1 on gear 2 (forward running) grows with s. With
-    sg = sign_slope sign(s - s_p), d1 = d1_start + p_bt s and the integrals L, S, M (s in base pitches):
-    force = (1/L) int sg dl = sign_slope S / L, arm1 = (1/L) int sg d1 dl = sign_slope (d1_start S + p_bt M) / L.
-    """
-    phase = np.arange(points) / points
-    length, signed, moment = contact_line_integrals((d1_end - d1_start) / base_pitch, eps_beta,
-                                                    (d1_pitch - d1_start) / base_pitch, phase)
-    i0, i1 = sign_slope * signed, sign_slope * moment
-    arm1 = (d1_start * i0 + base_pitch * i1) / length
-    force = i0 / length
-    return FrictionTables(phase, length / length.mean(), force, arm1, arm1 + d2_offset * force)
-
-
-def mesh_friction_tables(spec_geo: GearSetGeometry, points: int) -> tuple[FrictionTables, FrictionTables]:
-    """Friction tables of the sun-planet and planet-ring meshes (geometry as in the module docstring)."""
-    sun, planet, ring = spec_geo.sun, spec_geo.planet, spec_geo.ring
-    a = spec_geo.centre_distance
-    eps_b = spec_geo.sun_planet.overlap_ratio(spec_geo.helix_face_width)
-    ga = math.sqrt(sun.tip_radius**2 - sun.base_radius**2)
-    gp = math.sqrt(planet.tip_radius**2 - planet.base_radius**2)
-    gr = math.sqrt(ring.tip_radius**2 - ring.base_radius**2)
-    al_s = spec_geo.sun_planet.operating_pressure_angle
-    al_r = spec_geo.planet_ring.operating_pressure_angle
-    pb = sun.base_pitch
-    # sun (gear 1) - planet (gear 2), external: d1 from the sun's tangency, d2 = d1 - a sin(alpha)
-    k_s = -sun.base_radius / planet.base_radius  # kinematic omega_2 / omega_1
-    slope_s = math.copysign(1.0, 1.0 - k_s)
-    sun_t = friction_tables(a * math.sin(al_s) - gp, ga, sun.base_radius * math.tan(al_s), -a * math.sin(al_s),
-                            pb, eps_b, slope_s, points)
-    # planet (gear 1, driving clockwise) - ring (gear 2), internal: d2 = d1 + a sin(alpha)
-    k_r = planet.base_radius / ring.base_radius
-    slope_r = -math.copysign(1.0, 1.0 - k_r)  # forward running is omega_planet < 0
-    ring_t = friction_tables(-a * math.sin(al_r) + gr, gp, planet.base_radius * math.tan(al_r), a * math.sin(al_r),
-                             pb, eps_b, slope_r, points)
-    return sun_t, ring_t

@@ -28,7 +28,9 @@ mu F_n acts across the line of action with arms tabulated over the mesh cycle
 (:class:`flexgear.lumped.model.FrictionTables`), its direction set by the running direction,
 regularised as tanh(omega_1 p_bt / v_reg). The stiffness series and the friction law are the multibody
 model's compiled ones (flexgear.laws.compiled.series_value, tooth_friction). The input spin follows the STEP
-speed ramp exactly (prescribed); the load torque is the STEP load ramp on the output member (Table 5).
+speed ramp exactly (prescribed); the load torque is the STEP load ramp on the output member (Table 5): the ring
+(star), the carrier (planetary) or the wheel, planet 1 (the parallel-axis pair, whose one mesh is the sun-planet
+mesh of planet 1: flexgear.lumped.model).
 
 Integration: classical fixed-step Runge-Kutta 4 (``[lumped_assumed] integration_substeps`` steps per recorded
 step), the right-hand side compiled with numba; at the study's highest frequency (~8 kHz) omega h << 2.8 (RK4's limit).
@@ -62,7 +64,12 @@ from flexgear.progress import Progress
 from flexgear.results import RunResult, run_metadata, signal_columns
 from flexgear.spec import GearboxSpec, spec_hash
 
-__all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces"]
+__all__ = ["LumpedModel", "LumpedRHS", "build_lumped_model", "lumped_rhs", "run_lumped", "static_mesh_forces",
+           "OUTPUT_BODY"]
+
+OUTPUT_BODY = {"star": 1, "planetary": 2, "parallel": 3}
+"""Body (0 sun, 1 ring, 2 carrier, 3 + i planet i + 1) carrying the output per arrangement: its spin takes the load
+and its bearing gives the output acceleration (the parallel-axis pair's wheel is planet 1)."""
 
 
 @dataclass(frozen=True)
@@ -81,7 +88,7 @@ class LumpedModel:
     phase_coef: np.ndarray
     phase_offset: np.ndarray
     backlash: np.ndarray  # (meshes,) normal backlash [m]
-    tables: np.ndarray  # (2, points, 3) friction force, arm1, arm2 of sun and ring meshes
+    tables: np.ndarray  # (types, points, 3) friction force, arm1, arm2 of sun (and ring) meshes
     mesh_type: np.ndarray  # (meshes,) 0 sun mesh, 1 ring mesh
     tau: np.ndarray  # (meshes, 2) friction direction J n
     g1: np.ndarray  # (meshes,) d delta_t / d theta_1 (sign gives forward running of gear 1)
@@ -99,10 +106,11 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
     params = LumpedParameters.from_spec(d, hold_input=True)
     sysm = assemble(params)
     g, lc = spec.gears, spec.load_case
-    star = g.arrangement == "star"
-    r_c = 0.0 if star else g.sun_teeth / (g.sun_teeth + g.ring_teeth)  # Omega_c / omega_in
-    nplan = params.planet_count
-    out_spin = 5 if star else 8
+    planetary = g.arrangement == "planetary"
+    r_c = g.sun_teeth / (g.sun_teeth + g.ring_teeth) if planetary else 0.0  # Omega_c / omega_in
+    nplan, nm = params.planet_count, params.mesh_count
+    out_body = OUTPUT_BODY[g.arrangement]
+    out_spin = 3 * out_body + 2
     fp = np.zeros(kl.NFP)
     fp[kl.MU] = spec.contact.friction_coefficient
     fp[kl.W_IN] = lc.input_speed_rad_s
@@ -110,7 +118,7 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
     fp[kl.R_C] = r_c
     fp[kl.T_LOAD] = lc.load_torque_nm
     fp[kl.LOAD_SIGN] = -math.copysign(1.0, th.ratio)
-    ip = np.array([2, out_spin, 0, 1 if star else 2], dtype=np.int64)
+    ip = np.array([2, out_spin, 0, out_body], dtype=np.int64)
     mesh_k, mesh_c = sysm.mesh_stiffness, sysm.mesh_damping
     if spec.contact.law == "impact":  # the multibody model's law, whole face width, on every mesh
         law = mesh_laws(d)["outer"]
@@ -120,7 +128,7 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
     presc = np.flatnonzero(sysm.held_spin)
     coef = np.array([(1.0 - r_c) if i == 2 else -r_c for i in presc])
     psi = params.angles
-    meshes = [geo.sun_planet, geo.planet_ring]
+    meshes = [geo.sun_planet, geo.planet_ring] if params.ring_meshes else [geo.sun_planet]  # the pair: one mesh
     nh = spec.contact_assumed.stiffness_harmonics
     eps_b = geo.sun_planet.overlap_ratio(geo.helix_face_width)
     harm, centre = [], []
@@ -131,14 +139,14 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
         harm.append(np.broadcast_to(c, (nplan, nh)))
         centre.append(np.full(nplan, 0.5 * (ea + eps_b)))
     zs, zr = g.sun_teeth, g.ring_teeth
-    phase_index = np.r_[np.full(nplan, 2), np.full(nplan, 5)].astype(np.int64)
-    phase_coef = np.r_[np.full(nplan, zs / (2 * math.pi)), np.full(nplan, -zr / (2 * math.pi))]
+    phase_index = np.r_[np.full(nplan, 2), np.full(nplan, 5)].astype(np.int64)[:nm]
+    phase_coef = np.r_[np.full(nplan, zs / (2 * math.pi)), np.full(nplan, -zr / (2 * math.pi))][:nm]
     phase_offset = np.r_[-zs * psi / (2 * math.pi),
-                         zr * psi / (2 * math.pi) + spec.gears_assumed.outer_inner_mesh_phase]
-    t_sun, t_ring = mesh_friction_tables(geo, spec.lumped_assumed.friction_table_points)
-    tables = np.stack([np.stack([t.force, t.arm1, t.arm2], axis=1) for t in (t_sun, t_ring)])
+                         zr * psi / (2 * math.pi) + spec.gears_assumed.outer_inner_mesh_phase][:nm]
+    found = mesh_friction_tables(geo, spec.lumped_assumed.friction_table_points)  # sun (and ring) mesh
+    tables = np.stack([np.stack([t.force, t.arm1, t.arm2], axis=1) for t in found])
     jn = np.stack([-sysm.mesh_direction[:, 1], sysm.mesh_direction[:, 0]], axis=1)
-    g1 = np.r_[np.full(nplan, geo.sun.base_radius), np.full(nplan, -geo.planet.base_radius)]
+    g1 = np.r_[np.full(nplan, geo.sun.base_radius), np.full(nplan, -geo.planet.base_radius)][:nm]
     v_reg = spec.contact_assumed.friction_regularisation_m_per_s
     fscale = geo.sun.base_pitch / (np.abs(g1) * v_reg)
     spin_support = sysm.ground_spin_stiffness
@@ -146,8 +154,8 @@ def build_lumped_model(spec: GearboxSpec | Design) -> LumpedModel:
     return LumpedModel(
         sysm, fp, ip, np.flatnonzero(sysm.free), presc, coef, np.ascontiguousarray(np.vstack(harm)),
         np.concatenate(centre), phase_index, phase_coef, phase_offset,
-        np.full(2 * nplan, geo.sun_planet.normal_backlash), np.ascontiguousarray(tables),
-        np.r_[np.zeros(nplan), np.ones(nplan)].astype(np.int64), np.ascontiguousarray(jn), g1, fscale, ground,
+        np.full(nm, geo.sun_planet.normal_backlash), np.ascontiguousarray(tables),
+        np.r_[np.zeros(nplan), np.ones(nplan)].astype(np.int64)[:nm], np.ascontiguousarray(jn), g1, fscale, ground,
         spin_support, mesh_k, mesh_c,
     )
 
@@ -379,14 +387,13 @@ def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: 
     model = build_lumped_model(d)
     rec = _simulate(model, t_end, lc.step_size_s, spec.lumped_assumed.integration_substeps, progress)
     wall, cpu = time.perf_counter() - wall0, time.process_time() - cpu0
-    n = model.system.params.planet_count
-    nm = 2 * n
+    n, nm = model.system.params.planet_count, model.system.params.mesh_count
     t = np.arange(rec.shape[0]) * lc.step_size_s
     w_in, w_out = rec[:, 0], rec[:, 1]  # rad/s
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(w_in != 0.0, w_out / w_in, np.nan)
     data = np.column_stack([t, w_in, w_out, ratio, rec[:, 2], rec[:, 3:3 + nm], rec[:, 3 + nm:7 + nm]])
-    signals = pd.DataFrame(data, columns=signal_columns(n))
+    signals = pd.DataFrame(data, columns=signal_columns(n, inner=model.system.params.ring_meshes))
     meta = run_metadata("lumped", "lumped", spec_hash(spec, "lumped", t_end), t_end, lc, n, {}, d.theory,
                         status="ok", reason="", wall_time_s=wall, cpu_time_s=cpu,
                         integration={"method": "rk4", "substeps": spec.lumped_assumed.integration_substeps})
@@ -394,7 +401,8 @@ def run_lumped(spec: GearboxSpec, t_end_s: float | str | None = None, progress: 
 
 
 def static_mesh_forces(spec: GearboxSpec) -> tuple[np.ndarray, np.ndarray]:
-    """Normal mesh forces [N] (sun meshes, ring meshes) of the linear static problem at full load.
+    """Normal mesh forces [N] (sun meshes, ring meshes: none in the parallel-axis pair) of the linear static problem
+    at full load.
 
     Mean mesh stiffness, input spin held, load torque on the output member, no friction:
     K_ff q_f = F_f, F_m = k_m G_m . q.
