@@ -11,6 +11,14 @@
     outer_mesh_force_n = [798.1894, 800.7533, 798.1762]
     [published.table7]                   # mesh harmonic k -> bearing x acceleration at k x the mesh frequency
     mesh_1x = [0.0549, 0.0590, 0.0621, 0.0860]   # [multibody input, output, lumped input, output] [m/s^2]
+    [published.contact]                  # the impact law as the source prints it (its numbers, in its units)
+    stiffness_number = 1.0e8             # k's number, in N per (model length unit)^exponent
+    exponent = 1.5
+    damping_fraction = 1.0e-3            # c_max as a fraction of k's number
+    printed = "1.0e8 'N·m' (section 2.1)"  # how the source writes the stiffness, with where
+    penetration_depth_m = 1.0e-4
+    step_size_s = 1.0e-5
+    selection = "section 3"              # where the source names its selected (multibody) variant
 
 Every part is optional but ``source``. A gearbox file without the table gets a report without published columns.
 The table is report data, not a model input: it enters no hash (flexgear.spec.as_dict), so adding or changing it
@@ -27,12 +35,33 @@ from typing import Any
 
 from flexgear.schema_fields import SpecError
 
-__all__ = ["PublishedResults", "TABLE6_ROWS", "published_table"]
+__all__ = ["PublishedResults", "PublishedContact", "TABLE6_ROWS", "published_table"]
 
 TABLE6_ROWS = ("input_speed_deg_per_s", "output_speed_deg_per_s", "outer_mesh_force_n", "inner_mesh_force_n",
                "input_bearing_peak_accel_m_per_s2", "output_bearing_peak_accel_m_per_s2")
 """The rows a ``[published.table6]`` may give: the report's Table 6 indicators (flexgear.report.result_pages)."""
 _HARMONIC = re.compile(r"^mesh_(\d+)x$")
+
+
+@dataclass(frozen=True)
+class PublishedContact:
+    """The source's impact law as it prints it (``[published.contact]``): F = k delta^e with k's ``stiffness_number``
+    in N per (its model's length unit)^``exponent``, c_max ``damping_fraction`` of that number (N s per length
+    unit); ``printed``: the stiffness in the source's words; ``penetration_depth_m`` [m], ``step_size_s`` [s] (NaN:
+    not given); ``selection``: where the source names its selected variant. Which length unit the number is in is
+    what the report's reading pages weigh (flexgear.report.reading_pages)."""
+
+    stiffness_number: float
+    exponent: float
+    damping_fraction: float
+    printed: str = ""
+    penetration_depth_m: float = math.nan
+    step_size_s: float = math.nan
+    selection: str = ""
+
+    def __repr__(self) -> str:  # NaN written out: two reads of one file compare equal (PublishedResults._key)
+        return (f"PublishedContact({self.stiffness_number!r}, {self.exponent!r}, {self.damping_fraction!r}, "
+                f"{self.printed!r}, {str(self.penetration_depth_m)}, {str(self.step_size_s)}, {self.selection!r})")
 
 
 @dataclass(frozen=True, eq=False)
@@ -48,12 +77,14 @@ class PublishedResults:
     wall_time_s: dict[str, float] = field(default_factory=dict)
     table6: dict[str, tuple[float, float, float]] = field(default_factory=dict)
     table7: dict[int, tuple[float, float, float, float]] = field(default_factory=dict)
+    contact: PublishedContact | None = None
 
     def _key(self) -> str:
         """The content with NaN written out (NaN is not equal to itself: two reads of one file must compare
         equal)."""
         return repr((self.source, self.multibody_variant, self.ramp_time_s, self.simulated_time_s,
-                     sorted(self.wall_time_s.items()), sorted(self.table6.items()), sorted(self.table7.items())))
+                     sorted(self.wall_time_s.items()), sorted(self.table6.items()), sorted(self.table7.items()),
+                     self.contact))
 
     def __eq__(self, other: object) -> bool:
         return isinstance(other, PublishedResults) and self._key() == other._key()
@@ -74,7 +105,8 @@ def published_table(path: Path, raw: Any) -> PublishedResults | None:
     name = "published"
     if not isinstance(raw, dict):
         raise SpecError(path, name, "expected a table (module flexgear.schema_published)", raw)
-    allowed = ("source", "multibody_variant", "ramp_time_s", "simulated_time_s", "wall_time_s", "table6", "table7")
+    allowed = ("source", "multibody_variant", "ramp_time_s", "simulated_time_s", "wall_time_s", "table6", "table7",
+               "contact")
     unknown = sorted(set(raw) - set(allowed))
     if unknown:
         raise SpecError(path, f"{name}.{unknown[0]}", f"unknown field; allowed: {', '.join(allowed)}")
@@ -102,7 +134,28 @@ def published_table(path: Path, raw: Any) -> PublishedResults | None:
             raise SpecError(path, f"{name}.table7.{key}", "expected mesh_<k>x, k >= 1 the mesh harmonic")
         table7[int(match.group(1))] = _numbers(path, f"{name}.table7.{key}", values, 4)
     return PublishedResults(source, variant, *(times.get(k, math.nan) for k in ("ramp_time_s", "simulated_time_s")),
-                            walls, table6, dict(sorted(table7.items())))
+                            walls, table6, dict(sorted(table7.items())), _contact(path, f"{name}.contact",
+                                                                                   raw.get("contact")))
+
+
+def _contact(path: Path, field_name: str, raw: Any) -> PublishedContact | None:
+    """``[published.contact]`` (None when absent), checked."""
+    if raw is None:
+        return None
+    raw = _table(path, field_name, raw)
+    numbers = ("stiffness_number", "exponent", "damping_fraction", "penetration_depth_m", "step_size_s")
+    texts = ("printed", "selection")
+    unknown = sorted(set(raw) - set(numbers) - set(texts))
+    if unknown:
+        raise SpecError(path, f"{field_name}.{unknown[0]}", f"unknown field; allowed: {', '.join(numbers + texts)}")
+    for key in numbers[:3]:
+        if key not in raw:
+            raise SpecError(path, f"{field_name}.{key}", "missing (required in [published.contact])")
+    values = {k: _number(path, f"{field_name}.{k}", raw[k], positive=True) for k in numbers if k in raw}
+    for key in texts:
+        if key in raw and not isinstance(raw[key], str):
+            raise SpecError(path, f"{field_name}.{key}", "expected a string", raw[key])
+    return PublishedContact(**values, **{k: raw[k] for k in texts if k in raw})
 
 
 def _table(path: Path, field_name: str, raw: Any) -> dict:

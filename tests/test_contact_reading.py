@@ -1,6 +1,6 @@
-"""The study's contact stiffness under both readings of its unit (section 2.1), without simulation: the millimetre
-reading's variant files against the analytic unit conversion, both readings' static deflection, and the report page
-of flexgear.report.reading_pages on synthetic results folders."""
+"""The study's contact stiffness under both readings of its unit (section 2.1, ``[published.contact]`` of the study's
+gearbox file), without simulation: the millimetre reading's variant files against the analytic unit conversion, both
+readings' static deflection, and the report page of flexgear.report.reading_pages on synthetic results folders."""
 
 from __future__ import annotations
 
@@ -31,7 +31,9 @@ from flexgear.spec import load_variant
 
 MM_FOLDER = VARIANTS / "quick_mm_reading"
 QUICK_FOLDER = VARIANTS / "quick"
+PUBLISHED = load_variant(QUICK_FOLDER / "model1.toml").gearbox.published.contact
 STUDY_NUMBER = 1.0e8                       # section 2.1: "1.0x10^8 N*m"
+EXPONENT, FRACTION = 1.5, 1.0e-3           # section 2.1: "nonlinear coefficient" 1.5, damping "0.1 %" of stiffness
 K_MM_ANALYTIC = 1.0e8 * 10.0**4.5          # 1e8 N/mm^1.5 = 1e8 (1e3)^1.5 N/m^1.5 = 3.1622776601683795e12
 C_MM_ANALYTIC = 1.0e8                      # 0.1 % of 1e8 = 1e5 N s/mm = 1e8 N s/m
 STUDY_FORCE_N = load_variant(QUICK_FOLDER / "model1.toml").gearbox.published.table6["outer_mesh_force_n"][0]
@@ -46,11 +48,11 @@ def test_mm_reading_variant_holds_the_converted_law(n: int) -> None:
     quick = load_variant(QUICK_FOLDER / f"model{n}.toml")
     c = mm.gearbox.contact
     assert c.stiffness == pytest.approx(K_MM_ANALYTIC, rel=1e-12)
-    assert c.stiffness == pytest.approx(stiffness_n_per_m_exp(STUDY_NUMBER, 1e-3), rel=1e-12)
+    assert c.stiffness == pytest.approx(stiffness_n_per_m_exp(STUDY_NUMBER, 1e-3, EXPONENT), rel=1e-12)
     assert c.stiffness == pytest.approx(3.162e12, rel=1e-3)
     law = ContactLaw.from_contact(c)
     assert law.damping_max == pytest.approx(C_MM_ANALYTIC, rel=1e-12)
-    assert law.damping_max == pytest.approx(damping_n_s_per_m(STUDY_NUMBER, 1e-3), rel=1e-12)
+    assert law.damping_max == pytest.approx(damping_n_s_per_m(STUDY_NUMBER, 1e-3, FRACTION), rel=1e-12)
     assert c.damping_fraction_of_stiffness == pytest.approx(3.162e-5, rel=1e-3)
     assert (c.exponent, c.penetration_depth_m, c.law) == (1.5, 1.0e-4, "impact")
     assert c.friction_coefficient == quick.gearbox.contact.friction_coefficient
@@ -66,8 +68,16 @@ def test_project_reading_is_the_study_number_in_si() -> None:
     """The project's reading: k = 1e8 N/m^1.5 and c_max = 0.1 % of it, 1e5 N s/m (unit conversions with a 1 m
     length unit are the identity)."""
     c = load_variant(QUICK_FOLDER / "model1.toml").gearbox.contact
-    assert c.stiffness == stiffness_n_per_m_exp(STUDY_NUMBER, 1.0) == 1.0e8
-    assert ContactLaw.from_contact(c).damping_max == pytest.approx(damping_n_s_per_m(STUDY_NUMBER, 1.0)) == 1.0e5
+    assert c.stiffness == stiffness_n_per_m_exp(STUDY_NUMBER, 1.0, EXPONENT) == 1.0e8
+    assert ContactLaw.from_contact(c).damping_max == pytest.approx(damping_n_s_per_m(STUDY_NUMBER, 1.0, FRACTION)) \
+        == 1.0e5
+
+
+def test_the_study_file_publishes_its_law_as_printed() -> None:
+    """``[published.contact]`` of the study's gearbox file: section 2.1's number, exponent and damping fraction."""
+    assert (PUBLISHED.stiffness_number, PUBLISHED.exponent, PUBLISHED.damping_fraction) == (
+        STUDY_NUMBER, EXPONENT, FRACTION)
+    assert (PUBLISHED.penetration_depth_m, PUBLISHED.step_size_s) == (1.0e-4, 1.0e-5)
 
 
 @pytest.mark.parametrize("folder", [QUICK_FOLDER, MM_FOLDER])
@@ -96,7 +106,7 @@ ACCEL_SCALE = {READING_M: 10.0, READING_MM: 1.0}   # the N/m^1.5 folder's bearin
 def _folder(root: Path, reading: str) -> Path:
     """A results folder of synthetic runs (model4, model7 and a lumped run) under ``reading``: the study's Table 7
     amplitudes scaled by ACCEL_SCALE, a constant TE, a verdict.csv."""
-    k = stiffness_n_per_m_exp(STUDY_NUMBER, {READING_M: 1.0, READING_MM: 1e-3}[reading])
+    k = stiffness_n_per_m_exp(STUDY_NUMBER, {READING_M: 1.0, READING_MM: 1e-3}[reading], EXPONENT)
     contact = {"stiffness": k, "exponent": 1.5, "damping_fraction_of_stiffness": 1e8 / k if reading == READING_MM
                else 1e-3, "penetration_depth_m": 1e-4, "friction_coefficient": 0.02, "law": "impact"}
     out = root / reading.replace("/", "_").replace("^", "")
@@ -134,12 +144,12 @@ def test_contact_reading_pages_on_synthetic_folders(folders: dict[str, Path]) ->
         v = reading_values(case, reading)
         assert v.law["model7: static loaded TE (window mean) [µm]"] == pytest.approx(1e6 * TE_M[reading])
         force = v.law["model7: mean outer mesh force [N]"]
-        k = stiffness_n_per_m_exp(STUDY_NUMBER, {READING_M: 1.0, READING_MM: 1e-3}[reading])
-        assert v.law["law: static outer mesh deflection (F/k)^(2/3) [µm]"] == pytest.approx(
+        k = stiffness_n_per_m_exp(STUDY_NUMBER, {READING_M: 1.0, READING_MM: 1e-3}[reading], EXPONENT)
+        assert v.law["law: static outer mesh deflection (F/k)^(1/1.5) [µm]"] == pytest.approx(
             1e6 * (force / k) ** (2.0 / 3.0), rel=1e-9)
-        t7 = v.tables["T7 model4 vs study ADAMS: input bearing 1× mesh [m/s²]"]
-        assert t7 == pytest.approx(ACCEL_SCALE[reading] * v.study["T7 model4 vs study ADAMS: input bearing 1× mesh "
-                                                                  "[m/s²]"], rel=1e-3)
+        t7 = v.tables["T7 model4 vs source multibody: input bearing 1× mesh [m/s²]"]
+        assert t7 == pytest.approx(ACCEL_SCALE[reading] * v.study["T7 model4 vs source multibody: input bearing 1× "
+                                                                  "mesh [m/s²]"], rel=1e-3)
         assert v.verdicts["all purposes"] == "none, NOT RESOLVED"
     assert reading_values(m, READING_M).verdicts["mean_loads"] == "model4 (excellent)"
     assert reading_values(mm, READING_MM).verdicts["mean_loads"] == "model7 (excellent)"
@@ -154,6 +164,6 @@ def test_contact_reading_pages_on_synthetic_folders(folders: dict[str, Path]) ->
             texts += [t.get_text() for ax in fig.axes for t in ax.texts]
             texts += [c.get_text().get_text() for ax in fig.axes for tab in ax.tables for c in tab.get_celld().values()]
         text = " ".join(" ".join(texts).split())
-        assert f"the {READING_MM} reading reproduces the study better" in text
+        assert "the N/mm^1.5 reading reproduces the source better" in text
         assert "model7 (excellent)" in text and "model4 (excellent)" in text
         assert "900" in text and "15" in text    # both static TEs [um]

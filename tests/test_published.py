@@ -39,6 +39,10 @@ def test_the_studys_published_values_are_read_and_enter_no_hash(tmp_path):
     ('source = "x"\n[published.table7]\nmesh_0x = [1.0, 2.0, 3.0, 4.0]', "published.table7.mesh_0x", "mesh_<k>x"),
     ('source = "x"\n[published.wall_time_s]\nmodel1 = 3.0', "published.simulated_time_s", "missing"),
     ('source = "x"\nramp_time_s = -1.0', "published.ramp_time_s", "> 0"),
+    ('source = "x"\n[published.contact]\nexponent = 1.5\ndamping_fraction = 1e-3', "published.contact.stiffness_number",
+     "missing"),
+    ('source = "x"\n[published.contact]\nstiffness_number = 1e8\nexponent = 1.5\ndamping_fraction = 1e-3\nunit = 1',
+     "published.contact.unit", "unknown field"),
 ])
 def test_a_wrong_published_table_is_refused_in_one_line(tmp_path, table, field, words):
     path = tmp_path / "gearbox.toml"

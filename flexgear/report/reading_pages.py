@@ -1,10 +1,11 @@
-"""The study's contact stiffness under both readings of its unit (section 2.1): a report page.
+"""A source study's contact stiffness under both readings of its length unit: a report page.
 
-Section 2.1 prints the impact law's contact stiffness as "1.0×10^8 N·m", which is no stiffness unit. The project reads
-the number as N/m^1.5 (``model_variants/gearbox.toml [contact]``). ADAMS models are commonly built in millimetres and
-ADAMS's IMPACT law F = k delta^e depends on the length unit, so there the number means N/mm^1.5: 1000^1.5 times
-stiffer in SI, with the damping "0.1 % of the contact stiffness" 1e5 N s/mm = 1e8 N s/m
-(``model_variants/quick_mm_reading/``). :func:`contact_reading_pages` sets the results folders of the two readings
+A source may print its impact law's stiffness number without a usable unit (the GTF study's section 2.1: "1.0×10^8
+N·m"; ``[published.contact]`` of the gearbox file gives the number, the exponent e, the damping fraction and how it
+is printed). Multibody codes such as ADAMS are commonly run in millimetres, and the IMPACT law F = k delta^e depends
+on the length unit: the number read in N/mm^e is 1000^e times stiffer in SI than read in N/m^e, with the damping
+"fraction of the stiffness" fraction x number N s/mm (for the GTF study 1e5 N s/mm = 1e8 N s/m,
+``model_variants/quick_mm_reading/``). :func:`contact_reading_pages` sets the results folders of the two readings
 side by side:
 
 - the reference variant's static loaded transmission error (mean of ``transmission_error_m`` over its settled window,
@@ -16,8 +17,9 @@ side by side:
   file) and the lumped run, beside the study's published ADAMS and lumped columns (``[published]``: without it, no
   page);
 - each reading's verdict per purpose (``verdict.csv`` of the results folder);
-- one sentence naming the reading whose Tables 6-7 lie closer to the study's, by the mean absolute decimal
-  log-ratio of the values to the study's (:func:`log_distance`).
+- one sentence naming the reading whose Tables 6-7 lie closer to the source's, by the mean absolute decimal
+  log-ratio of the values to the source's (:func:`log_distance`).
+Without ``[published.contact]`` (or without ``[published]``) there is no page.
 """
 
 from __future__ import annotations
@@ -36,40 +38,31 @@ from flexgear.report.data import ReportData
 from flexgear.report.figures import fmt
 from flexgear.report.layout import Page, table_pages
 from flexgear.results import RunResult
+from flexgear.schema_published import PublishedContact
 from flexgear.spec import Contact
 from flexgear.study.compare import TABLE7_HARMONICS, compare_results
 from flexgear.study.purposes import static_te_split
 
 __all__ = ["contact_reading_pages", "reading_of", "stiffness_n_per_m_exp", "damping_n_s_per_m", "log_distance",
-           "ReadingValues", "reading_values", "READINGS", "READING_M", "READING_MM", "STUDY_STIFFNESS_NUMBER",
-           "STUDY_DAMPING_FRACTION", "STUDY_EXPONENT"]
+           "ReadingValues", "reading_values", "READINGS", "READING_M", "READING_MM"]
 
-STUDY_STIFFNESS_NUMBER = 1.0e8
-"""Section 2.1: the contact stiffness's number, printed as "1.0×10^8 N·m" (unit of the model's length^exponent)."""
-
-STUDY_DAMPING_FRACTION = 1.0e-3
-"""Section 2.1: the damping coefficient "0.1 % of the contact stiffness value" (in the model's units)."""
-
-STUDY_EXPONENT = 1.5
-"""Section 2.1: the impact law's "nonlinear coefficient" (exponent, unitless)."""
-
-READING_M, READING_MM = "N/m^1.5", "N/mm^1.5"
+READING_M, READING_MM = "N/m^e", "N/mm^e"
 READINGS: dict[str, float] = {READING_M: 1.0, READING_MM: 1.0e-3}
-"""Each reading of the study's stiffness unit -> the model's length unit [m] (metre, millimetre)."""
+"""Each reading of a source's stiffness unit -> the model's length unit [m] (metre, millimetre)."""
 
 
 _REL_TOL = 1e-6   # a run's saved stiffness matches a reading within this relative tolerance
 _TE_UM, _F_N = "µm", "N"
 
 
-def stiffness_n_per_m_exp(number: float, length_unit_m: float, exponent: float = STUDY_EXPONENT) -> float:
+def stiffness_n_per_m_exp(number: float, length_unit_m: float, exponent: float) -> float:
     """The impact law's stiffness in SI [N/m^exponent] of ``number`` given in N per (model length unit)^exponent,
     ``length_unit_m`` the model's length unit [m]: F = number (delta / unit)^e, so k = number / unit^e (a millimetre
     model: number 1000^e)."""
     return number / length_unit_m**exponent
 
 
-def damping_n_s_per_m(number: float, length_unit_m: float, fraction: float = STUDY_DAMPING_FRACTION) -> float:
+def damping_n_s_per_m(number: float, length_unit_m: float, fraction: float) -> float:
     """The impact law's maximum damping in SI [N s/m] when it is ``fraction`` of the stiffness ``number`` in the
     model's units (N s per model length unit): c = fraction number / unit (a millimetre model: 0.1 % of 1e8 is
     1e5 N s/mm = 1e8 N s/m)."""
@@ -87,12 +80,15 @@ def _stiffnesses(case: ReportData) -> set[float]:
 
 
 def reading_of(case: ReportData) -> str | None:
-    """The reading (:data:`READINGS`) of the study's stiffness number whose SI value every impact-law run of
-    ``case`` carries (``run.meta["spec"]["contact"]["stiffness"]``); None when the runs carry another value, several,
-    or none."""
+    """The reading (:data:`READINGS`) of the source's stiffness number (``[published.contact]`` of the case's gearbox
+    file) whose SI value every impact-law run of ``case`` carries (``run.meta["spec"]["contact"]["stiffness"]``);
+    None when the runs carry another value, several, or none, or the gearbox file gives no published law."""
+    pub = case.gearbox.published
+    if pub is None or pub.contact is None:
+        return None
     ks = _stiffnesses(case)
     for name, unit in READINGS.items():
-        target = stiffness_n_per_m_exp(STUDY_STIFFNESS_NUMBER, unit)
+        target = stiffness_n_per_m_exp(pub.contact.stiffness_number, unit, pub.contact.exponent)
         if ks and all(math.isclose(k, target, rel_tol=_REL_TOL) for k in ks):
             return name
     return None
@@ -148,8 +144,9 @@ def _law_rows(case: ReportData, out: ReadingValues) -> None:
     names = {f.name for f in dataclasses.fields(Contact)}
     law = ContactLaw.from_contact(Contact(**{k: v for k, v in spec_contact.items() if k in names})) \
         if spec_contact else None
+    e = case.gearbox.published.contact.exponent
     out.law["results folder"] = case.results_dir.name
-    out.law["contact stiffness k [N/m^1.5]"] = law.stiffness if law else math.nan
+    out.law[f"contact stiffness k [N/m^{e:g}]"] = law.stiffness if law else math.nan
     out.law["maximum damping c_max [N s/m]"] = law.damping_max if law else math.nan
     out.law["penetration (cutting) depth [m]"] = law.penetration_depth if law else math.nan
     steps = sorted({float(r.meta["step_size_s"]) for r in case.runs.values() if r.meta.get("step_size_s")})
@@ -172,9 +169,9 @@ def _law_rows(case: ReportData, out: ReadingValues) -> None:
     for m, f in forces.items():
         out.law[f"{ref_name}: mean {m} mesh force [{_F_N}]"] = f
     for m in forces:
-        out.law[f"law: static {m} mesh deflection (F/k)^(2/3) [{_TE_UM}]"] = 1e6 * deflection[m]
+        out.law[f"law: static {m} mesh deflection (F/k)^(1/{e:g}) [{_TE_UM}]"] = 1e6 * deflection[m]
     for m, f in forces.items():
-        out.law[f"law: {m} mesh tangent stiffness 1.5 F/delta [N/m]"] = (
+        out.law[f"law: {m} mesh tangent stiffness {e:g} F/delta [N/m]"] = (
             effective_stiffness(f, law) if known[m] else math.nan)
     beta_b = as_design(case.gearbox).gears.sun_planet.gear1.base_helix_angle
     split = static_te_split(te_m, deflection["outer"], deflection["inner"], beta_b)
@@ -207,7 +204,7 @@ def _table_rows(case: ReportData, out: ReadingValues) -> None:
     multibody column and of the lumped run against the lumped column (Table 6: column 1 and 2; Table 7: columns 0-1
     and 2-3)."""
     pub = case.gearbox.published
-    runs = {pub.multibody_variant: (case.runs.get(pub.multibody_variant), 1, 0, "ADAMS"),
+    runs = {pub.multibody_variant: (case.runs.get(pub.multibody_variant), 1, 0, "multibody"),
             "lumped": (case.lumped, 2, 2, "lumped")}
     for name, (r, col6, col7, who) in runs.items():
         t6: dict[str, float] = {}
@@ -223,12 +220,12 @@ def _table_rows(case: ReportData, out: ReadingValues) -> None:
             except (ValueError, KeyError) as exc:
                 out.notes.append(f"{case.results_dir.name}: {name} not in Tables 6-7 ({exc})")
         for key, label in _T6_LABELS.items():
-            row = f"T6 {name} vs study {who}: {label}"
+            row = f"T6 {name} vs source {who}: {label}"
             out.tables[row] = float(t6.get(key, math.nan))
             out.study[row] = pub.table6[key][col6] if key in pub.table6 else math.nan
         for k in TABLE7_HARMONICS:
             for j, side in enumerate(("input", "output")):
-                row = f"T7 {name} vs study {who}: {side} bearing {k}× mesh [m/s²]"
+                row = f"T7 {name} vs source {who}: {side} bearing {k}× mesh [m/s²]"
                 out.tables[row] = t7.get((k, side), math.nan)
                 out.study[row] = pub.table7[k][col7 + j] if k in pub.table7 else math.nan
 
@@ -279,71 +276,92 @@ def _case_words(case: ReportData | None) -> str:
     return f"{case.results_dir.name}, ramps {ramps} s" if ramps else case.results_dir.name
 
 
-def _sentence(m: ReadingValues | None, mm: ReadingValues, keys: list[str]) -> str:
-    """Which reading reproduces the study's Tables 6-7 better, by :func:`log_distance` over ``keys``."""
+def _sentence(m: ReadingValues | None, mm: ReadingValues, keys: list[str], names: dict[str, str]) -> str:
+    """Which reading reproduces the source's Tables 6-7 better, by :func:`log_distance` over ``keys`` (``names``: each
+    reading's label with the source's exponent)."""
     e_mm = log_distance(mm.tables, mm.study, keys)
+    r_m, r_mm = names[READING_M], names[READING_MM]
     if m is None:
-        return (f"Only the {READING_MM} reading was run: its Tables 6-7 lie a mean |log10(ours/study)| of "
-                f"{e_mm:.3g} decades from the study's; no {READING_M} folder to set beside it.")
+        return (f"Only the {r_mm} reading was run: its Tables 6-7 lie a mean |log10(ours/source)| of "
+                f"{e_mm:.3g} decades from the source's; no {r_m} folder to set beside it.")
     e_m = log_distance(m.tables, m.study, keys)
     if not (np.isfinite(e_m) and np.isfinite(e_mm)):
         return "No Table 6-7 value is there for both readings: no comparison."
-    better = READING_MM if e_mm < e_m else READING_M
+    better = r_mm if e_mm < e_m else r_m
     lo, hi = min(e_m, e_mm), max(e_m, e_mm)
     by_table = ", ".join(
         f"Table {n} alone {log_distance(m.tables, m.study, part):.3g} / {log_distance(mm.tables, mm.study, part):.3g}"
         for n in (6, 7) if (part := [k for k in keys if k.startswith(f"T{n} ")]))
-    return (f"Over the {len(keys)} Table 6-7 values both readings give ({mm.multibody} against the study's "
-            f"ADAMS column, the lumped run against its lumped column) the mean |log10(ours/study)| is {e_m:.3g} "
-            f"decades under the {READING_M} reading and {e_mm:.3g} under the {READING_MM} reading: the {better} "
-            f"reading reproduces the study better (its values a geometric-mean factor {10 ** lo:.3g} off the "
-            f"study's, against {10 ** hi:.3g}). By table ({READING_M} / {READING_MM}): {by_table}.")
+    source = mm.case.gearbox.published.source
+    return (f"Over the {len(keys)} Table 6-7 values both readings give ({mm.multibody} against the multibody column "
+            f"of {source}, the lumped run against its lumped column) the mean |log10(ours/source)| is {e_m:.3g} "
+            f"decades under the {r_m} reading and {e_mm:.3g} under the {r_mm} reading: the {better} "
+            f"reading reproduces the source better (its values a geometric-mean factor {10 ** lo:.3g} off the "
+            f"source's, against {10 ** hi:.3g}). By table ({r_m} / {r_mm}): {by_table}.")
 
 
-_STUDY_LAW = {"contact stiffness k [N/m^1.5]": "1.0e8 'N·m' (2.1)", "maximum damping c_max [N s/m]": "0.1 % of k (2.1)",
-              "penetration (cutting) depth [m]": "1.0e-4 m (2.1)", "step size [s]": "1e-5 (3.1)"}
-"""The study's value of a law row, in words with its section."""
+def _source_law(contact: PublishedContact) -> dict[str, str]:
+    """The source's value of each law row, in its own words (``[published.contact]``)."""
+    e = contact.exponent
+    out = {f"contact stiffness k [N/m^{e:g}]": contact.printed or fmt(contact.stiffness_number),
+           "maximum damping c_max [N s/m]": f"{100 * contact.damping_fraction:g} % of k"}
+    if math.isfinite(contact.penetration_depth_m):
+        out["penetration (cutting) depth [m]"] = f"{contact.penetration_depth_m:g} m"
+    if math.isfinite(contact.step_size_s):
+        out["step size [s]"] = f"{contact.step_size_s:g}"
+    return out
 
 
 def contact_reading_pages(d: ReportData, others: list[ReportData]) -> list[Page]:
-    """The two readings of the study's contact stiffness side by side (module docstring); [] unless ``d`` or one of
-    ``others`` is a millimetre-reading run (its runs' saved stiffness is 1e8 * 1000^1.5 N/m^1.5)."""
+    """The two readings of the source's contact stiffness side by side (module docstring); [] unless ``d`` or one of
+    ``others`` is a millimetre-reading run (its runs' saved stiffness is the published number times 1000^e N/m^e)
+    whose gearbox file gives ``[published.contact]``."""
     cases = [d, *others]
     mm_case = _pick(cases, READING_MM, d if reading_of(d) != READING_MM else None)
-    if mm_case is None or mm_case.gearbox.published is None:  # no published Tables 6-7 to set them beside
+    if mm_case is None or mm_case.gearbox.published is None or mm_case.gearbox.published.contact is None:
         return []
+    contact = mm_case.gearbox.published.contact
+    e = contact.exponent
+    names = {r: r.replace("^e", f"^{e:g}") for r in READINGS}
     m_case = _pick(cases, READING_M, mm_case)
     mm = reading_values(mm_case, READING_MM)
     m = reading_values(m_case, READING_M) if m_case is not None else None
     blank = ReadingValues(mm_case, READING_M)
     mv = m if m is not None else blank
-    rows = [{"quantity": "unit of section 2.1's stiffness number 1.0e8", "study": "'N·m' (as printed)",
-             READING_M: READING_M, READING_MM: READING_MM}]
+    law = _source_law(contact)
+    rows = [{"quantity": f"unit of the source's stiffness number {fmt(contact.stiffness_number)}",
+             "study": contact.printed or "–", READING_M: names[READING_M], READING_MM: names[READING_MM]}]
     for label in mm.law:
-        rows.append({"quantity": label, "study": _STUDY_LAW.get(label, "–"), READING_M: mv.law.get(label, math.nan),
+        rows.append({"quantity": label, "study": law.get(label, "–"), READING_M: mv.law.get(label, math.nan),
                      READING_MM: mm.law[label]})
     for label in mm.tables:
         rows.append({"quantity": label, "study": mm.study[label], READING_M: mv.tables.get(label, math.nan),
                      READING_MM: mm.tables[label]})
     for purpose in dict.fromkeys([*mv.verdicts, *mm.verdicts]):
-        rows.append({"quantity": f"verdict: {purpose}", "study": f"{mm.multibody} (section 3)"
-                     if purpose == "all purposes" else "–", READING_M: mv.verdicts.get(purpose, "–"),
-                     READING_MM: mm.verdicts.get(purpose, "–")})
+        chosen = f"{mm.multibody} ({contact.selection})" if contact.selection else mm.multibody
+        rows.append({"quantity": f"verdict: {purpose}", "study": chosen if purpose == "all purposes" else "–",
+                     READING_M: mv.verdicts.get(purpose, "–"), READING_MM: mm.verdicts.get(purpose, "–")})
     keys = [k for k in mm.tables if np.isfinite(mm.tables[k]) and np.isfinite(mv.tables.get(k, math.nan))]
     if m is None:
         keys = [k for k in mm.tables if np.isfinite(mm.tables[k])]
-    measure = {"quantity": "mean |log10(ours / study)| over Tables 6-7 [decades]", "study": 0.0,
+    measure = {"quantity": "mean |log10(ours / source)| over Tables 6-7 [decades]", "study": 0.0,
                READING_M: log_distance(mv.tables, mv.study, keys) if m is not None else math.nan,
                READING_MM: log_distance(mm.tables, mm.study, keys)}
     rows.append(measure)
     table = pd.DataFrame(rows, columns=["quantity", "study", READING_M, READING_MM])
     table = table.assign(**{c: [fmt(v, 4) for v in table[c]] for c in ("study", READING_M, READING_MM)})
-    table = table.rename(columns={READING_M: f"reading {READING_M}", READING_MM: f"reading {READING_MM}"})
+    table = table.rename(columns={"study": "source", READING_M: f"reading {names[READING_M]}",
+                                  READING_MM: f"reading {names[READING_MM]}"})
+    k_mm = stiffness_n_per_m_exp(contact.stiffness_number, READINGS[READING_MM], e)
+    c_mm = damping_n_s_per_m(contact.stiffness_number, READINGS[READING_MM], contact.damping_fraction)
+    printed = contact.printed or fmt(contact.stiffness_number)
     intro = " ".join([
-        f"Section 2.1's contact stiffness '1.0×10^8 N·m' read as N/m^1.5 ({_case_words(m_case)}) and as N/mm^1.5 = "
-        f"3.162e12 N/m^1.5 with c_max 1e8 N s/m ({_case_words(mm_case)}).",
-        _sentence(m, mm, keys),
+        f"The contact stiffness of {mm_case.gearbox.published.source}, {printed}, "
+        f"read as {names[READING_M]} ({_case_words(m_case)}) and as {names[READING_MM]} = {k_mm:.4g} "
+        f"{names[READING_M]} with c_max {c_mm:.3g} N s/m ({_case_words(mm_case)}).",
+        _sentence(m, mm, keys, names),
         *(["Not shown: " + "; ".join([*mv.notes, *mm.notes]) + "."] if mv.notes or mm.notes else [])])
-    return table_pages("The study's contact stiffness under both readings of its unit", table,
-                       {"quantity": 70, "study": 20, f"reading {READING_M}": 26, f"reading {READING_MM}": 26},
+    return table_pages("The source's contact stiffness under both readings of its unit", table,
+                       {"quantity": 70, "source": 20, f"reading {names[READING_M]}": 26,
+                        f"reading {names[READING_MM]}": 26},
                        [0.46, 0.12, 0.21, 0.21], intro, fontsize=7)
