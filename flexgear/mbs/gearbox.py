@@ -61,7 +61,7 @@ def mesh_contacts(spec: GearboxSpec | Design, drive_sign: float = 1.0) -> list[G
     zs, aw = g.sun_teeth, geo.centre_distance
     sigma = 1.0 if drive_sign >= 0 else -1.0
     # nominal spins per drive angle: the star's carrier fixed, the planetary's ring fixed (flexgear.theory)
-    carrier = 0.0 if g.arrangement == "star" else th.ratio
+    carrier = th.ratio if g.arrangement == "planetary" else 0.0
     spin = {"sun": 1.0, "planet": carrier - g.sun_teeth / g.planet_teeth * (1.0 - carrier),
             "ring": th.ratio if carrier == 0.0 else 0.0}
     common = dict(contact=spec.contact, contact_assumed=spec.contact_assumed, carrier_spin=carrier,
