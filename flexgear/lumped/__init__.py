@@ -1,1 +1,1 @@
-"""Lumped-parameter model of the study (eq. 1-13): parameters and assembly, time integration, modes."""
+"""Lumped-parameter model (the study's eq. 1-13, any arrangement): parameters and assembly, time integration, modes."""

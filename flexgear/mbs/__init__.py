@@ -1,1 +1,2 @@
-"""Multibody model on Exudyn: bodies, elements, gear contacts, gear trains, the study's gearbox, runs."""
+"""Multibody model on Exudyn: bodies, elements, gear contacts, gear trains, the star, planetary and parallel-axis
+stages and their connections, runs."""
