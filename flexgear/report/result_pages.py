@@ -135,7 +135,10 @@ def _refused_page(d: ReportData) -> Page:
 def diagram_pages(d: ReportData) -> list[Page]:
     """The study mode's diagram, then the reference screening's (or why it was refused): the last is the verdict's."""
     weights = dataclasses.asdict(d.settings.weights)
-    used = ", ".join(f"{name.replace('_', ' ')} {100 * w:g} %" for name, w in weights.items() if w > 0)
+    table = d.study.indicators
+    if len(table) and "weight" in table:  # the weights the screening used (rescaled where an indicator is missing)
+        weights = dict(zip(table["indicator"], table["weight"], strict=True))
+    used = ", ".join(f"{name.replace('_', ' ')} {100 * w:.4g} %" for name, w in weights.items() if w > 0)
     pages = [_diagram_page(d.study, "Westgard decision diagram, the study's mode: Bias against theory (section "
                            "2.2, Fig. 2)", f"Indicators weighted by [screening.weights] ({used}), TEa = "
                            f"{d.study.lines.tea_pct:g} %. They are fixed by kinematics and torque balance and barely "

@@ -232,7 +232,8 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
     """Screen one finished run.
 
     ``reference`` None: the study's mode, the five indicators against ``result.meta["theory"]``,
-    composite Bias and CV the weighted sums in %. Otherwise the reference variant's indicator means on their
+    composite Bias and CV the weighted sums in % (the weights of the indicators present rescaled to sum 1 where the
+    stage lacks one: the parallel-axis pair's inner mesh). Otherwise the reference variant's indicator means on their
     judging scales (:func:`reference_means`): every indicator both runs have, each Bias and CV on its scale and
     divided by its own TEa (``[screening.reference_indicators]``), composite = weighted sum in % of TEa (weights
     of the indicators present, rescaled to sum 1).
@@ -243,6 +244,9 @@ def screen_result(result: RunResult, settings: ScreeningSettings,
         theory = result.meta["theory"]
         targets = {k: float(theory[_THEORY_KEYS[k]]) for k in samples}
         weights = dataclasses.asdict(settings.weights)
+        if set(samples) < set(weights):  # an indicator the stage has not (the parallel-axis pair's inner mesh)
+            present = sum(weights[k] for k in samples)
+            weights = {k: weights[k] / present for k in samples}
         tols = dict.fromkeys(samples, (settings.allowable_total_error_pct, "relative"))
     else:
         window, samples = indicator_samples(result, settings, window=window)
