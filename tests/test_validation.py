@@ -13,7 +13,7 @@ import dataclasses
 import math
 import tomllib
 from pathlib import Path
-from typing import Any, get_type_hints
+from typing import Any, get_args, get_type_hints
 
 import pytest
 
@@ -43,12 +43,17 @@ def to_toml(data: dict[str, Any], prefix: str = "") -> str:
     return "\n".join(lines)
 
 
+def _table(hint: Any) -> type | None:
+    """The dataclass of a table field (``Bearing`` or ``Bearing | None``), None for a leaf."""
+    return next((a for a in (hint, *get_args(hint)) if dataclasses.is_dataclass(a)), None)
+
+
 def _leaves(cls: type, prefix: str) -> list[tuple[str, dataclasses.Field, Any]]:
     hints = get_type_hints(cls)
     out = []
     for f in dataclasses.fields(cls):
-        if dataclasses.is_dataclass(hints[f.name]):
-            out += _leaves(hints[f.name], f"{prefix}{f.name}.")
+        if _table(hints[f.name]) is not None:
+            out += _leaves(_table(hints[f.name]), f"{prefix}{f.name}.")
         else:
             out.append((f"{prefix}{f.name}", f, hints[f.name]))
     return out
@@ -110,6 +115,11 @@ def _has_default(f: dataclasses.Field) -> bool:
             or bool(f.metadata.get("derived")))
 
 
+ARRANGEMENT_REQUIRED = ("gears.ring_teeth", "gears.planet_count", "bearings.planet")
+"""Required by the star and planetary arrangements (the study's file is a star), left out of a parallel-axis pair's
+file (the schema gives them a default or a derived value for it): required here."""
+
+
 def _optional_ancestor(path: str) -> bool:
     """Whether a table above the leaf ``path`` has a default (its own fields then come from that default)."""
     *tables, _ = path.split(".")
@@ -118,18 +128,21 @@ def _optional_ancestor(path: str) -> bool:
     if tables[0] not in REQUIRED_TABLES:
         return True
     cls = get_type_hints(GearboxSpec)[tables[0]]
-    for name in tables[1:]:
+    for k, name in enumerate(tables[1:], 1):
         f = next(x for x in dataclasses.fields(cls) if x.name == name)
-        if _has_default(f):
+        if _has_default(f) and ".".join(tables[:k + 1]) not in ARRANGEMENT_REQUIRED:
             return True
-        cls = get_type_hints(cls)[name]
+        cls = _table(get_type_hints(cls)[name])
     return False
 
 
-REQUIRED = [path for path, f, _ in schema_fields() if f is not None and not _has_default(f)
-            and not _optional_ancestor(path)]
+def _optional(path: str, f: dataclasses.Field | None) -> bool:
+    return f is None or (_has_default(f) and path not in ARRANGEMENT_REQUIRED) or _optional_ancestor(path)
+
+
+REQUIRED = [path for path, f, _ in schema_fields() if not _optional(path, f)]
 FIELDS = {path: f for path, f, _ in schema_fields()}
-OPTIONAL = [path for path, f, _ in schema_fields() if f is None or _has_default(f) or _optional_ancestor(path)]
+OPTIONAL = [path for path, f, _ in schema_fields() if _optional(path, f)]
 
 
 def _expect(tmp_path: Path, data: dict, field: str, words: tuple[str, ...], name: str = "gearbox.toml") -> str:
