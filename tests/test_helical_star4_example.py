@@ -18,8 +18,7 @@ slide against their axial bearings, 278 and 373 Hz, damping ratio about 1 %): th
 reactions move by a few tenths of a percent with the window, hence 1 %.
 
 The all-flexible variant (the ring and output shaft reduced together, about four minutes of CPU to build) is
-checked the same way under ``make test-heavy``. Every body is built in the examples' cache, coarse meshes (the CI
-part: about half a minute of CPU).
+checked the same way. Every body is built in the examples' cache, coarse meshes.
 """
 
 from __future__ import annotations
@@ -120,7 +119,7 @@ def test_rigid_and_flexible_gears_variants_meet_hand_theory(tmp_path, example_ca
             assert abs(planet) < 0.01 * axial, (name, i)
 
 
-@pytest.mark.heavy  # the tied ring and output shaft's reduction: about four minutes of CPU (make test-heavy)
+@pytest.mark.slow  # the tied ring and output shaft's reduction: about four minutes of CPU
 def test_all_flexible_variant_meets_hand_theory(tmp_path, example_cache, gearbox):
     from flexgear.cli import main
     from flexgear.results import load_result
