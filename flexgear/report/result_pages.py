@@ -243,10 +243,13 @@ def overlay_pages(d: ReportData) -> list[Page]:
     pages = []
     targets = dict.fromkeys(("outer_mesh_force", "inner_mesh_force"), th.get("mesh_force_n"))
     targets |= {k: np.degrees(th[f"{k}_rad_per_s"]) for k in ("input_speed", "output_speed") if f"{k}_rad_per_s" in th}
+    pair = not d.gearbox.gears.has_ring
     for kind, (title, ylabel) in SIGNAL_TYPES.items():
         having = {n: r for n, r in runs.items() if r.has(kind)}
         if not having or kind == "input_speed":
             continue
+        if pair and kind == "outer_mesh_force":  # the parallel-axis pair's one mesh: pinion and wheel
+            title = "mesh force (pinion-wheel)"
 
         def draw(fig: Figure, kind=kind, having=having, ylabel=ylabel) -> None:
             top = fig.add_axes([0.1, 0.53, 0.87, 0.36])
