@@ -101,18 +101,20 @@ def _given(given: dict[str, Any], name: str, default: float) -> float:
 def _root_diameters_mm(g: GearSet, a: GearSetAssumed) -> tuple[float, float, float]:
     """Root diameters [mm] of sun, planet and ring, profile-shifted to the operating centre distance; unshifted
     sun and ring where that distance cannot be reached (the feasibility check then refuses the set by name)."""
-    if not g.has_ring:  # the parallel-axis pair: the ring's sizes (unused) follow the wheel as if it were a ring
-        gs = gear_set_geometry_of(g, a)
-        return (2 * gs.sun.root_radius / _MM, 2 * gs.planet.root_radius / _MM,
-                2 * (gs.planet.tip_radius + 2 * g.normal_module_m) / _MM)
     try:
         gs = gear_set_geometry_of(g, a)
     except ValueError:
         mt, m = g.normal_module_mm / math.cos(g.helix_angle_rad), g.normal_module_mm
         shifts = (0.0, a.planet_shift_coefficient, 0.0)
-        return tuple(mt * z + (1 if internal else -1) * 2 * m * (a.dedendum_coefficient - x)
-                     for z, x, internal in zip((g.sun_teeth, g.planet_teeth, g.ring_teeth), shifts,
-                                               (False, False, True), strict=True))
+        sun, planet, ring = (mt * z + (1 if internal else -1) * 2 * m * (a.dedendum_coefficient - x)
+                             for z, x, internal in zip((g.sun_teeth, g.planet_teeth, g.ring_teeth), shifts,
+                                                       (False, False, True), strict=True))
+        if not g.has_ring:  # the wheel's tip circle plus two modules (module docstring)
+            ring = planet + 2 * m * (a.dedendum_coefficient + a.addendum_coefficient + 2.0)
+        return sun, planet, ring
+    if not g.has_ring:  # the parallel-axis pair: the ring's sizes (unused) follow the wheel as if it were a ring
+        return (2 * gs.sun.root_radius / _MM, 2 * gs.planet.root_radius / _MM,
+                2 * (gs.planet.tip_radius + 2 * g.normal_module_m) / _MM)
     return tuple(2 * getattr(gs, n).root_radius / _MM for n in ("sun", "planet", "ring"))
 
 

@@ -101,6 +101,7 @@ def test_the_example_file_gives_gears_helix_layout_bearings_and_load_case(gearbo
 
 
 @pytest.mark.parametrize(("table", "line", "field"), [
+    ("gears_assumed", "operating_centre_distance_mm = 100.0", "gears_assumed.operating_centre_distance_mm"),
     ("gears", "ring_teeth = 200", "gears.ring_teeth"),
     ("gears", "planet_count = 2", "gears.planet_count"),
     ("gears", "planet_positions_deg = [0.0]", "gears.planet_positions_deg"),

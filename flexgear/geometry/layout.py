@@ -146,11 +146,14 @@ def geometry_hash(spec: GearboxSpec, *extra: object) -> str:
 
     A gear set with a helix that is not swept in one piece in metres (:func:`helix_sweep`) also hashes its
     sweeps: such solids were swept in one piece before (or could not be built), so earlier cache entries are not
-    reused; every other key, the study's among them, is unchanged.
+    reused; a parallel-axis pair hashes its shafts' straddle rule (:data:`NEAR_SEAT_GAP_PER_WIDTH`); every other key,
+    the study's among them, is unchanged.
     """
     sweeps = _helix_sweeps(spec)
     construction = () if all(w.plain for w in sweeps) else (
         ("precise_sweeps", *((w.pieces, w.scale) for w in sweeps)),)
+    if not spec.gears.has_ring:  # the parallel-axis pair's shafts reach to their near bearing seats
+        construction = (*construction, ("straddle", NEAR_SEAT_GAP_PER_WIDTH))
     return spec_hash(spec.gears, spec.gears_assumed, spec.components_assumed, spec.material_assumed,
                      GEOMETRY_VERSION, *construction, *extra, *_imported_files(spec, extra))
 
