@@ -50,6 +50,12 @@ EXACT = 1e-9  # closed forms of the linear model: round-off only
 SETTLED_WINDOW_S = 0.02  # the last 0.02 s of the example's run: 25 mesh cycles at 3000 rpm (f_m = 1250 Hz)
 
 
+@pytest.fixture(autouse=True)
+def _private_cache(example_cache):
+    """Every cache entry (the exact mass properties) in the examples' cache of the run, not the project's."""
+    return example_cache
+
+
 @pytest.fixture(scope="module")
 def pair():
     """The pair without tooth friction (the loss-free theory's scope)."""
