@@ -36,7 +36,8 @@ from flexgear.mbs.elements import (
 from flexgear.spec import COMPONENT_GEOMETRY, GearboxSpec, Variant
 
 __all__ = ["GearboxModel", "helix_halves", "mesh_contacts", "build_star_gearbox", "mass_source_of", "dynamic_modes",
-           "run_cost", "add_component", "component_sources", "joint_axes", "linear_frame_tolerance"]
+           "run_cost", "add_component", "component_sources", "joint_axes", "linear_frame_tolerance",
+           "add_gear_and_shaft", "dynamic_cutoff_hz"]
 
 
 def helix_halves(geo: GearSetGeometry) -> list[tuple[float, int, float]]:
@@ -153,7 +154,7 @@ def run_cost(variant: Variant) -> float | None:
 
     d = as_design(variant.gearbox)
     spec = d.spec
-    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * d.theory.mesh_frequency
+    cutoff = dynamic_cutoff_hz(d)
     cost = 0.0
     for component, form in variant.components.items():
         if form != "flexible":
@@ -242,6 +243,35 @@ def add_component(mbs, name: str, form: str, geometry: str, position: np.ndarray
     return replace(body, dropped=cache[geometry])
 
 
+def dynamic_cutoff_hz(d: Design) -> float:
+    """The frequency [Hz] below which a gear's modes stay coordinates (``[reduction_assumed]
+    dynamic_cutoff_mesh_orders`` times the load case's mesh frequency; 0: every mode dynamic)."""
+    return d.spec.reduction_assumed.dynamic_cutoff_mesh_orders * d.theory.mesh_frequency
+
+
+def add_gear_and_shaft(mbs, d: Design, name: str, gear: str, gear_form: str, shaft: str, shaft_form: str,
+                       spin_rad_s: float, centre: np.ndarray, props: MassSource, reduced: ReducedSource, level: str,
+                       dropped: dict, superelements: bool, contacts: list[GearContact],
+                       bearing_points: dict[str, list[np.ndarray]] | None = None,
+                       ) -> tuple[Body, Body, list[FixedJointElement]]:
+    """A gear and its shaft as two bodies at ``centre`` [m] (:func:`add_component`, the gear named ``name``) and
+    their fixed joints (flexgear.fe.reduced.gear_shaft_joints, points in the gear's frame, the joints' at ``centre``
+    plus them): (gear body, shaft body, joints). The shaft carries its ``d.supports[shaft]`` bearing and any
+    ``bearing_points``; the gear keeps its modes below :func:`dynamic_cutoff_hz`."""
+    from flexgear.fe.reduced import gear_shaft_joints
+
+    found = gear_shaft_joints(d, gear)
+    joints = [FixedJointElement.gear_shaft(name, shaft, (a, b, centre + p)) for a, b, p in found]
+    spec = d.spec
+    lead = add_component(mbs, name, gear_form, gear, centre, spec, level, props, reduced,
+                         {a: p for a, _, p in found}, cutoff_hz=dynamic_cutoff_hz(d), dropped=dropped,
+                         spin_rad_s=spin_rad_s, superelement=superelements, contacts=contacts)
+    other = add_component(mbs, shaft, shaft_form, shaft, centre, spec, level, props, reduced,
+                          {b: p for _, b, p in found}, d.supports[shaft], spin_rad_s=spin_rad_s,
+                          superelement=superelements, bearing_points=bearing_points)
+    return lead, other, joints
+
+
 def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = None,
                        reduced_source: ReducedSource | None = None, superelements: bool = False,
                        design: Design | None = None) -> GearboxModel:
@@ -266,7 +296,6 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     its ``ObjectFFRFreducedOrder`` even when the linear forms need none (for mesh-node sensors: recorded states).
     ``design``: the design of the variant's gearbox (flexgear.design; made from it when None).
     """
-    from flexgear.fe.reduced import gear_shaft_joints
 
     d = as_design(variant.gearbox if design is None else design)
     spec = d.spec
@@ -278,7 +307,7 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
     th, geo = d.theory, d.gears
     level = variant.mesh_level
     lc = spec.load_case
-    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
+    cutoff = dynamic_cutoff_hz(d)
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
     supports = d.supports
     contacts = mesh_contacts(d, math.copysign(1.0, lc.input_speed_rad_s))
@@ -296,13 +325,9 @@ def build_star_gearbox(mbs, variant: Variant, mass_source: MassSource | None = N
                                          contacts=contacts, source=TIED_PAIR))
             ends[gear] = gear
         else:
-            joints = [FixedJointElement.gear_shaft(gear, shaft, j) for j in gear_shaft_joints(d, gear)]
-            lead = add_component(mbs, gear, form[gear], gear, np.zeros(3), spec, level, props, reduced,
-                                  {j.interface: j.point for j in joints}, cutoff_hz=cutoff, dropped=dropped,
-                                  spin_rad_s=spin, superelement=superelements, contacts=contacts)
-            other = add_component(mbs, shaft, form[shaft], shaft, np.zeros(3), spec, level, props, reduced,
-                                   {j.other_interface: j.point for j in joints}, supports[shaft], spin_rad_s=spin,
-                                   superelement=superelements)
+            lead, other, joints = add_gear_and_shaft(mbs, d, gear, gear, form[gear], shaft, form[shaft], spin,
+                                                     np.zeros(3), props, reduced, level, dropped, superelements,
+                                                     contacts)
             bodies += [lead, other]
             pairs.append((lead, other, joints, spin / th.input_speed))  # spin per drive angle
             ends[gear] = shaft

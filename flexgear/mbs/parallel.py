@@ -18,7 +18,6 @@ import math
 import numpy as np
 
 from flexgear.design import Design, as_design
-from flexgear.geometry.elements import FixedJointElement
 from flexgear.geometry.massprops import combine_mass_properties
 from flexgear.geometry.supports import NEAR
 from flexgear.mbs.bodies import Body, add_rigid_body
@@ -27,7 +26,7 @@ from flexgear.mbs.elements import support_points
 from flexgear.mbs.gearbox import (
     MassSource,
     ReducedSource,
-    add_component,
+    add_gear_and_shaft,
     component_sources,
     linear_frame_tolerance,
     mesh_contacts,
@@ -46,8 +45,6 @@ def build_parallel_gearbox(mbs, variant: Variant, mass_source: MassSource | None
     """Assemble the parallel-axis pair of ``variant`` into ``mbs`` (call ``mbs.Assemble()`` afterwards); the
     arguments as flexgear.mbs.gearbox.build_star_gearbox's. The wheel's body is :data:`WHEEL`; its mesh forces are
     the model's ``outer_contacts`` (``inner_contacts`` empty)."""
-    from flexgear.fe.reduced import gear_shaft_joints
-
     d = as_design(variant.gearbox if design is None else design)
     spec = d.spec
     if spec.gears.arrangement != "parallel":
@@ -56,7 +53,6 @@ def build_parallel_gearbox(mbs, variant: Variant, mass_source: MassSource | None
     props, reduced = component_sources(variant, d, mass_source, reduced_source)
     form, th = variant.components, d.theory
     level, lc = variant.mesh_level, spec.load_case
-    cutoff = spec.reduction_assumed.dynamic_cutoff_mesh_orders * th.mesh_frequency  # Hz, 0: all modes dynamic
     dropped: dict = {}  # geometry -> its dropped modes (flexgear.mbs.residual.DroppedModes), once per build
     contacts = mesh_contacts(d, math.copysign(1.0, lc.input_speed_rad_s))
     wheel_centre = np.array([d.gears.centre_distance, 0.0, 0.0])
@@ -70,15 +66,10 @@ def build_parallel_gearbox(mbs, variant: Variant, mass_source: MassSource | None
             bodies.append(add_rigid_body(mbs, name, merged, centre, spin, linear_frame_tolerance(spec)))
             ends[gear] = name
             continue
-        found = gear_shaft_joints(d, gear)  # points in the gear's frame
-        joints = [FixedJointElement.gear_shaft(name, shaft, (a, b, centre + p)) for a, b, p in found]
-        lead = add_component(mbs, name, gear_form, gear, centre, spec, level, props, reduced,
-                             {a: p for a, _, p in found}, cutoff_hz=cutoff, dropped=dropped, spin_rad_s=spin,
-                             superelement=superelements, contacts=contacts)
-        near = d.supports[shaft + NEAR]
-        other = add_component(mbs, shaft, form[shaft], shaft, centre, spec, level, props, reduced,
-                              {b: p for _, b, p in found}, d.supports[shaft], spin_rad_s=spin,
-                              superelement=superelements, bearing_points={near.interface: support_points(near)})
+        near = d.supports[shaft + NEAR]  # the shaft's second bearing, beyond the gear
+        lead, other, joints = add_gear_and_shaft(mbs, d, name, gear, gear_form, shaft, form[shaft], spin, centre,
+                                                 props, reduced, level, dropped, superelements, contacts,
+                                                 {near.interface: support_points(near)})
         bodies += [lead, other]
         pairs.append((lead, other, joints, spin / th.input_speed))  # spin per drive angle
         ends[gear] = shaft
