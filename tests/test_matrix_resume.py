@@ -50,7 +50,7 @@ def _start(tmp_path: Path, out: Path, paths: list[Path], slow_s: float) -> subpr
 
 def _wait_for(path: Path, proc: subprocess.Popen, timeout_s: float = 120.0) -> None:
     t0 = time.monotonic()
-    while not path.exists():
+    while not (path.exists() and path.read_text().strip()):  # written, not only created
         assert proc.poll() is None, proc.stdout.read().decode()
         assert time.monotonic() - t0 < timeout_s, f"{path} never appeared"
         time.sleep(0.1)
