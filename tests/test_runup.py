@@ -18,6 +18,7 @@ from flexgear.study.runup import (
     mesh_phase,
     order_tracks,
     ridges,
+    single_mode_acceleration,
     spectrogram,
     swept_crossings,
     swept_peak,
@@ -71,6 +72,23 @@ def test_swept_peak_follows_the_signal(runup_signal):
     predicted = swept_peak(t, n, PER_RPM, k, f, z, NOMINAL)
     assert found["speed_rpm"].iloc[0] == pytest.approx(predicted, rel=2e-3)
     assert predicted > f / (k * PER_RPM)
+
+
+def test_single_mode_acceleration_is_the_state_space_solution_and_its_steady_amplitude():
+    """The exact first-order-hold filter against scipy's state-space integration (lsim, the same hold) on a chirp,
+    and at constant frequency against the steady amplitude Omega^2 / |omega^2 - Omega^2 + 2 i zeta omega Omega|
+    (the hold's sinc^2(f dt) factor is 3e-4 at 1 kHz)."""
+    t = np.arange(0.0, 0.2, DT)
+    f_n, zeta = 1500.0, 0.03
+    w = 2 * math.pi * f_n
+    chirp = np.cos(2 * math.pi * (500.0 * t + 5000.0 * t**2))
+    ref = lsim(([[0.0, 1.0], [-w * w, -2 * zeta * w]], [[0.0], [1.0]], [[-w * w, -2 * zeta * w]], [[1.0]]), chirp, t)[1]
+    got = single_mode_acceleration(t, chirp, f_n, zeta)
+    assert np.abs(got - ref).max() < 1e-10 * np.abs(ref).max()
+    big = 2 * math.pi * 1000.0
+    steady = single_mode_acceleration(t, np.cos(big * t), f_n, zeta)[t > 0.15]  # transient decayed: e^-42
+    expected = big**2 / abs(w * w - big**2 + 2j * zeta * w * big)
+    assert abs(np.abs(steady).max() / expected - 1.0) < 1e-3
 
 
 def test_spectrogram_amplitude_of_a_tone():

@@ -59,6 +59,8 @@ from flexgear.study.runup import (
     MIN_MESH_CYCLES,
     ORDERS,
     RPM_PER_RAD_PER_S,
+    SERIES_LIMIT,
+    hold_step_coefficients,
     mesh_excitation,
     mesh_phase,
     order_tracks,
@@ -72,22 +74,6 @@ RAMP_POINTS = 12
 """Linearisations along the ramp with ``along_ramp`` (module docstring), evenly spaced in time from the first
 resolved track speed to the ramp's end: between two of them the mesh load changes by at most about a twelfth of
 its range."""
-
-SERIES_LIMIT = 1e-3
-"""|z| = |lambda dt| below which the step coefficients b0, b1 are evaluated by their Taylor series (their closed
-forms lose digits to cancellation as z -> 0; the series' truncation error is below |z|^4 / 120)."""
-
-
-def _step_coefficients(lam: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """(e^z, b0, b1) of the exact first-order-hold step (module docstring), z = lam dt."""
-    z = lam * dt
-    small = np.abs(z) < SERIES_LIMIT
-    zs = np.where(small, 1.0, z)
-    e1 = np.expm1(z)
-    r0 = np.where(small, 1.0 + z / 2 + z**2 / 6 + z**3 / 24, e1 / zs)  # (e^z - 1) / z
-    r1 = np.where(small, 0.5 + z / 6 + z**2 / 24 + z**3 / 120, (e1 - z) / zs**2)  # (e^z - 1 - z) / z^2
-    return e1 + 1.0, dt * (r0 - r1), dt * r1
-
 
 def _modal(system: Operating, forces: np.ndarray) -> tuple[np.ndarray, ...]:
     """(lambda (2n,), V, V^-1 in the undamped modal state (p, p'), Phi (n, n), P (2n, H) = V^-1 B f_h,
@@ -141,7 +127,7 @@ def linear_response(time_s: np.ndarray, phase_cycles: np.ndarray, envelope: np.n
         else:
             pinv = np.linalg.inv(phi)
             eta0 = vinv @ np.concatenate([pinv @ x[:n], pinv @ x[n:]])
-        ep, bp0, bp1 = _step_coefficients(lam, dt)
+        ep, bp0, bp1 = hold_step_coefficients(lam, dt)
         eta_end = np.empty(lam.size, complex)
         part = np.zeros((y.shape[0], k1 + 1 - k0))
         for j in range(lam.size):
