@@ -2,7 +2,7 @@
 Jacobians per step, and the Python functions (cProfile)?
 
 Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
-     [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints]
+     [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints] [--midlife on|off|both] [--rounds 3]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then solved as a run solves it
@@ -14,6 +14,8 @@ per case: every non-zero timer's share applied to the solve's CPU time, in secon
 ``--frozen contacts joints``: the flexible gears' contact columns (flexgear.mbs.contact_kinematics.ContactKinematics)
 and the turning joints' coefficients (flexgear.mbs.joints.TurningBlocks) written at the first step only (wrong physics:
 a bound on what the Newton iterations and Jacobians that their change from step to step costs).
+``--midlife off``: without the production's mid-life Jacobian (flexgear.mbs.newton.MidlifeJacobian); ``both``: each
+case with and without it, side by side in every round; ``--rounds``: rounds, the medians of CPU per step printed last.
 """
 
 from __future__ import annotations
@@ -33,14 +35,15 @@ from pathlib import Path
 from bench_speed import floor_variant, load_average, shortened
 
 from flexgear.mbs.gearbox import build_star_gearbox
-from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
+from flexgear.mbs.newton import JacobianEconomy, MidlifeJacobian, MultiplierWarmStart, turning_updaters, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, simulation_settings
 from flexgear.spec import load_variant
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = False) -> tuple[str, float, float]:
+def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = False, midlife: bool = True
+          ) -> tuple[str, float, float]:
     """Build and solve; returns Exudyn's printed statistics, wall and CPU time of the solve."""
     import exudyn as exu
 
@@ -63,6 +66,9 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
     if not sv.reference:  # as flexgear.mbs.run's post-step guard drives it
         economy = JacobianEconomy(sv.jacobian_cost_iterations)
         mbs.SetPostStepUserFunction(lambda mbs, t: economy(mbs) or True)
+        updaters = turning_updaters(mbs)
+        if midlife and updaters:
+            mbs.SetSystemJacobianUserFunction(MidlifeJacobian(updaters, variant.gearbox.load_case.step_size_s))
     if warm:
         mbs.SetPreNewtonResidualUserFunction(MultiplierWarmStart())
     prof = cProfile.Profile() if profile else None
@@ -152,6 +158,9 @@ def main() -> None:
                     help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
     ap.add_argument("--frozen", nargs="+", choices=("contacts", "joints"), default=(),
                     help="write these constraint coefficients at the first step only (a cost bound, wrong physics)")
+    ap.add_argument("--midlife", choices=("on", "off", "both"), default="on",
+                    help="the mid-life Jacobian (production: on); both: each case with and without it")
+    ap.add_argument("--rounds", type=int, default=1, help="rounds over the cases (medians printed last)")
     a = ap.parse_args()
     from threadpoolctl import threadpool_limits
 
@@ -161,13 +170,17 @@ def main() -> None:
     threadpool_limits(limits=a.blas_threads, user_api="blas")
     folder = Path(a.variants_dir)
     print(f"profile_mbs: t_end {a.t_end} s; {load_average()}", flush=True)
-    for case in a.cases:
+    modes = {"on": (True,), "off": (False,), "both": (True, False)}[a.midlife]
+    per_step: dict[str, list[float]] = {}
+    for _, case, midlife in ((r, c, m) for r in range(a.rounds) for c in a.cases for m in modes):
         variant = floor_variant(load_variant(folder / "model1.toml")) if case == "floor" else \
             load_variant(folder / f"{case}.toml")
         if a.ramp is not None:
             variant = shortened(variant, a.ramp, max(a.t_end, a.ramp))
-        solve(variant, 1e-4, False, False)
-        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0)
+        solve(variant, 1e-4, False, False, midlife=midlife)
+        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0, midlife)
+        if len(modes) > 1:
+            case = f"{case} (mid-life Jacobian {'on' if midlife else 'off'})"
         if a.trace_newton:
             lines = [ln for ln in text.splitlines() if "initial residual" in ln or "NEWTON STEP" in ln]
             starts = [k for k, ln in enumerate(lines) if "initial residual" in ln]
@@ -176,8 +189,13 @@ def main() -> None:
         print(f"{case}: solve wall {wall:.2f} s, cpu {cpu:.2f} s ({1e6 * cpu / steps:.1f} us/step cpu); "
               f"{load_average()}")
         print("\n".join(summary(text, steps, cpu)))
+        per_step.setdefault(case, []).append(1e6 * cpu / steps)
         if a.cprofile:
             print(text[text.find("Ordered by"):])
+    if a.rounds > 1:
+        for case, values in per_step.items():
+            print(f"median of {len(values)} rounds: {case} {sorted(values)[len(values) // 2]:.1f} us/step cpu "
+                  f"({', '.join(f'{v:.1f}' for v in values)})")
 
 
 if __name__ == "__main__":

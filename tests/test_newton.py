@@ -137,3 +137,58 @@ def test_warm_started_multipliers_keep_every_signal_and_save_iterations(full_spe
     assert agreement.ok(), agreement.table
     assert warm.meta["newton_iterations"] < cold.meta["newton_iterations"]
     assert warm.meta["jacobians"] < cold.meta["jacobians"]
+
+
+def test_the_midlife_jacobian_holds_the_turning_coefficients_of_the_middle_of_its_life(full_speed_model4):
+    """Exudyn's Newton Jacobian with flexgear.mbs.newton.MidlifeJacobian (an expected life of 10 steps) equals the
+    Jacobian computed with every turning coefficient written at 5 steps later (the joints' and seats', the contact
+    columns'), entry by entry."""
+    import exudyn as exu
+
+    from flexgear.mbs.gearbox import build_star_gearbox
+    from flexgear.mbs.newton import MidlifeJacobian, turning_updaters
+    from flexgear.mbs.recording import simulation_settings
+
+    v = full_speed_model4
+    h = v.gearbox.load_case.step_size_s
+    mbs = exu.SystemContainer().AddSystem()
+    build_star_gearbox(mbs, v)
+    mbs.Assemble()
+    settings = simulation_settings(v, 0.006, False, True)  # beyond the ramps: full speed
+    mbs.SolveDynamic(settings, solverType=exu.DynamicSolverType.GeneralizedAlpha, storeSolver=True)
+    solver = mbs.sys["dynamicSolver"]
+    updaters = turning_updaters(mbs)
+    assert len(updaters) == 2  # the linear joints and seats; the contact columns
+
+    def jacobian() -> np.ndarray:
+        solver.ComputeNewtonJacobian(mbs, settings)
+        return np.array(solver.GetSystemJacobian())
+
+    now = {id(u): u.time for u in updaters}
+    at_rest = jacobian()
+    for u in updaters:
+        u(mbs, now[id(u)] + 5 * h)
+    shifted = jacobian()
+    for u in updaters:
+        u(mbs, now[id(u)])
+    midlife = MidlifeJacobian(updaters, h)
+    midlife.lives.append(10.0)
+    mbs.SetSystemJacobianUserFunction(midlife)
+    got = jacobian()
+    scale = np.abs(shifted).max()
+    assert np.abs(shifted - at_rest).max() > 1e-9 * scale  # the coefficients did turn
+    assert np.abs(got - shifted).max() <= 1e-13 * scale
+
+
+def test_the_midlife_jacobian_keeps_every_signal(full_speed_model4, monkeypatch):
+    """The production run with the mid-life Jacobian against the same run with the Jacobian of its own step: the
+    agreement rule (means 0.1 %, 1x amplitudes 2 %; the converged solution is the same to the Newton tolerance)."""
+    import flexgear.mbs.run as run_module
+
+    midlife = run_variant(full_speed_model4)
+    monkeypatch.setattr(run_module, "turning_updaters", lambda mbs: [])
+    own = run_variant(full_speed_model4)
+    assert midlife.ok and own.ok, (midlife.meta.get("reason"), own.meta.get("reason"))
+    lc = full_speed_model4.gearbox.load_case
+    agreement = signal_agreement(own, midlife, (lc.ramp_time_s, lc.end_time_s), own.meta["theory"]["mesh_frequency_hz"])
+    assert agreement.ok(), agreement.table

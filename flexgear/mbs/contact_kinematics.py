@@ -164,6 +164,26 @@ class ContactKinematics:
         self._args = (float(ramp_time), float(drive_speed), self.tables, self._dest, self.n_modes, self.signs,
                       self.psi, self.spin)
         self._kernel = None  # the kernel's compiled entry for these arguments (first call)
+        self.time = 0.0  # the time [s] whose entries the buffer holds
+
+    @property
+    def buffer(self) -> np.ndarray:
+        """The constraint blocks' entries, flat (their scaling matrices are views of it, :attr:`views`)."""
+        return self._buffer
+
+    @property
+    def views(self) -> list[tuple[int, str, np.ndarray]]:
+        """(constraint, parameter, its scaling matrix: a view of :attr:`buffer`) of every gear pair's block."""
+        return [(obj, "scalingMarker1", view) for obj, view in self._views]
+
+    def buffer_at(self, t: float, out: np.ndarray) -> np.ndarray:
+        """The buffer's values at time ``t`` [s] written into ``out`` (an array of its size): the entries a Jacobian
+        evaluated then would hold (flexgear.mbs.newton.MidlifeJacobian)."""
+        np.copyto(out, self._buffer)  # the frame columns and other constant entries
+        if self._kernel is None:
+            self._kernel = bound_entry(interpolated_entries, (out, float(t), *self._args))
+        self._kernel(out, float(t), *self._args)
+        return out
 
     def matrix_at(self, t: float) -> np.ndarray:
         """The constraint's scaling matrix (frame + modal columns) at time t (compiled; the returned
@@ -196,6 +216,7 @@ class ContactKinematics:
         if kernel is None:
             kernel = self._kernel = bound_entry(interpolated_entries, (self._buffer, float(t), *self._args))
         kernel(self._buffer, t, *self._args)
+        self.time = t
         set_parameter = mbs.SetObjectParameter
         for obj, scaling in self._views:
             set_parameter(obj, "scalingMarker1", scaling)

@@ -321,6 +321,23 @@ class TurningBlocks:
         self._args = (self.ramp_time, self.drive_speed, self.const, self.cos_part, self.sin_part, self.spin_index,
                       self.spins, self.target)
         self._kernel = None  # turned_blocks' compiled entry for these arguments (first call)
+        self.time = 0.0  # the time [s] whose coefficients the buffer holds
+
+    @property
+    def views(self) -> list[tuple[int, str, np.ndarray]]:
+        """(constraint, parameter, its matrix: a view of :attr:`buffer`) of every entry."""
+        return self.items
+
+    def buffer_at(self, t: float, out: np.ndarray) -> np.ndarray:
+        """The buffer's values at time ``t`` [s] written into ``out`` (an array of its size): the coefficients a
+        Jacobian evaluated then would hold (flexgear.mbs.newton.MidlifeJacobian)."""
+        self._bound(out, t)(out, float(t), *self._args)
+        return out
+
+    def _bound(self, buffer: np.ndarray, t: float):
+        if self._kernel is None:
+            self._kernel = bound_entry(turned_blocks, (buffer, float(t), *self._args))
+        return self._kernel
 
     def turned(self, t: float) -> np.ndarray:
         """All blocks at time t, column by column (6, W): the numpy reference of the compiled kernel."""
@@ -330,8 +347,9 @@ class TurningBlocks:
     def __call__(self, mbs, t: float) -> bool:
         kernel = self._kernel
         if kernel is None:
-            kernel = self._kernel = bound_entry(turned_blocks, (self.buffer, float(t), *self._args))
+            kernel = self._bound(self.buffer, t)
         kernel(self.buffer, t, *self._args)
+        self.time = t
         set_parameter = mbs.SetObjectParameter
         for obj, param, matrix in self.items:
             set_parameter(obj, param, matrix)

@@ -33,13 +33,26 @@ in its first increment by that angle times all of them. From the last step's mul
 carries only their change over one step. Converged is then a residual below
 :func:`newton_absolute_tolerance`, the level the relative tolerance accepts from a zero start at the nominal load,
 or the relative tolerance of the (now smaller) initial residual, whichever comes first.
+
+:class:`MidlifeJacobian` (production, where constraint coefficients turn with the spin: the linear joints and seats,
+flexgear.mbs.joints.TurningBlocks, and the flexible gears' contact columns, flexgear.mbs.contact_kinematics.
+ContactKinematics) is Exudyn's system Jacobian user function. The modified Newton method keeps a Jacobian for its
+life of l steps while the turning coefficients C(t) move on; evaluated with the step's own C(t_j), the Jacobian
+lags by up to l steps of spin at the end of its life. The function adds C(t_j + l h / 2) - C(t_j) to the
+constraint rows and their transposed columns ([[., C^T], [C, 0]]: Exudyn's constraint Jacobian, unscaled), so that
+the Jacobian holds the coefficients of the middle of its expected life, l the mean of the last
+:data:`LIFE_SAMPLES` lives: its largest lag is halved. The residual keeps the step's own coefficients, so the
+converged solution is the same to the Newton tolerance; only the matrix the iteration uses changes.
 """
 
 from __future__ import annotations
 
 import time
+from collections import deque
 from collections.abc import Callable, Iterable
 from typing import TYPE_CHECKING
+
+import numpy as np
 
 from flexgear.spec import GearboxSpec
 from flexgear.theory import theory
@@ -47,10 +60,13 @@ from flexgear.theory import theory
 if TYPE_CHECKING:
     from flexgear.mbs.bodies import Body
 
-__all__ = ["MIN_SAMPLES", "JacobianEconomy", "MultiplierWarmStart", "newton_absolute_tolerance", "warm_starts"]
+__all__ = ["MIN_SAMPLES", "LIFE_SAMPLES", "JacobianEconomy", "MidlifeJacobian", "MultiplierWarmStart",
+           "newton_absolute_tolerance", "turning_updaters", "warm_starts"]
 
 MIN_SAMPLES = 8
 """Steps without a Jacobian needed (beside one with a Jacobian) before the cost ratio is reported as measured."""
+LIFE_SAMPLES = 4
+"""Jacobian lifetimes (steps between two Jacobians) whose mean :class:`MidlifeJacobian` takes as the next one's."""
 
 
 class JacobianEconomy:
@@ -165,3 +181,77 @@ class MultiplierWarmStart:
         if newton_iteration == 0:
             data = mbs.systemData
             data.SetAECoordinates(data.GetAECoordinates(self._start))
+
+
+def turning_updaters(mbs) -> list:
+    """The pre-step functions of ``mbs`` whose constraint coefficients turn with the spin (those with
+    ``buffer_at``: flexgear.mbs.joints.TurningBlocks, flexgear.mbs.contact_kinematics.ContactKinematics)."""
+    function = mbs.GetPreStepUserFunction()
+    function = function.get("function") if isinstance(function, dict) else function
+    return [f for f in getattr(function, "functions", [function]) if hasattr(f, "buffer_at")]
+
+
+class MidlifeJacobian:
+    """System Jacobian user function (Exudyn's ``SetSystemJacobianUserFunction``) of one run: the turning
+    coefficients of ``updaters`` (:func:`turning_updaters`) at the middle of the Jacobian's expected life (module
+    docstring); ``step_s`` [s] the time step."""
+
+    def __init__(self, updaters: list, step_s: float) -> None:
+        self.updaters, self.step = list(updaters), float(step_s)
+        self.lives: deque[float] = deque(maxlen=LIFE_SAMPLES)
+        self._last: float | None = None
+        self._layout: list[tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]] | None = None
+        self._scratch = [np.empty_like(u.buffer) for u in self.updaters]
+        self._size = 0
+
+    def _place(self, mbs) -> None:
+        """Per updater: (its buffer's entries, their Jacobian rows and columns, signs), both the constraint rows
+        and the transposed columns; the system's size."""
+        data = mbs.systemData
+        first_ae = data.ODE2Size() + data.ODE1Size()
+        self._size = first_ae + data.AEsize()
+        self._layout = []
+        for u in self.updaters:
+            start = u.buffer.__array_interface__["data"][0]
+            entries, rows, cols, signs = [], [], [], []
+            for obj, param, view in u.views:
+                offset = (view.__array_interface__["data"][0] - start) // view.itemsize
+                ae = first_ae + np.asarray(data.GetObjectLTGAE(obj), np.int64)
+                coordinates = np.asarray(data.GetObjectLTGODE2(obj), np.int64)
+                # Exudyn's equation: scalingMarker1 q1 - scalingMarker0 q0 - offset = 0, marker 0's coordinates first
+                width0 = np.asarray(mbs.GetObjectParameter(obj, "scalingMarker0")).shape[1]
+                columns = coordinates[width0:width0 + view.shape[1]] if param == "scalingMarker1" else (
+                    coordinates[:view.shape[1]])
+                r, c = np.meshgrid(ae, columns, indexing="ij")
+                k = offset + np.arange(view.size)
+                sign = 1.0 if param == "scalingMarker1" else -1.0
+                entries += [k, k]
+                rows += [r.ravel(), c.ravel()]
+                cols += [c.ravel(), r.ravel()]
+                signs += [np.full(k.size, sign)] * 2
+            self._layout.append(tuple(np.concatenate(a) if a else np.zeros(0) for a in (entries, rows, cols, signs)))
+
+    @property
+    def life(self) -> float:
+        """The expected life [steps] of the next Jacobian: the mean of the last ones (0 before the second)."""
+        return float(np.mean(self.lives)) if self.lives else 0.0
+
+    def __call__(self, mbs, t: float, factor_ode2: float, factor_ode2_t: float, factor_ode1: float):
+        import exudyn as exu
+
+        if self._last is not None and t > self._last:
+            self.lives.append((t - self._last) / self.step)
+        self._last = t
+        if self._layout is None:
+            self._place(mbs)
+        triplets = [np.zeros((0, 3))]
+        shift = 0.5 * self.life * self.step
+        if shift > 0.0:
+            for u, scratch, (entries, rows, cols, signs) in zip(self.updaters, self._scratch, self._layout,
+                                                                strict=True):
+                moved = u.buffer_at(u.time + shift, scratch)
+                delta = signs * (moved[entries] - u.buffer[entries])
+                triplets.append(np.column_stack([rows, cols, delta]))
+        out = exu.MatrixContainer()
+        out.SetWithSparseMatrixCSR(self._size, self._size, np.vstack(triplets), useDenseMatrix=False)
+        return out

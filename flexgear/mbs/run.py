@@ -27,7 +27,7 @@ from flexgear.design import design
 from flexgear.mbs.assemble import build_gearbox
 from flexgear.mbs.deflection import mesh_deflection_signals, transmission_error
 from flexgear.mbs.gearbox import GearboxModel, MassSource, ReducedSource
-from flexgear.mbs.newton import JacobianEconomy, MultiplierWarmStart, warm_starts
+from flexgear.mbs.newton import JacobianEconomy, MidlifeJacobian, MultiplierWarmStart, turning_updaters, warm_starts
 from flexgear.mbs.recording import add_gearbox_sensors, joint_axis_torque, simulation_settings
 from flexgear.mbs.states import add_state_sensors, state_bodies, state_table
 from flexgear.progress import Progress
@@ -196,12 +196,15 @@ def _solve(mbs, variant: Variant, t_start: float, t_end: float, guard: RunGuard,
     if t_start == 0.0 and mbs.GetPostStepUserFunction() not in (0, None):
         raise RuntimeError("the model has a post-step user function already; the divergence guard needs it")
     mbs.SetPostStepUserFunction(guard)
-    if guard.economy is not None:
+    step = variant.gearbox.load_case.step_size_s if step_s is None else step_s
+    if guard.economy is not None:  # the production formulation
         guard.economy.new_solve()
+        updaters = turning_updaters(mbs)
+        if updaters:
+            mbs.SetSystemJacobianUserFunction(MidlifeJacobian(updaters, step))
     if guard.warm_start:
         mbs.SetPreNewtonResidualUserFunction(MultiplierWarmStart())
     settings = simulation_settings(variant, t_end, False, guard.warm_start)
-    step = variant.gearbox.load_case.step_size_s if step_s is None else step_s
     settings.timeIntegration.startTime = t_start
     settings.timeIntegration.numberOfSteps = max(1, round((t_end - t_start) / step))
     was_printing = exu.config.printToConsole
