@@ -1,5 +1,5 @@
 """The single-mode integration of the run-up's swept predictions (flexgear.study.runup.swept_peak): the exact
-first-order-hold filter (flexgear.study.runup.single_mode_acceleration) against scipy's state-space integration
+first-order-hold filter (flexgear.study.hold.single_mode_acceleration) against scipy's state-space integration
 (scipy.signal.lsim, the same hold), side by side on the same forcing: wall time per call and their largest
 difference relative to the response's peak.
 
@@ -17,7 +17,7 @@ import time
 import numpy as np
 from scipy.signal import lsim
 
-from flexgear.study.runup import single_mode_acceleration
+from flexgear.study.hold import single_mode_acceleration
 
 MODES = ((1500.0, 0.03), (4400.0, 0.05), (9000.0, 0.005))
 """(frequency [Hz], damping ratio) of the modes timed."""

@@ -12,13 +12,13 @@ import pytest
 from scipy.signal import lsim
 
 from flexgear.laws.ramps import step
+from flexgear.study.hold import single_mode_acceleration
 from flexgear.study.runup import (
     match_crossings,
     mesh_excitation,
     mesh_phase,
     order_tracks,
     ridges,
-    single_mode_acceleration,
     spectrogram,
     swept_crossings,
     swept_peak,

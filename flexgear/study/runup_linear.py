@@ -53,14 +53,13 @@ import pandas as pd
 from flexgear.harmonic.base import Operating
 from flexgear.modal.eigenmodes import state_space_roots
 from flexgear.results import RunResult
+from flexgear.study.hold import SERIES_LIMIT, hold_step_coefficients
 from flexgear.study.runup import (
     DEFAULT_HOP_S,
     DEFAULT_WINDOW_S,
     MIN_MESH_CYCLES,
     ORDERS,
     RPM_PER_RAD_PER_S,
-    SERIES_LIMIT,
-    hold_step_coefficients,
     mesh_excitation,
     mesh_phase,
     order_tracks,
