@@ -157,15 +157,19 @@ def section_interface(fe, name: str, z0: float, z1: float) -> Interface:
 
 
 def interface_compliance(fe_or_body, load, held) -> np.ndarray:
-    """6 x 6 compliance of the RBE3 motion of interface ``load`` under its RBE3 loads, ``held`` held:
-    full FE by the constrained solve, a reduced body by its modes (u = Phi_h q, as flexgear.fe.compliance)."""
+    """Compliance of the RBE3 motion of interface ``load`` (or of each of a list of interfaces: 6 k x 6 k) under its
+    RBE3 loads, ``held`` held: full FE by the constrained solve, a reduced body by its modes (u = Phi_h q, as
+    flexgear.fe.compliance)."""
+    import scipy.sparse as sp
+
     from flexgear.fe.cms import ReducedBody, rbe3_rows, rbe3_weights
     from flexgear.fe.fem import rigid_body_modes
 
+    loads = list(load) if isinstance(load, list | tuple) else [load]
     if not isinstance(fe_or_body, ReducedBody):
-        c_load = rbe3_rows(fe_or_body, load)
+        c_load = sp.vstack([rbe3_rows(fe_or_body, itf) for itf in loads]).tocsr()
         u = free_body_solver(fe_or_body).constrained(rbe3_rows(fe_or_body, held)).solve(
-            c_load.T.toarray(), np.zeros((6, 6)))
+            c_load.T.toarray(), np.zeros((6, c_load.shape[0])))
         return c_load @ u
     body = fe_or_body
     rig = rigid_body_modes(body.nodes).reshape(len(body.nodes), 3, 6)
@@ -173,7 +177,8 @@ def interface_compliance(fe_or_body, load, held) -> np.ndarray:
     def c_r(itf):
         return np.einsum("idc,icm->dm", rbe3_weights(body.nodes, itf), rig[itf.nodes])
 
-    phi_h = body.interface_motion(load.name) - c_r(load) @ np.linalg.solve(c_r(held), body.interface_motion(held.name))
+    held_motion = np.linalg.solve(c_r(held), body.interface_motion(held.name))
+    phi_h = np.vstack([body.interface_motion(itf.name) - c_r(itf) @ held_motion for itf in loads])
     return (phi_h / body.stiffness) @ phi_h.T
 
 

@@ -19,7 +19,6 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import scipy.sparse as sp
 from test_attachment import interface_compliance, section_interface, timoshenko_seat_compliance
 
 import flexgear as fg
@@ -47,35 +46,12 @@ def shaft(request, gearbox, example_cache):
     return name, fe, body
 
 
-def _compliance(fe_or_body, loads, held) -> np.ndarray:
-    """Compliance of the RBE3 motions of the interfaces ``loads`` under their RBE3 loads, ``held`` held (6 k x 6 k):
-    full FE by the constrained solve, a reduced body by its modes (tests/test_attachment.interface_compliance)."""
-    from flexgear.fe.cms import ReducedBody, rbe3_rows, rbe3_weights
-    from flexgear.fe.compliance import free_body_solver
-    from flexgear.fe.fem import rigid_body_modes
-
-    if not isinstance(fe_or_body, ReducedBody):
-        rows = sp.vstack([rbe3_rows(fe_or_body, itf) for itf in loads]).tocsr()
-        u = free_body_solver(fe_or_body).constrained(rbe3_rows(fe_or_body, held)).solve(
-            rows.T.toarray(), np.zeros((6, rows.shape[0])))
-        return rows @ u
-    body = fe_or_body
-    rigid = rigid_body_modes(body.nodes).reshape(len(body.nodes), 3, 6)
-
-    def rigid_rows(itf):
-        return np.einsum("idc,icm->dm", rbe3_weights(body.nodes, itf), rigid[itf.nodes])
-
-    held_motion = np.linalg.solve(rigid_rows(held), body.interface_motion(held.name))
-    phi = np.vstack([body.interface_motion(itf.name) - rigid_rows(itf) @ held_motion for itf in loads])
-    return (phi / body.stiffness) @ phi.T
-
-
 def test_gear_seat_and_near_bearing_compliance_equals_full_fe(shaft):
     name, fe, body = shaft
     joint, near, far = (body.interface(n) for n in (body.interfaces[0].name, "bearing_seat_near", "bearing_seat"))
     assert joint.name == {"input_shaft": "sun_seat", "output_shaft": "planet_seat"}[name]
-    full = _compliance(fe, [joint, near], far)
-    reduced = _compliance(body, [joint, near], far)
+    full = interface_compliance(fe, [joint, near], far)
+    reduced = interface_compliance(body, [joint, near], far)
     assert np.all(np.diag(full) > 0)
     assert np.abs(reduced - full).max() < 1e-6 * np.diag(full).max()
 

@@ -180,10 +180,14 @@ class ContactKinematics:
         """The buffer's values at time ``t`` [s] written into ``out`` (an array of its size): the entries a Jacobian
         evaluated then would hold (flexgear.mbs.newton.MidlifeJacobian)."""
         np.copyto(out, self._buffer)  # the frame columns and other constant entries
-        if self._kernel is None:
-            self._kernel = bound_entry(interpolated_entries, (out, float(t), *self._args))
-        self._kernel(out, float(t), *self._args)
+        self._bound(out, t)(out, float(t), *self._args)
         return out
+
+    def _bound(self, buffer: np.ndarray, t: float):
+        """The kernel's compiled entry for these arguments (bound at the first call)."""
+        if self._kernel is None:
+            self._kernel = bound_entry(interpolated_entries, (buffer, float(t), *self._args))
+        return self._kernel
 
     def matrix_at(self, t: float) -> np.ndarray:
         """The constraint's scaling matrix (frame + modal columns) at time t (compiled; the returned
@@ -214,7 +218,7 @@ class ContactKinematics:
         """Pre-step: each gear pair's block at the step's time t (the entries of :meth:`matrix_at`)."""
         kernel = self._kernel
         if kernel is None:
-            kernel = self._kernel = bound_entry(interpolated_entries, (self._buffer, float(t), *self._args))
+            kernel = self._bound(self._buffer, t)
         kernel(self._buffer, t, *self._args)
         self.time = t
         set_parameter = mbs.SetObjectParameter

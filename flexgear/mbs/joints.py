@@ -335,6 +335,7 @@ class TurningBlocks:
         return out
 
     def _bound(self, buffer: np.ndarray, t: float):
+        """turned_blocks' compiled entry for these arguments (bound at the first call)."""
         if self._kernel is None:
             self._kernel = bound_entry(turned_blocks, (buffer, float(t), *self._args))
         return self._kernel
