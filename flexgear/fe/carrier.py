@@ -25,6 +25,7 @@ from flexgear.fe.carrier_part import imported_carrier_mesh, level_mesh, pin_bore
 from flexgear.fe.cms import ReducedBody, interface, reduce
 from flexgear.fe.fem import FEModel, fe_model
 from flexgear.fe.imported import IMPORT_VERSION
+from flexgear.fe.parts import exchange_form
 from flexgear.fe.reduced import cached_reduced_body
 from flexgear.geometry.carrier import CarrierSizes, carrier_sizes, carrier_solid
 from flexgear.progress import say
@@ -32,6 +33,7 @@ from flexgear.schema import CARRIER
 from flexgear.spec import GearboxSpec, spec_hash
 
 __all__ = ["carrier_fe_model", "carrier_volume_mesh", "carrier_body", "carrier_body_key", "carrier_interfaces",
+           "carrier_exchange_solid",
            "pin_interface", "SEAT", "CUTOFF_FACTOR"]
 
 CUTOFF_FACTOR = 3.0
@@ -47,16 +49,20 @@ SEAT = "seat"
 def pin_interface(k: int) -> str:
     """The name of the interface of planet ``k``'s pin (0-based, in the order of the planets' angles)."""
     return f"pin_{k}"
-_VERSION = 1
-"""Bump when the carrier's mesh or reduction changes without an input changing (enters the cache key)."""
+_VERSION = 2
+"""Bump when the carrier's mesh or reduction changes without an input changing (enters the cache key). 2: meshed in
+its STEP exchange form."""
+_EXCHANGE_PASSES = 2
+"""STEP round trips that bring the carrier's solid to its exchange form (flexgear.fe.parts.exchange_form): the
+first read computes its cut faces' curve parameters anew, the second leaves every digit as it is."""
 _FACE_TOL = 1e-6
 """Distance [m] within which a face's centre lies on an axis or at a height."""
 
 
 def _named_solid(sizes: CarrierSizes, pin_size: float):
-    """The carrier's solid with its pin bores named ``pin_<k>`` (mesh size ``pin_size`` [m]) and the output-side
-    plate's bore named ``seat``."""
-    solid = carrier_solid(sizes)
+    """The carrier's solid in its STEP exchange form (:func:`carrier_exchange_solid`) with its pin bores named
+    ``pin_<k>`` (mesh size ``pin_size`` [m]) and the output-side plate's bore named ``seat``."""
+    solid = carrier_exchange_solid(sizes)
     half = sizes.gap / 2
     for k, face in pin_bore_faces(solid, sizes.pin_centres()[:, :2]):
         face.name, face.maxh = pin_interface(k), pin_size
@@ -65,6 +71,12 @@ def _named_solid(sizes: CarrierSizes, pin_size: float):
         if np.hypot(c.x, c.y) < _FACE_TOL and c.z > half and abs(_radius(face) - sizes.bore_radius) < _FACE_TOL:
             face.name = SEAT
     return solid
+
+
+def carrier_exchange_solid(sizes: CarrierSizes):
+    """The carrier's solid (flexgear.geometry.carrier.carrier_solid) as a STEP file carries it
+    (flexgear.fe.parts.exchange_form): the solid it is meshed in and ``flexgear export-geometry`` writes."""
+    return exchange_form(carrier_solid(sizes), _EXCHANGE_PASSES)
 
 
 def _radius(face) -> float:

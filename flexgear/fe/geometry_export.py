@@ -27,23 +27,16 @@ import numpy as np
 from flexgear.design import as_design
 from flexgear.fe.mesh import component_brep, component_mesh
 from flexgear.fe.mesh_io import write_vtu
+from flexgear.fe.parts import STEP_UNIT_MM, write_step_mm
 from flexgear.spec import CARRIER, GearboxSpec, stage_geometries
 
 __all__ = ["export_geometry", "exported_components", "write_step", "STEP_UNIT_MM"]
 
-STEP_UNIT_MM = 1e3
-"""Millimetres per metre: the STEP files are written in mm."""
-
-
 def write_step(brep: Path | object, path: Path) -> Path:
     """The solid of ``brep`` (a ``.brep`` file or an OCC shape, metres) as a STEP file in millimetres at ``path``."""
-    from netgen.occ import OCCGeometry, Pnt
+    from netgen.occ import OCCGeometry
 
-    shape = (OCCGeometry(str(brep)).shape if isinstance(brep, Path) else brep).Scale(Pnt(0, 0, 0), STEP_UNIT_MM)
-    tmp = path.with_name(f".{path.name}.tmp.step")
-    shape.WriteStep(str(tmp))
-    tmp.replace(path)
-    return path
+    return write_step_mm(OCCGeometry(str(brep)).shape if isinstance(brep, Path) else brep, path)
 
 
 def _point_sets(spec: GearboxSpec, component: str, nodes: np.ndarray, regions: dict) -> dict[str, np.ndarray]:
@@ -69,13 +62,13 @@ def exported_components(spec: GearboxSpec) -> tuple[str, ...]:
 
 def _carrier_files(spec: GearboxSpec, level: str, folder: Path) -> list[Path]:
     """The carrier's STEP and VTU (module docstring)."""
-    from flexgear.fe.carrier import carrier_interfaces, carrier_volume_mesh
-    from flexgear.geometry.carrier import carrier_sizes, carrier_solid
+    from flexgear.fe.carrier import carrier_exchange_solid, carrier_interfaces, carrier_volume_mesh
+    from flexgear.geometry.carrier import carrier_sizes
 
     sizes = carrier_sizes(spec)
     fe, elements = carrier_volume_mesh(spec, level, sizes)
     sets = {**fe.regions, **{f"interface_{itf.name}": itf.nodes for itf in carrier_interfaces(fe, sizes)}}
-    return [write_step(carrier_solid(sizes), folder / f"{CARRIER}.step"),
+    return [write_step(carrier_exchange_solid(sizes), folder / f"{CARRIER}.step"),
             write_vtu(folder / f"{CARRIER}.vtu", fe.nodes, elements, sets)]
 
 

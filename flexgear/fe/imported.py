@@ -25,10 +25,7 @@ node or nodes on more than one surface (the message names the selector).
 
 from __future__ import annotations
 
-import contextlib
 import math
-import os
-from collections.abc import Iterator
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -46,7 +43,7 @@ from flexgear.fe.mesh import (
     source_mesh,
 )
 from flexgear.fe.mesh_io import MeshFileError, boundary_faces, netgen_mesh, read_volume_mesh
-from flexgear.fe.parts import cached_brep, register_file_parts
+from flexgear.fe.parts import cached_brep, quiet_occ, register_file_parts
 from flexgear.fe.selectors import SelectorError, group_points, selected_regions, whole_faces
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
 from flexgear.schema_geometry import CONTACT_BAND, SELECTABLE_REGIONS, ComponentGeometry
@@ -74,22 +71,6 @@ class GeometryFileError(ValueError):
         super().__init__(f"[components_geometry] {component}: {entry.source}: {reason}")
 
 
-@contextlib.contextmanager
-def _quiet() -> Iterator[None]:
-    """OpenCascade's own messages (on the process's stdout and stderr) silenced: a refused file ends in one line."""
-    saved = [os.dup(1), os.dup(2)]
-    try:
-        with open(os.devnull, "wb") as null:
-            os.dup2(null.fileno(), 1)
-            os.dup2(null.fileno(), 2)
-            yield
-    finally:
-        os.dup2(saved[0], 1)
-        os.dup2(saved[1], 2)
-        for fd in saved:
-            os.close(fd)
-
-
 def imported_brep(spec: GearboxSpec | Design, component: str, progress: bool = False) -> Path:
     """Path of the cached solid (``.brep``, metres) of ``component`` read from its ``[components_geometry]`` file;
     read, checked (one solid, its extent against the gear data) and stored on a cache miss."""
@@ -112,7 +93,7 @@ def read_solid(component: str, entry: ComponentGeometry, expected_radius: float)
     from netgen.occ import OCCGeometry, Pnt
 
     try:
-        with _quiet():
+        with quiet_occ():
             shape = OCCGeometry(str(entry.source)).shape
     except Exception as exc:  # netgen raises NgException or RuntimeError for a damaged file
         raise GeometryFileError(component, entry, f"cannot be read as {entry.kind.upper()} "

@@ -44,7 +44,7 @@ from flexgear.cache import (
     read_entry,
 )
 from flexgear.design import Design, as_design
-from flexgear.fe.parts import cached_brep, file_parts, private_temporary
+from flexgear.fe.parts import cached_brep, exchange_form, file_parts, private_temporary
 from flexgear.geometry.layout import ComponentLayout, geometry_hash
 from flexgear.progress import say
 from flexgear.spec import GEOMETRY_COMPONENTS, GearboxSpec, MeshingSettings
@@ -170,12 +170,14 @@ def component_brep(spec: GearboxSpec | Design, component: str, progress: bool = 
 
 def layout_brep(layout: ComponentLayout, key: str, progress: bool = False) -> Path:
     """Path of the cached OCC solid (``solid-<layout name>-<key>.brep``) of ``layout``
-    (flexgear.geometry.solids.component_solid), checked against its digest; built on a cache miss or when the
-    file does not match its digest. ``key``: a hash of everything the layout is made from."""
+    (flexgear.geometry.solids.component_solid) in its STEP exchange form (flexgear.fe.parts.exchange_form: the
+    solid exported as STEP and imported again is meshed exactly as this one), checked against its digest; built on
+    a cache miss or when the file does not match its digest. ``key``: a hash of everything the layout is made
+    from."""
     from flexgear.geometry.solids import component_solid
 
-    return cached_brep(cache_dir() / f"solid-{layout.name}-{key}.brep", lambda: component_solid(layout),
-                       f"{layout.name}: solid built", progress)
+    return cached_brep(cache_dir() / f"solid-{layout.name}-{key}.brep",
+                       lambda: exchange_form(component_solid(layout)), f"{layout.name}: solid built", progress)
 
 
 def _say(progress: bool, text: str) -> None:

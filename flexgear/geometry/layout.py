@@ -70,9 +70,10 @@ __all__ = [
 ]
 
 _HANDS = {"sun": 1.0, "planet": -1.0, "ring": -1.0}
-GEOMETRY_VERSION = 2
+GEOMETRY_VERSION = 3
 """Version of the geometry construction, part of every geometry cache key (:func:`geometry_hash`, the toothed
-bodies' solids): bump when the construction changes, which invalidates every cache entry."""
+bodies' solids): bump when the construction changes, which invalidates every cache entry. 3: the solids are
+meshed in their STEP exchange form (flexgear.fe.parts.exchange_form)."""
 
 
 
