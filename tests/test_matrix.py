@@ -102,6 +102,26 @@ def test_resume_skips_unchanged_runs(variants, tmp_path):
     assert not changed["resumed"].any()
 
 
+def test_a_run_made_with_replaced_bodies_runs_again(variants, tmp_path, monkeypatch):
+    """The input hash holds the cache keys of the bodies a run is built from (flexgear.study.pool.body_keys): a new
+    geometry construction (its version, part of every body's key) replaces the bodies, so the runs made with the
+    old ones are not kept. The tied ring and output shaft is among an all-flexible variant's bodies only."""
+    import flexgear.geometry.layout as layout
+    from flexgear.spec import load_variant
+    from flexgear.study.pool import body_keys
+
+    flex = load_variant(VARIANTS / "model7.toml")
+    assert any("tied" in k for k in body_keys(flex))
+    assert not any("tied" in k for k in body_keys(load_variant(VARIANTS / "model1.toml")))
+    out = tmp_path / "results"
+    run_matrix([variants["rigid"]], out, t_end_s=0.6, workers=1, progress=False, runner=fake_runner)
+    assert run_matrix([variants["rigid"]], out, t_end_s=0.6, workers=1, progress=False,
+                      runner=fake_runner)["resumed"].all()
+    monkeypatch.setattr(layout, "GEOMETRY_VERSION", layout.GEOMETRY_VERSION + 1)
+    assert not run_matrix([variants["rigid"]], out, t_end_s=0.6, workers=1, progress=False,
+                          runner=fake_runner)["resumed"].any()
+
+
 def _confine(workdir: str, forbidden: list[str]) -> str:
     """On a Dask worker: run in ``workdir`` and refuse any file access under ``forbidden`` (the caller's
     variant files and output folder), as on a cluster node that does not share the caller's disk."""

@@ -31,8 +31,8 @@ from flexgear.progress import Progress, say
 from flexgear.results import RunResult, save_result
 from flexgear.spec import Variant, load_variant, spec_hash
 
-__all__ = ["Runner", "RunTask", "make_task", "run_input_hash", "run_task", "save_task_result", "failed_result",
-           "execute", "say_progress", "write_table"]
+__all__ = ["Runner", "RunTask", "make_task", "run_input_hash", "body_keys", "run_task", "save_task_result",
+           "failed_result", "execute", "say_progress", "write_table"]
 
 Runner = Callable[..., RunResult]
 
@@ -42,7 +42,9 @@ _POLL_S = 0.2
 
 def run_input_hash(variant: Variant, t_end_s: float | str, error_window_s: float = 0.0) -> str:
     """Hash of everything a run depends on: the variant, its gearbox (without ``[screening]``, except the settling
-    test's fields for a run continued until it settles), t_end (s, or "settled"), the error windows' length."""
+    test's fields for a run continued until it settles), t_end (s, or "settled"), the error windows' length, and
+    the cache keys of the bodies it is built from (:func:`body_keys`): a run made with bodies that a new
+    geometry, mesh or reduction has replaced is not kept."""
     gearbox = dataclasses.replace(variant.gearbox, screening=None)
     if t_end_s != "settled":
         extra: tuple = (float(t_end_s),)
@@ -53,7 +55,23 @@ def run_input_hash(variant: Variant, t_end_s: float | str, error_window_s: float
                  sc.settle_acceleration_floor_m_per_s2)
     if error_window_s > 0:
         extra = (*extra, "error_window", float(error_window_s))
-    return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn")
+    return spec_hash(dataclasses.replace(variant, gearbox=gearbox), *extra, "exudyn", *body_keys(variant))
+
+
+def body_keys(variant: Variant) -> tuple[str, ...]:
+    """The cache keys (flexgear.fe.build.build_key) of the bodies ``variant`` is built from at its mesh level: every
+    component's reduced body (a rigid one takes its mass properties from the same mesh) and the tied ring and output
+    shaft where the variant joins them (flexgear.fe.build.variant_build_items). () when they cannot be named (a bad
+    variant: its run fails with the reason)."""
+    from flexgear.fe.build import build_key, variant_build_items
+    from flexgear.spec import COMPONENT_GEOMETRY
+
+    try:
+        items = {COMPONENT_GEOMETRY[c] for c in variant.components}
+        items |= set(variant_build_items(variant.gearbox, variant.components))
+        return tuple(sorted(build_key(variant.gearbox, item, variant.mesh_level) for item in items))
+    except Exception:  # noqa: BLE001  (a bad variant is refused with its reason when it runs)
+        return ()
 
 
 def _default_runner() -> Runner:
