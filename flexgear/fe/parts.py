@@ -65,11 +65,12 @@ def exchange_form(solid, passes: int = 1):
     metres, as a ``[components_geometry]`` STEP part is read (flexgear.fe.imported.read_solid); ``passes`` times.
 
     OCC's STEP reader starts some faces' edge loops at another edge than the solid built in memory (the toothed
-    loops of a gear's end faces), and Netgen meshes such a face differently. The exchange form is a fixed point of
-    the round trip once the file's digits are all the solid holds: the project's solids are meshed in it, so that a
-    solid exported by ``flexgear export-geometry`` and imported again is meshed exactly as the built-in one. A
-    solid whose faces the reader gives parameters it computes itself (the carrier's, made by Boolean cuts) needs a
-    second pass to reach it. ValueError when the file does not hold exactly one solid."""
+    loops of a gear's end faces), and Netgen meshes such a face differently. The exchange form keeps its loops
+    through a further round trip: the project's solids are meshed in it, so that a solid exported by ``flexgear
+    export-geometry`` and imported again is meshed as the built-in one. Where the reader then leaves every digit as
+    it is (swept helical teeth; the carrier, made by Boolean cuts, after a second pass) the meshes are the same node
+    for node; where it computes some edges' parameters anew at each read (extruded spur teeth, at round-off) they
+    differ by the mesh's round-off variation. ValueError when the file does not hold exactly one solid."""
     from netgen.occ import OCCGeometry, Pnt
 
     for _ in range(passes):

@@ -30,9 +30,10 @@ Nothing lost: every file is written atomically and a run folder is complete once
 there (written last). A matrix killed at any moment (SIGKILL included) resumes when started again: a
 run is skipped when its folder holds an ``ok`` result whose ``input_hash`` equals the hash of the
 variant (the gearbox without its ``[screening]`` table, which is post-processing only), the simulated
-end time and the cache keys of its bodies (flexgear.study.pool.body_keys); the temporary files of interrupted writes are deleted. A variant whose file is bad (SpecError),
-whose runner returns a failed result (divergence, wall-time budget), raises, or kills its worker process
-is recorded as failed with its reason while the others go on. CPU time is the worker process's
+end time and the cache keys of its bodies (flexgear.study.pool.body_keys); the temporary files of interrupted
+writes are deleted. A variant whose file is bad (SpecError), whose runner returns a failed result (divergence,
+wall-time budget), raises, or kills its worker process is recorded as failed with its reason while the others go
+on. CPU time is the worker process's
 ``time.process_time`` (all its threads).
 """
 
