@@ -188,7 +188,8 @@ def test_model5_planets_dropped_modes_answer_their_bearing_force():
     """Model 5 (flexible planets and shafts), impact law, a short run: cut-off 8 against every mode dynamic. A
     planet on its Table 2 bearing (about 1.6 kHz) is above resonance at the 4.4 kHz mesh frequency, so its inertia
     takes most of the 1x mesh load. With the dropped modes answering the bearing's force every mesh force keeps its
-    mean within 0.1 % and every mesh force and load deflection its 1x amplitude within 2 % (the agreement rule)."""
+    mean within 0.1 % and every mesh force and load deflection its 1x amplitude within 2 % (the agreement rule); the
+    load deflections' means move at most as far as the residual's spin dependence allows."""
     from flexgear.mbs.run import run_variant
     from flexgear.study.agreement import signal_agreement
 
@@ -208,11 +209,34 @@ def test_model5_planets_dropped_modes_answer_their_bearing_force():
     assert len(meshes) == 20
     new = table.loc[meshes]
     forces = [c for c in meshes if "mesh_force" in c]
-    assert new.loc[forces, "mean_diff"].abs().max() < 1e-3  # measured within 4.8e-4
-    # the load deflections' means: within 0.25 %, of either sign planet by planet: the residual is averaged over
-    # the gear's spin, the window is 0.6 of a planet's revolution (0.1 % not met)
-    assert new.loc[[c for c in meshes if c not in forces], "mean_diff"].abs().max() < 3e-3
+    assert new.loc[forces, "mean_diff"].abs().max() < 1e-3
+    # the load deflections' means: the residual is the spin average of C(phi), the window 0.6 of a planet's
+    # revolution, so their error is at most the residual's spread over the spin against the planet's whole
+    # compliance at its contacts (of either sign planet by planet)
+    deflections = [c for c in meshes if c not in forces]
+    assert new.loc[deflections, "mean_diff"].abs().max() < _planet_residual_bound(g, cut_off)
     assert new["amp_diff"].abs().max() < 2e-2
+
+
+def _planet_residual_bound(gearbox, cut_off: float) -> float:
+    """The largest change of a planet's load deflection that averaging its residual compliance over the spin can
+    make in any window: max_phi |C_res(phi) - C_res| (the residual's ``spread`` times its largest diagonal term)
+    over the planet's whole seat-relative compliance at each contact (every mode dropped), the largest over its
+    contacts."""
+    from flexgear.fe.reduced import component_reduced_body
+    from flexgear.theory import theory
+
+    body = component_reduced_body(gearbox, "planet", "coarse")
+    keep = body.modes_below(cut_off * theory(gearbox).mesh_frequency)
+    geo = gear_set_geometry(gearbox)
+    psi = geo.planet_angles[0]
+    stand_in = {"planet1": types.SimpleNamespace(position=geo.centre_distance * np.array([np.cos(psi), np.sin(psi),
+                                                                                           0.0]), reduced=body)}
+    args = (mesh_contacts(gearbox), stand_in)
+    order, band = gearbox.reduction_assumed.contact_fourier_order, gearbox.gears.normal_module_m
+    whole = residual_compliance(*args, {"planet1": dropped_modes(gearbox, body, 0, "planet")}, order, band)
+    rest = residual_compliance(*args, {"planet1": dropped_modes(gearbox, body, keep, "planet")}, order, band)
+    return float(rest.spread * np.diag(rest.matrix)[rest.rows].max() / np.diag(whole.matrix)[whole.rows].min())
 
 
 @pytest.mark.parametrize("orders", [4.0, 8.0])
