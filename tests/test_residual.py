@@ -42,6 +42,13 @@ def test_truncated_body_keeps_the_invariants_of_its_lowest_modes(gearbox):
     assert kept.n_modes == 3 and body.modes_below(body.frequencies_hz[5] * (1 + 1e-9)) == 6
 
 
+def _planet1_centre(gearbox) -> np.ndarray:
+    """Planet 1's centre [m] in the gearbox frame: on the centre distance at its polar angle."""
+    geo = gear_set_geometry(gearbox)
+    psi = geo.planet_angles[0]
+    return geo.centre_distance * np.array([np.cos(psi), np.sin(psi), 0.0])
+
+
 @pytest.mark.parametrize("gear", ["sun", "planet", "ring"])
 def test_seat_relative_rows_give_the_held_seat_compliance(gearbox, gear):
     """All modes 'dropped': C = sum_j a a^T / lambda_j must be the gear's compliance with its seat held."""
@@ -50,10 +57,8 @@ def test_seat_relative_rows_give_the_held_seat_compliance(gearbox, gear):
     body = component_reduced_body(gearbox, gear, "coarse")
     seat = gear_seat(body, gear)  # bore; the ring's bolt patches
     contacts = mesh_contacts(gearbox)
-    geo = gear_set_geometry(gearbox)
     name = "planet1" if gear == "planet" else gear
-    psi = geo.planet_angles[0]
-    centre = geo.centre_distance * np.array([np.cos(psi), np.sin(psi), 0.0]) if gear == "planet" else np.zeros(3)
+    centre = _planet1_centre(gearbox) if gear == "planet" else np.zeros(3)
     stand_in = {name: types.SimpleNamespace(position=centre, reduced=body)}
     order = gearbox.reduction_assumed.contact_fourier_order
     # one spin angle (phi = 0): the held-seat solve below sees the gear at rest
@@ -81,9 +86,7 @@ def test_seat_loads_reduce_to_the_seat_relative_form_under_the_quasi_static_reac
     body = component_reduced_body(gearbox, "planet", "coarse")
     keep = body.modes_below(8 * theory(gearbox).mesh_frequency)
     dropped = {"planet1": dropped_modes(gearbox, body, keep, "planet")}
-    geo = gear_set_geometry(gearbox)
-    psi = geo.planet_angles[0]
-    centre = geo.centre_distance * np.array([np.cos(psi), np.sin(psi), 0.0])
+    centre = _planet1_centre(gearbox)
     stand_in = {"planet1": types.SimpleNamespace(position=centre, reduced=body)}
     contacts = mesh_contacts(gearbox)
     args = (contacts, stand_in, dropped, gearbox.reduction_assumed.contact_fourier_order,
@@ -228,10 +231,7 @@ def _planet_residual_bound(gearbox, cut_off: float) -> float:
 
     body = component_reduced_body(gearbox, "planet", "coarse")
     keep = body.modes_below(cut_off * theory(gearbox).mesh_frequency)
-    geo = gear_set_geometry(gearbox)
-    psi = geo.planet_angles[0]
-    stand_in = {"planet1": types.SimpleNamespace(position=geo.centre_distance * np.array([np.cos(psi), np.sin(psi),
-                                                                                           0.0]), reduced=body)}
+    stand_in = {"planet1": types.SimpleNamespace(position=_planet1_centre(gearbox), reduced=body)}
     args = (mesh_contacts(gearbox), stand_in)
     order, band = gearbox.reduction_assumed.contact_fourier_order, gearbox.gears.normal_module_m
     whole = residual_compliance(*args, {"planet1": dropped_modes(gearbox, body, 0, "planet")}, order, band)
