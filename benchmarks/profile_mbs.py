@@ -2,7 +2,8 @@
 Jacobians per step, and the Python functions (cProfile)?
 
 Run: nice -n 5 python benchmarks/profile_mbs.py model1 [floor] [model7] [--t-end 0.02] [--cprofile]
-     [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints] [--midlife on|off|both] [--rounds 3]
+     [--trace-newton 6] [--blas-threads 2] [--frozen contacts joints] [--held BODY ...]
+     [--midlife on|off|both] [--rounds 3]
 
 Each case is built as flexgear.mbs.run.run_variant builds it (``floor``: model 1 with a constant mesh
 stiffness and no friction, bench_speed.floor_variant), warmed with a 1e-4 s run, then solved as a run solves it
@@ -14,6 +15,9 @@ per case: every non-zero timer's share applied to the solve's CPU time, in secon
 ``--frozen contacts joints``: the flexible gears' contact columns (flexgear.mbs.contact_kinematics.ContactKinematics)
 and the turning joints' coefficients (flexgear.mbs.joints.TurningBlocks) written at the first step only (wrong physics:
 a bound on what the Newton iterations and Jacobians that their change from step to step costs).
+``--held BODY ...``: the same bound for the named bodies only (shell patterns: ``'planet*'``): their contact columns
+and the turning joints' and seats' blocks on them keep their first-step values (a joint is held when either of its
+bodies is).
 ``--midlife off``: without the production's mid-life Jacobian (flexgear.mbs.newton.MidlifeJacobian); ``both``: each
 case with and without it, side by side in every round; ``--rounds``: rounds, the medians of CPU per step printed last.
 """
@@ -30,6 +34,8 @@ import re
 import sys
 import time
 import warnings
+from collections.abc import Sequence
+from fnmatch import fnmatch
 from pathlib import Path
 
 from bench_speed import floor_variant, load_average, shortened
@@ -42,8 +48,8 @@ from flexgear.spec import load_variant
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = False, midlife: bool = True
-          ) -> tuple[str, float, float]:
+def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = False, midlife: bool = True,
+          held: Sequence[str] = ()) -> tuple[str, float, float]:
     """Build and solve; returns Exudyn's printed statistics, wall and CPU time of the solve."""
     import exudyn as exu
 
@@ -63,6 +69,8 @@ def solve(variant, t_end: float, timers: bool, profile: bool, trace: bool = Fals
             warnings.simplefilter("ignore", DeprecationWarning)
             settings.displayComputationTime = True
             settings.displayStatistics = True
+    if held:
+        hold_bodies(mbs, held)
     if not sv.reference:  # as flexgear.mbs.run's post-step guard drives it
         economy = JacobianEconomy(sv.jacobian_cost_iterations)
         mbs.SetPostStepUserFunction(lambda mbs, t: economy(mbs) or True)
@@ -96,6 +104,31 @@ def _frozen_classes() -> dict:
     from flexgear.mbs.joints import TurningBlocks
 
     return {"contacts": ContactKinematics, "joints": TurningBlocks}
+
+
+def hold_bodies(mbs, patterns: Sequence[str]) -> None:
+    """The turning coefficients of the bodies matching ``patterns`` at their first-step values (``--held``): their
+    spin per drive angle set to zero in the contact columns (flexgear.mbs.contact_kinematics.ContactKinematics) and in
+    the blocks of the joints and seats whose constraint names them (flexgear.mbs.joints.TurningBlocks)."""
+    import numpy as np
+
+    from flexgear.mbs.contact_kinematics import ContactKinematics
+    from flexgear.mbs.joints import TurningBlocks
+
+    def named(name: str) -> bool:
+        return any(fnmatch(name, f) for p in patterns for f in (p, f"{p}_*", f"*_{p}_*", f"*_{p}"))
+
+    for u in turning_updaters(mbs):
+        if isinstance(u, ContactKinematics):
+            u.spin[[named(b) for b in u.bodies]] = 0.0  # the compiled kernel reads this array
+        elif isinstance(u, TurningBlocks):
+            start = 0
+            for obj, _, view in u.views:
+                if named(mbs.GetObject(obj)["name"]):
+                    u.spin[start:start + view.shape[1]] = 0.0
+                start += view.shape[1]
+            u.spins, u.spin_index = np.unique(u.spin, return_inverse=True)
+            u._args = (u.ramp_time, u.drive_speed, u.const, u.cos_part, u.sin_part, u.spin_index, u.spins, u.target)
 
 
 def freeze_after_first_step(cls) -> None:
@@ -158,6 +191,8 @@ def main() -> None:
                     help="BLAS threads during build and solve (flexgear.mbs.run.run_variant uses 1)")
     ap.add_argument("--frozen", nargs="+", choices=("contacts", "joints"), default=(),
                     help="write these constraint coefficients at the first step only (a cost bound, wrong physics)")
+    ap.add_argument("--held", nargs="+", default=(), metavar="BODY",
+                    help="hold the turning coefficients of these bodies only (shell patterns; a bound, wrong physics)")
     ap.add_argument("--midlife", choices=("on", "off", "both"), default="on",
                     help="the mid-life Jacobian (production: on); both: each case with and without it")
     ap.add_argument("--rounds", type=int, default=1, help="rounds over the cases (medians printed last)")
@@ -177,8 +212,8 @@ def main() -> None:
             load_variant(folder / f"{case}.toml")
         if a.ramp is not None:
             variant = shortened(variant, a.ramp, max(a.t_end, a.ramp))
-        solve(variant, 1e-4, False, False, midlife=midlife)
-        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0, midlife)
+        solve(variant, 1e-4, False, False, midlife=midlife, held=a.held)
+        text, wall, cpu = solve(variant, a.t_end, True, a.cprofile, a.trace_newton > 0, midlife, a.held)
         if len(modes) > 1:
             case = f"{case} (mid-life Jacobian {'on' if midlife else 'off'})"
         if a.trace_newton:
