@@ -397,9 +397,12 @@ def main(argv: list[str] | None = None) -> int:
     try:
         return args.func(args)
     except (ValueError, OSError) as exc:  # SpecError is a ValueError; missing/unreadable paths are OSErrors
-        text = " ".join(str(exc).split())
-        print(f"error: {text}", file=sys.stderr)
+        print(f"error: {' '.join(str(exc).split())}", file=sys.stderr)
         return 2
+    except RuntimeError as exc:  # a computation that failed (Exudyn's solver errors are RuntimeErrors)
+        kind = "" if type(exc) is RuntimeError else f"{type(exc).__name__}: "
+        print(f"error: {kind}{' '.join(str(exc).split())}", file=sys.stderr)
+        return 1
 
 
 if __name__ == "__main__":

@@ -61,6 +61,22 @@ def test_compare_names_a_wrong_folder_in_one_line(tmp_path, capsys):
     assert err.count("\n") == 1 and str(tmp_path) in err and "run folder" in err
 
 
+def test_a_computation_that_fails_ends_in_one_line(monkeypatch, capsys):
+    """A solver that gives up (Exudyn's errors are RuntimeErrors) ends the command with exit code 1 and one line
+    naming it, not a traceback."""
+    import exudyn
+
+    import flexgear.modal.period
+
+    def fails(*args, **kwargs):
+        raise exudyn.SolverError("SolveStatic terminated due to errors\n  more")
+
+    monkeypatch.setattr(flexgear.modal.period, "period_modes", fails)
+    assert main(["modes", str(VARIANTS / "model1.toml")]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and err.startswith("error: SolverError: SolveStatic terminated due to errors more")
+
+
 def test_run_warns_inside_the_ramps_and_saves_its_inputs(tmp_path, capsys):
     pytest.importorskip("exudyn")
     shutil.copy(VARIANTS / "gearbox.toml", tmp_path / "gearbox.toml")

@@ -255,3 +255,30 @@ def test_planar_pair_modes_equal_the_lumped_models(example_cache, speed_rpm):
     assert len(m) == np.count_nonzero(keep) >= 4
     np.testing.assert_allclose(m.frequencies_hz, lumped.frequencies_hz[keep], rtol=1e-9)
     assert list(m.kinds) == list(np.asarray(lumped.kinds)[keep])
+
+
+def test_flexible_pairs_modes_over_one_revolution(example_cache):
+    """With only the wheel flexible the pair's linearisation is periodic in one revolution of the wheel (its contact
+    columns turn with it; z_w mesh periods): the modes at t* + P equal those at t* within 1e-9, half a revolution on
+    they do not. The example's all-flexible pair (`flexgear modes`): the static equilibrium is found at every
+    sample of the revolution (Newton stalls at round-off, a few 1e-10 of the load, at some of the gears' angles)."""
+    import dataclasses
+
+    from flexgear.modal import linearize, modes
+    from flexgear.modal.period import period_modes, period_samples
+
+    variant = fg.load_variant(EXAMPLE / "flexible.toml")
+    wheel = dataclasses.replace(variant, components={k: "flexible" if k == "planets" else "rigid"
+                                                     for k in variant.components})
+    first = linearize(wheel)
+    times = period_samples(first, 4)
+    period = 4 * (times[1] - times[0])
+    g, lc = variant.gearbox.gears, variant.gearbox.load_case
+    assert period == pytest.approx(60.0 / (lc.input_speed_rpm * g.sun_teeth / g.planet_teeth), rel=1e-12)
+    f0 = modes(first, 5000.0).frequencies_hz
+    f_full = modes(linearize(wheel, t_star=float(times[0] + period)), 5000.0).frequencies_hz
+    f_half = modes(linearize(wheel, t_star=float(times[2])), 5000.0).frequencies_hz
+    np.testing.assert_allclose(f_full, f0, rtol=1e-9)
+    assert len(f_half) == len(f0) and np.max(np.abs(f_half - f0) / f0) > 1e-6  # the angle matters
+    found = period_modes(variant, None, 5000.0)
+    assert len(found) > 0 and np.all(np.isfinite(found.frequencies_hz)) and np.all(np.isfinite(found.spread_pct))
