@@ -131,7 +131,15 @@ def _linear_models(variant: Any, speeds_rpm: np.ndarray, linearization: str) -> 
     return nodes, [models[0]] + [_in_coordinates(lm, models[0]) for lm in models[1:]]
 
 
-def _in_coordinates(lm: Any, ref: Any, rtol: float = 1e-6) -> Any:
+SAME_COORDINATES_RTOL = 1e-6
+"""Two linearisations have the same independent coordinates when the least-squares map between their null-space
+bases (:func:`_in_coordinates`) reproduces one from the other within this share of its largest entry; the contact
+and output rows drawn from the mapped basis then agree to the same share of the basis' largest entry."""
+
+_EACH_HINT = "use linearization='each' (flexgear sweep-speed --linearization each)"
+
+
+def _in_coordinates(lm: Any, ref: Any, rtol: float = SAME_COORDINATES_RTOL) -> Any:
     """``lm`` in the independent coordinates of ``ref``: the constraints' column-pivoted QR may choose other
     independent coordinates at another speed, spanning the same motions q = B z. With B_ref = B T (least squares,
     checked to ``rtol``), z = T z_ref and each matrix A becomes T^T A T."""
@@ -140,12 +148,12 @@ def _in_coordinates(lm: Any, ref: Any, rtol: float = 1e-6) -> Any:
     if lm.basis.shape[0] != ref.basis.shape[0]:
         raise ValueError(f"the model has {ref.basis.shape[0]} coordinates at {ref.speed_rpm:g} rpm and "
                          f"{lm.basis.shape[0]} at {lm.speed_rpm:g} rpm (a speed-dependent reduction): no interpolation "
-                         "between them; use linearization='each'")
+                         f"between them; {_EACH_HINT}")
     t = np.linalg.lstsq(lm.basis, ref.basis, rcond=None)[0]
     basis = lm.basis @ t
     if np.abs(basis - ref.basis).max() > rtol * np.abs(ref.basis).max():
         raise ValueError(f"the linearisations at {ref.speed_rpm:g} and {lm.speed_rpm:g} rpm span different motions; "
-                         "use linearization='each'")
+                         f"{_EACH_HINT}")
     return dataclasses.replace(lm, mass=t.T @ lm.mass @ t, damping=t.T @ lm.damping @ t,
                                gyroscopic=t.T @ lm.gyroscopic @ t, stiffness=t.T @ lm.stiffness @ t, basis=basis,
                                coordinates=ref.coordinates)
@@ -354,12 +362,10 @@ def _spin_operating(models: list[Any], nodes: np.ndarray, selectors: Any, law_te
 
     a, b = models
     sel_a, sel_b = selectors(a), selectors(b)
+    scale = SAME_COORDINATES_RTOL * np.abs(a.basis).max()  # the rows are drawn from the mapped basis
     for x, y in zip(sel_a[:3], sel_b[:3], strict=True):
-        # entries far below the largest are round-off of the null-space basis (1e-11 of it for the flexible
-        # planetary's carrier-frame basis): compared against the largest entry
-        if not np.allclose(x, y, rtol=1e-9, atol=1e-9 * max(np.abs(x).max(), 1e-300)):
-            raise ValueError("the two linearisations select different contact or output coordinates: use "
-                             "linearization='each'")
+        if np.abs(np.asarray(x) - np.asarray(y)).max() > scale:
+            raise ValueError(f"the two linearisations select different contact or output coordinates: {_EACH_HINT}")
     rows, acc, te, _ = sel_a
 
     def terms(lm: Any, sel: tuple) -> dict[str, np.ndarray]:
