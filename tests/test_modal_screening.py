@@ -35,7 +35,9 @@ def test_shares_in_unit_interval_rigid_components_zero(screened):
     for c in ("input_shaft", "planets", "output_shaft"):
         assert s[c] == 0.0
     assert s["sun"] > 0.0 and s["ring"] > 0.0
+    np.testing.assert_array_equal(t.judged, [c in ("sun", "ring") for c in t.index])  # model 4's flexible ones
     np.testing.assert_array_equal(t.must_be_flexible, s > screened.threshold)
+    assert screened.reason.endswith("; not judged, rigid in model4: input_shaft, planets, output_shaft")
     assert screened.weights.sum() == pytest.approx(1.0) and np.all(screened.weights > 0.0)
     assert screened.f_band_hz == pytest.approx(10 * screened.f_mesh_hz)
     assert np.all(screened.modes.frequencies_hz <= screened.f_band_hz)
@@ -59,6 +61,17 @@ def test_threshold_bounds(model4_linear):
     assert everything.recommended == "model4"
     nothing = modal_screening(model4_linear, threshold=1.0)
     assert not nothing.table.must_be_flexible.any() and nothing.recommended == "model1"
+
+
+def test_a_variant_without_flexible_components_is_refused_before_its_linearisation(monkeypatch):
+    """Every component rigid (model 1): nothing to judge; refused in one line naming the file and the field, before
+    the linearisation (which would fail the test here)."""
+    import flexgear.modal
+
+    monkeypatch.setattr(flexgear.modal, "linearize", None)
+    with pytest.raises(ValueError, match=r"model1\.toml: field 'components': .* model1 makes none flexible") as e:
+        modal_screening(load_variant(VARIANTS / "model1.toml"))
+    assert "\n" not in str(e.value)
 
 
 def test_recommend_all_flexible_when_none_fits():

@@ -161,7 +161,8 @@ def cmd_screening(a: argparse.Namespace) -> int:
     print(f"{variant.name}: {len(result.weights)} modes up to {result.f_band_hz:g} Hz (mesh frequency "
           f"{result.f_mesh_hz:g} Hz), threshold {result.threshold:g}")
     for _, row in result.table.iterrows():
-        verdict = "must be flexible" if row.must_be_flexible else "may be rigid"
+        verdict = ("must be flexible" if row.must_be_flexible else "may be rigid" if row.judged else
+                   f"not judged (rigid in {variant.name})")
         print(f"  {row.component:<13} {row.weighted_elastic_strain_share:7.4f}  {verdict}")
     print(f"recommended: {result.recommended} ({result.reason})")
     print(f"-> {out / 'modal_screening.csv'}")

@@ -7,7 +7,9 @@ resonance peak (damping ratio zeta >= 1/sqrt(2), flexgear.modal.campbell_diagram
 
 Elastic share. For a component c and a mode j, s_cj is the share of the mode's strain energy in c's own elastic
 coordinates (flexgear.modal.eigenmodes: column ``strain_<c>_elastic``; the planets' shares are added into one component,
-``planets``, as in Table 3; a component that is rigid in the variant has none: s_cj = 0).
+``planets``, as in Table 3; a component that is rigid in the variant has none: s_cj = 0, and it is not judged: the
+screening cannot see whether its deformation matters, so it is marked so, never "may be rigid", and the reason names
+it. A variant with no flexible component is refused).
 
 Weight. A mode matters as much as the mesh excitation can amplify it: a harmonic force at k f_m drives mode j (a
 single degree of freedom, frequency f_j, damping ratio zeta_j) with the dynamic amplification
@@ -82,10 +84,10 @@ class ModalScreening:
     """The screening's result (module docstring).
 
     ``table``: component (Table 3's, and the planetary stage's carrier where it is flexible),
-    weighted_elastic_strain_share [-], must_be_flexible; ``recommended``: the recommended variant's name;
-    ``reason``: one line; ``modes``: the modes of the band; ``weighted``: the indices of those with a resonance
-    peak, ``weights``: their w_j; ``f_mesh_hz``, ``f_band_hz`` [Hz], ``threshold`` [-]; ``candidates``: Table 3's
-    variants {name: flexible components}.
+    weighted_elastic_strain_share [-], judged (flexible in the screened variant), must_be_flexible;
+    ``recommended``: the recommended variant's name; ``reason``: one line; ``modes``: the modes of the band;
+    ``weighted``: the indices of those with a resonance peak, ``weights``: their w_j; ``f_mesh_hz``, ``f_band_hz``
+    [Hz], ``threshold`` [-]; ``candidates``: Table 3's variants {name: flexible components}.
     """
 
     table: pd.DataFrame
@@ -177,6 +179,12 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     """
     from flexgear.modal import linearize, mesh_frequency_hz, modes, resonant
 
+    given = variant_flexible_all.variant if isinstance(variant_flexible_all, LinearModel) else variant_flexible_all
+    flexible = flexible_components(given)
+    if not flexible:  # before the linearisation: nothing to judge
+        raise ValueError(f"{given.source}: field 'components': the modal screening judges the components a variant "
+                         f"makes flexible and {given.name} makes none flexible; screen the all-flexible variant "
+                         "(Table 3's model 7)")
     model = variant_flexible_all if isinstance(variant_flexible_all, LinearModel) else linearize(variant_flexible_all)
     variant = model.variant
     f_mesh = mesh_frequency_hz(variant.gearbox, model.speed_rpm)
@@ -198,10 +206,14 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
         if column in found.energy:
             shares[_table3_component(c)] += float(weights @ found.energy[column].to_numpy()[keep])
     table = pd.DataFrame({"component": list(shares), "weighted_elastic_strain_share": list(shares.values())})
-    table["must_be_flexible"] = table.weighted_elastic_strain_share > threshold
+    table["judged"] = table.component.isin(flexible)
+    table["must_be_flexible"] = table.judged & (table.weighted_elastic_strain_share > threshold)
     must = tuple(table.component[table.must_be_flexible])
     if candidates is None:
         folder = Path(variants_dir) if variants_dir is not None else Path(variant.source).parent
         candidates = folder_variants(folder, variant.gearbox.gears)
     name, reason = recommend(must, candidates)
+    unseen = tuple(table.component[~table.judged])
+    if unseen:
+        reason += f"; not judged, rigid in {variant.name}: {', '.join(unseen)}"
     return ModalScreening(table, name, reason, found, keep, weights, f_mesh, band, threshold, candidates)
