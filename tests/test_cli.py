@@ -55,6 +55,15 @@ def test_compare_refuses_unequal_load_cases(tmp_path, capsys):
     assert "warning" in capsys.readouterr().err
 
 
+def test_compare_takes_two_settled_runs_whatever_their_end_times(tmp_path):
+    """Runs continued until they settled end where each settles: the same load case all the same."""
+    a = _results(tmp_path / "A", ["m1"], t_end_s=0.2028, settled=True)
+    b = _results(tmp_path / "B", ["m1"], t_end_s=0.2034, settled=True)
+    assert main(["compare", str(a / "m1"), str(b / "m1")]) == 0
+    c = _results(tmp_path / "C", ["m1"], t_end_s=0.2034, settled=True, ramp_time_s=0.05)
+    assert main(["compare", str(a / "m1"), str(c / "m1")]) == 2  # a load case that differs is still refused
+
+
 def test_compare_names_a_wrong_folder_in_one_line(tmp_path, capsys):
     assert main(["compare", str(tmp_path), str(tmp_path / "nowhere")]) == 2
     err = capsys.readouterr().err

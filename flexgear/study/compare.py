@@ -181,18 +181,24 @@ _LOAD_CASE_KEYS = (("t_end_s", "end time [s]"), ("step_size_s", "step [s]"), ("r
 
 def load_case_differences(a: RunResult, b: RunResult, rel: float = 1e-9) -> list[str]:
     """The load-case values in which two runs differ (end time, step, ramps, theory speed and torque):
-    compared runs must share their load case, or Tables 6 and 7 compare different things."""
+    compared runs must share their load case, or Tables 6 and 7 compare different things. Two runs continued until
+    they settled (``meta["settled"]``) end where each settles: their end times are not compared."""
     def value(meta: dict, dotted: str) -> float | None:
         for key in dotted.split("."):
             meta = meta.get(key) if isinstance(meta, dict) else None
         return None if meta is None else float(meta)
 
+    settled = bool(a.meta.get("settled")) and bool(b.meta.get("settled"))
     out = []
     for key, label in _LOAD_CASE_KEYS:
+        if settled and key == "t_end_s":
+            continue
         va, vb = value(a.meta, key), value(b.meta, key)
         if va is not None and vb is not None and not math.isclose(va, vb, rel_tol=rel):
             out.append(f"{label} {va:g} vs {vb:g}")
     return out
+
+
 HARMONIC_PROMINENCE = 10.0
 """A harmonic k of the mesh frequency is "present" when its amplitude is this many times the median
 amplitude of the spectrum between (k - 1/2) and (k + 1/2) times the mesh frequency (20 dB)."""
