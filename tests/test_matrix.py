@@ -276,3 +276,27 @@ def test_part_files_travel_with_the_task_and_land_in_the_run_folders_inputs(gear
     # without the part in the task the worker would look for the caller's file, which is gone
     bare = run_task(dataclasses.replace(task, parts=()), _part_runner)
     assert not bare.ok and "sun.vtu" in bare.meta["reason"]
+
+
+def _body(n_modes: int) -> int:
+    if n_modes < 0:
+        raise RuntimeError("no mesh")
+    return n_modes
+
+
+def test_cold_bodies_are_reported_as_they_are_built(capsys):
+    """A newcomer's first matrix builds its bodies before any run ends: each body's line says when it is built (or
+    why not)."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    from flexgear.progress import Progress
+    from flexgear.study.pool import _run_pool
+
+    first = [(("build", "ring+output_shaft", "coarse", 0), _body, (63,)),
+             (("build", "sun", "coarse", 1), _body, (-1,))]
+    with ThreadPoolExecutor(1) as pool:
+        _, _, done = _run_pool([], pool.submit, None, True, Progress(0, "matrix", enabled=False), first=first)
+    assert done[first[0][0]] == 63 and isinstance(done[first[1][0]], RuntimeError)
+    err = capsys.readouterr().err
+    assert "ring+output_shaft (coarse) body built (" in err
+    assert "sun (coarse) body not built (RuntimeError: no mesh) (" in err

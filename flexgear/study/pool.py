@@ -233,6 +233,11 @@ def _run_pool(tasks: list[RunTask], submit: Callable, runner: Runner | None, pro
                 done[key] = fut.result()
             except Exception as exc:  # recorded by the caller: the screenings of the runs do not depend on it
                 done[key] = exc
+            if key[0] == "build":  # a cold body (flexgear.study.matrix): the runs that need it start now
+                outcome = "built" if not isinstance(done[key], BaseException) else (
+                    f"not built ({type(done[key]).__name__}: {done[key]})")
+                say_progress(progress, f"{key[1]} ({key[2]}) body {outcome} "
+                                       f"({time.perf_counter() - started:.0f} s elapsed)")
         finished = [f for f in futures if f.done()]
         for fut in finished:
             task = futures.pop(fut)
