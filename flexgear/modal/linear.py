@@ -352,9 +352,8 @@ operating point by about that share, far below any modal quantity."""
 
 
 def _solve_static(mbs, ss) -> bool:
-    """Exudyn's static solve with :func:`static_solver_settings`, again at each of
-    :data:`RETRY_RELATIVE_TOLERANCES` while Newton stalls at round-off; each attempt from the same start. False when
-    none converges."""
+    """Exudyn's static solve with :func:`static_solver_settings`, again at each of :data:`RETRY_RELATIVE_TOLERANCES`
+    while Newton stalls at round-off, each attempt from the same start; False when none converges."""
     import exudyn as exu
 
     start = np.array(mbs.systemData.GetODE2Coordinates())
