@@ -39,8 +39,9 @@ mkstemp alone would give 0600, unreadable by others."""
 
 
 def cache_dir() -> Path:
-    """Cache folder: ``$FLEXGEAR_CACHE_DIR`` or ``meshes/`` of the project (created on demand)."""
-    path = Path(os.environ.get("FLEXGEAR_CACHE_DIR", Path(__file__).resolve().parents[1] / "meshes"))
+    """Cache folder: ``$FLEXGEAR_CACHE_DIR`` or, where it is unset or empty, ``meshes/`` of the project (created on
+    demand)."""
+    path = Path(os.environ.get("FLEXGEAR_CACHE_DIR") or Path(__file__).resolve().parents[1] / "meshes")
     path.mkdir(parents=True, exist_ok=True)
     return path
 

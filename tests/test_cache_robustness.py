@@ -173,6 +173,18 @@ def _wait_for(path: Path, timeout: float = 120.0) -> None:
         time.sleep(0.02)
 
 
+def test_an_empty_cache_variable_means_the_projects_cache(monkeypatch, tmp_path):
+    """``FLEXGEAR_CACHE_DIR=`` (set, empty) is the default folder, not the working directory."""
+    from flexgear.cache import cache_dir
+
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.delenv("FLEXGEAR_CACHE_DIR", raising=False)
+    default = cache_dir()
+    monkeypatch.setenv("FLEXGEAR_CACHE_DIR", "")
+    assert cache_dir() == default == ROOT / "meshes"
+    assert not any(tmp_path.iterdir())
+
+
 def test_two_processes_build_a_missing_entry_once(tmp_path):
     """The second process asks while the first is building (the first writes its file only after the second has
     found it missing): the second waits for the lock and reads the first's file."""
