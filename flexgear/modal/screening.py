@@ -179,13 +179,14 @@ def modal_screening(variant_flexible_all: Variant | LinearModel, f_band_hz: floa
     """
     from flexgear.modal import linearize, mesh_frequency_hz, modes, resonant
 
-    given = variant_flexible_all.variant if isinstance(variant_flexible_all, LinearModel) else variant_flexible_all
+    linear = isinstance(variant_flexible_all, LinearModel)
+    given = variant_flexible_all.variant if linear else variant_flexible_all
     flexible = flexible_components(given)
     if not flexible:  # before the linearisation: nothing to judge
         raise ValueError(f"{given.source}: field 'components': the modal screening judges the components a variant "
                          f"makes flexible and {given.name} makes none flexible; screen the all-flexible variant "
                          "(Table 3's model 7)")
-    model = variant_flexible_all if isinstance(variant_flexible_all, LinearModel) else linearize(variant_flexible_all)
+    model = variant_flexible_all if linear else linearize(given)
     variant = model.variant
     f_mesh = mesh_frequency_hz(variant.gearbox, model.speed_rpm)
     band = 10.0 * f_mesh if f_band_hz is None else float(f_band_hz)
